@@ -1,0 +1,116 @@
+// Structs that cross between host and device, defined once.
+// Included by the OpenCL program (first in the source list) and by the host inside
+// namespace candela::dev (host/device_types.hpp), which static_asserts every layout.
+// Only 4-byte scalars and arrays of them: no float3, no vector types, explicit padding.
+
+#ifndef CANDELA_DEVICE_TYPES_H
+#define CANDELA_DEVICE_TYPES_H
+
+// Material types (switch-dispatched in bsdf.cl)
+#define MATERIAL_DIFFUSE 0u
+
+// Light types (light-selection table in lights.cl)
+#define LIGHT_TRIANGLE 0u
+#define LIGHT_BACKGROUND 1u
+
+// Integration strategies (no MIS: each light path is counted by exactly one of them)
+#define STRATEGY_NEE 0u
+#define STRATEGY_BSDF 1u
+
+// Texture wrap modes (glTF sampler wrapS / wrapT)
+#define WRAP_REPEAT 0u
+#define WRAP_CLAMP 1u
+#define WRAP_MIRROR 2u
+
+#define NO_TEXTURE (-1)
+
+// BVH node, 32 bytes. Interior: count == 0, children at `left` and `right`.
+// Leaf: count > 0 triangles starting at `first` (left == first).
+typedef struct {
+  float bmin[3];
+  int left;  // interior: left child; leaf: first triangle
+  float bmax[3];
+  int right;  // interior: right child; leaf: -(triangle count)
+} BvhNode;
+
+// Triangle positions in BVH order, 48 bytes.
+typedef struct {
+  float v0[3];
+  unsigned int material;
+  float v1[3];
+  unsigned int prim;  // index into TriangleShading (original order)
+  float v2[3];
+  unsigned int pad0;
+} Triangle;
+
+// Per-vertex shading data of one triangle, 64 bytes.
+typedef struct {
+  float n0[3];
+  float uv0_u;
+  float n1[3];
+  float uv0_v;
+  float n2[3];
+  float uv1_u;
+  float uv1_v;
+  float uv2_u;
+  float uv2_v;
+  float pad0;
+} TriangleShading;
+
+// Material, 64 bytes. Colours are linear RGB.
+typedef struct {
+  unsigned int type;  // MATERIAL_*
+  int base_color_texture;  // index into TextureInfo or NO_TEXTURE
+  unsigned int double_sided;
+  unsigned int pad0;
+  float base_color[4];  // rgba factor
+  float emission[4];  // rgb radiance (factor x strength), w unused
+  float params[4];  // reserved: roughness, metallic, ior, anisotropy
+} Material;
+
+// A texture inside the shared texel array (linear RGBA float4 texels), 16 bytes.
+typedef struct {
+  unsigned int offset;  // first texel
+  unsigned int width;
+  unsigned int height;
+  unsigned int wrap;  // wrap_s | wrap_t << 8
+} TextureInfo;
+
+// One entry of the light-selection table, 32 bytes.
+typedef struct {
+  unsigned int type;  // LIGHT_*
+  unsigned int index;  // LIGHT_TRIANGLE: index into Triangle array
+  float area;  // LIGHT_TRIANGLE: triangle area (world units)
+  float pad0;
+  float radiance[4];  // emitted radiance, rgb
+} Light;
+
+// Pinhole camera, 64 bytes: ray direction = forward + (2x-1) right + (1-2y) up.
+typedef struct {
+  float origin[3];
+  float pad0;
+  float forward[3];
+  float pad1;
+  float right[3];  // scaled by tan(xfov/2)
+  float pad2;
+  float up[3];  // scaled by tan(yfov/2)
+  float pad3;
+} Camera;
+
+// Everything one launch needs besides buffers, 128 bytes.
+typedef struct {
+  Camera camera;
+  float background[4];  // constant radiance of escaping rays, rgb
+  unsigned int width;
+  unsigned int height;
+  unsigned int seed;
+  unsigned int max_depth;  // scattering events; 0 = emission seen directly only
+  unsigned int strategy;  // STRATEGY_*
+  unsigned int num_lights;
+  unsigned int sample_begin;  // first sample index of this launch
+  unsigned int sample_count;  // samples per pixel in this launch
+  unsigned int rr_depth;  // Russian roulette starts after this many bounces
+  unsigned int pad[3];
+} RenderParams;
+
+#endif  // CANDELA_DEVICE_TYPES_H

@@ -1,0 +1,48 @@
+// Sampling routines of the lecture, each with its pdf.
+
+#define PI_F 3.14159265358979323846f
+#define INV_PI_F 0.31830988618379067154f
+
+// Cosine-weighted hemisphere around +z: theta = acos(sqrt(v)), phi = 2 pi u
+float3 sample_cosine_hemisphere(float u, float v) {
+  float cos_theta = sqrt(v);
+  float sin_theta = sqrt(1.0f - v);
+  float phi = 2.0f * PI_F * u;
+  return (float3)(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+float sample_cosine_hemisphere_pdf(float cos_theta) { return fmax(cos_theta, 0.0f) * INV_PI_F; }
+
+// Uniform direction on the unit sphere: z = 1 - 2v, phi = 2 pi u
+float3 sample_uniform_sphere(float u, float v) {
+  float z = 1.0f - 2.0f * v;
+  float r = sqrt(fmax(0.0f, 1.0f - z * z));
+  float phi = 2.0f * PI_F * u;
+  return (float3)(r * cos(phi), r * sin(phi), z);
+}
+
+float sample_uniform_sphere_pdf(void) { return 0.25f * INV_PI_F; }
+
+// Uniform point on a triangle: s = 1 - sqrt(u), t = v sqrt(u), x = s v1 + t v2 + (1-s-t) v3.
+// Returns (s, t); the pdf is 1 / area.
+float2 sample_triangle(float u, float v) {
+  float su = sqrt(u);
+  return (float2)(1.0f - su, v * su);
+}
+
+// Index i with probability cdf[i] - cdf[i-1]; cdf is increasing with cdf[n-1] == 1.
+uint sample_discrete_cdf(__global const float* cdf, uint n, float u) {
+  uint lo = 0u, hi = n - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi) / 2u;
+    if (u < cdf[mid])
+      hi = mid;
+    else
+      lo = mid + 1u;
+  }
+  return lo;
+}
+
+float sample_discrete_pmf(__global const float* cdf, uint i) {
+  return i == 0u ? cdf[0] : cdf[i] - cdf[i - 1u];
+}

@@ -1,0 +1,37 @@
+// Surface data at a ray hit.
+
+typedef struct {
+  float3 p;
+  float3 ng;  // geometric normal, turned to the side the ray came from
+  float3 ns;  // shading normal, on the same side as ng
+  float2 uv;
+  uint material;
+  bool front;  // the ray hit the front face (counter-clockwise winding)
+} SurfaceHit;
+
+SurfaceHit surface_at(__global const Triangle* tris, __global const TriangleShading* shading,
+                      Hit hit, float3 ray_dir) {
+  __global const Triangle* tri = &tris[hit.tri];
+  __global const TriangleShading* sh = &shading[tri->prim];
+  float3 v0 = load3(tri->v0), v1 = load3(tri->v1), v2 = load3(tri->v2);
+  float b0 = 1.0f - hit.b1 - hit.b2;
+  SurfaceHit s;
+  s.p = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
+  s.ng = normalize(cross(v1 - v0, v2 - v0));
+  s.front = dot(s.ng, ray_dir) < 0.0f;
+  if (!s.front) s.ng = -s.ng;
+  float3 n = b0 * load3(sh->n0) + hit.b1 * load3(sh->n1) + hit.b2 * load3(sh->n2);
+  float len = length(n);
+  s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
+  if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+  s.uv = b0 * (float2)(sh->uv0_u, sh->uv0_v) + hit.b1 * (float2)(sh->uv1_u, sh->uv1_v) +
+         hit.b2 * (float2)(sh->uv2_u, sh->uv2_v);
+  s.material = tri->material;
+  return s;
+}
+
+// Radiance a surface emits toward the side the ray came from
+float3 surface_emission(__global const Material* m, bool front) {
+  if (!front && !m->double_sided) return (float3)(0.0f);
+  return load3(m->emission);
+}

@@ -1,0 +1,270 @@
+// candela command line: `candela devices`, `candela render SCENE -o OUT ...`.
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+
+#include "device.hpp"
+#include "error.hpp"
+#include "gltf_loader.hpp"
+#include "kernel_sources.hpp"
+#include "renderer.hpp"
+
+namespace {
+
+using namespace candela;
+
+std::atomic<bool> g_interrupted{false};
+
+void on_sigint(int) {
+  if (g_interrupted.exchange(true)) std::_Exit(130);  // second Ctrl-C: leave at once
+}
+
+struct RenderArgs {
+  std::string scene;
+  std::vector<std::string> outputs;
+  uint32_t spp = 0;
+  double time = 0.0;
+  int width = 0, height = 0;
+  std::string device;
+  uint32_t seed = 0;
+  uint32_t max_depth = 16;
+  std::string strategy = "nee";
+  std::string background;
+  std::string stats;
+  float exposure = 0.0f;
+  std::string look_from, look_at, up;
+  float fov = 0.0f;
+  bool quiet = false;
+};
+
+glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
+  std::stringstream ss(text);
+  glm::vec3 v;
+  char comma1 = 0, comma2 = 0;
+  if (!(ss >> v.x >> comma1 >> v.y >> comma2 >> v.z) || comma1 != ',' || comma2 != ',' ||
+      !(ss >> std::ws).eof() || !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+    throw Error(option + " expects three comma-separated numbers, e.g. 1,0.5,0; got '" + text + "'");
+  return v;
+}
+
+std::string format_duration(double s) {
+  char buf[32];
+  if (s < 60)
+    std::snprintf(buf, sizeof buf, "%.1fs", s);
+  else
+    std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
+  return buf;
+}
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, double pixels) : enabled_(enabled), pixels_(pixels) {}
+  void update(const RenderProgress& p) {
+    if (!enabled_) return;
+    double frac = p.spp_target ? double(p.spp_done) / p.spp_target : std::min(1.0, p.seconds / p.time_limit);
+    double rate = p.seconds > 0 ? p.spp_done * pixels_ / p.seconds : 0.0;
+    double eta = frac > 0 ? p.seconds * (1.0 - frac) / frac : 0.0;
+    int width = 30, filled = int(frac * width + 0.5);
+    std::string bar = std::string(filled, '#') + std::string(width - filled, '-');
+    std::fprintf(stderr, "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s   ", bar.c_str(), p.spp_done,
+                 p.spp_target ? ("/" + std::to_string(p.spp_target)).c_str() : "", rate * 1e-6,
+                 format_duration(eta).c_str());
+    std::fflush(stderr);
+    drawn_ = true;
+  }
+  void finish() {
+    if (drawn_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  double pixels_;
+  bool drawn_ = false;
+};
+
+// Image size: --width/--height, else derived from the camera's aspect ratio, else 512
+void resolve_size(const RenderArgs& a, const Scene& scene, int* w, int* h) {
+  float aspect = scene.camera ? scene.camera->aspect : 0.0f;
+  *w = a.width;
+  *h = a.height;
+  if (*w == 0 && *h == 0) *w = 512;
+  if (*h == 0) *h = aspect > 0 ? std::max(1, int(std::lround(*w / aspect))) : *w;
+  if (*w == 0) *w = aspect > 0 ? std::max(1, int(std::lround(*h * aspect))) : *h;
+}
+
+void apply_camera_options(const RenderArgs& a, Scene* scene) {
+  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov > 0;
+  if (!any) return;
+  CameraDesc cam = resolve_camera(*scene);
+  if (!a.look_from.empty()) cam.position = parse_vec3(a.look_from, "--look-from");
+  if (!a.look_at.empty()) {
+    glm::vec3 target = parse_vec3(a.look_at, "--look-at");
+    if (glm::length(target - cam.position) <= 0) throw Error("--look-at must differ from the camera position");
+    cam.forward = glm::normalize(target - cam.position);
+  }
+  if (!a.up.empty()) cam.up = parse_vec3(a.up, "--up");
+  if (a.fov > 0) {
+    if (a.fov >= 180) throw Error("--fov must be below 180 degrees");
+    cam.yfov = a.fov * 3.14159265f / 180.0f;
+  }
+  scene->camera = cam;
+}
+
+int run_render(const RenderArgs& a) {
+  Strategy strategy;
+  if (a.strategy == "nee")
+    strategy = Strategy::Nee;
+  else if (a.strategy == "bsdf")
+    strategy = Strategy::Bsdf;
+  else
+    throw Error("--strategy must be nee or bsdf, not '" + a.strategy + "'");
+  if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
+  for (const auto& out : a.outputs) {
+    std::string ext = out.size() >= 4 ? out.substr(out.size() - 4) : "";
+    for (auto& c : ext) c = char(std::tolower((unsigned char)c));
+    if (ext != ".exr" && ext != ".png") throw Error("output must end in .exr or .png: " + out);
+  }
+
+  Scene scene = load_gltf(a.scene);
+  if (!a.background.empty()) scene.background = parse_vec3(a.background, "--background");
+  apply_camera_options(a, &scene);
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  float bg_max = std::max(scene.background.x, std::max(scene.background.y, scene.background.z));
+  if (!scene.has_emission() && !(bg_max > 0))
+    std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
+  if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
+
+  RenderSettings settings;
+  resolve_size(a, scene, &settings.width, &settings.height);
+  settings.seed = a.seed;
+  settings.max_depth = a.max_depth;
+  settings.strategy = strategy;
+
+  DeviceEntry device = select_device(a.device);
+  if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
+  Renderer renderer(device, scene, settings);
+  if (!a.quiet)
+    std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; kernel build %.2fs%s\n",
+                 renderer.triangles(), renderer.lights(), renderer.bvh_build_seconds(),
+                 renderer.kernel_build_seconds(), renderer.kernel_from_cache() ? " (cached)" : "");
+
+  uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
+  std::signal(SIGINT, on_sigint);
+  double pixels = double(settings.width) * settings.height;
+  ProgressBar bar(!a.quiet && isatty(STDERR_FILENO), pixels);
+  RenderResult r = renderer.render(
+      0, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
+      [] { return g_interrupted.load(); });
+  bar.finish();
+  std::signal(SIGINT, SIG_DFL);
+
+  if (r.spp == 0) throw Error("interrupted before any sample was rendered; nothing written");
+  double samples_per_second = r.spp * pixels / std::max(r.seconds, 1e-9);
+  uint64_t dropped = r.film.dropped_samples();
+  std::map<std::string, std::string> meta = {
+      {"spp", std::to_string(r.spp)},
+      {"seconds", std::to_string(r.seconds)},
+      {"device", device.description()},
+      {"seed", std::to_string(a.seed)},
+      {"strategy", a.strategy},
+      {"max_depth", std::to_string(a.max_depth)},
+      {"dropped_samples", std::to_string(dropped)},
+      {"scene", a.scene}};
+  for (const auto& out : a.outputs) {
+    write_image(out, r.film, meta, a.exposure);
+    std::printf("wrote %s\n", out.c_str());
+  }
+  std::printf("%u spp in %.2fs: %.3f Msamples/s on %s%s\n", r.spp, r.seconds, samples_per_second * 1e-6,
+              device.description().c_str(), r.interrupted ? " (interrupted)" : "");
+  if (dropped) std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)dropped);
+
+  if (!a.stats.empty()) {
+    nlohmann::json j = {{"spp", r.spp},
+                        {"seconds", r.seconds},
+                        {"samples_per_second", samples_per_second},
+                        {"kernel_build_seconds", renderer.kernel_build_seconds()},
+                        {"kernel_from_cache", renderer.kernel_from_cache()},
+                        {"bvh_build_seconds", renderer.bvh_build_seconds()},
+                        {"triangles", renderer.triangles()},
+                        {"lights", renderer.lights()},
+                        {"device", device.description()},
+                        {"width", settings.width},
+                        {"height", settings.height},
+                        {"strategy", a.strategy},
+                        {"max_depth", a.max_depth},
+                        {"seed", a.seed},
+                        {"interrupted", r.interrupted},
+                        {"dropped_samples", dropped}};
+    std::ofstream f(a.stats);
+    if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + a.stats);
+  }
+  return r.interrupted ? 130 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"candela: a physically based path tracer running on OpenCL devices"};
+  app.set_version_flag("--version", "candela " CANDELA_VERSION);
+  app.require_subcommand(1);
+  std::string kernel_dir;
+  app.add_option("--kernel-dir", kernel_dir,
+                 "Load kernel sources from this cl/ directory instead of the embedded copy "
+                 "(also: CANDELA_KERNEL_DIR)");
+
+  auto* devices_cmd = app.add_subcommand("devices", "List OpenCL platforms and devices");
+
+  RenderArgs a;
+  auto* render = app.add_subcommand("render", "Render a glTF scene");
+  render->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
+  render->add_option("-o,--output", a.outputs, "Output image, .exr (linear) or .png (sRGB); repeatable")->required();
+  auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(CLI::Range(1u, 1u << 24));
+  render->add_option("--time", a.time, "Render for this many seconds instead of a sample count")
+      ->check(CLI::PositiveNumber)
+      ->excludes(spp_opt);
+  render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")->check(CLI::Range(1, 65536));
+  render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")->check(CLI::Range(1, 65536));
+  render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU");
+  render->add_option("--seed", a.seed, "Random seed (default 0)");
+  render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
+  render->add_option("--strategy", a.strategy, "nee (next-event estimation, default) or bsdf (BSDF sampling only)");
+  render->add_option("--background", a.background, "Constant background radiance R,G,B (overrides the scene's)");
+  render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
+  render->add_option("--exposure", a.exposure, "PNG exposure in stops (default 0)");
+  render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
+  render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
+  render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
+  render->add_option("--fov", a.fov, "Vertical field of view in degrees");
+  render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
+    if (*devices_cmd) {
+      std::printf("%s", format_device_table(list_devices()).c_str());
+      return 0;
+    }
+    return run_render(a);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    return 1;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "candela: error: %s\n", cl_error_message(e.what(), e.err()).c_str());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,37 @@
+// OpenCL platforms and devices: listing and selection.
+#pragma once
+
+#include <CL/opencl.hpp>
+#include <string>
+#include <vector>
+
+namespace candela {
+
+struct DeviceEntry {
+  size_t platform_index = 0;
+  size_t device_index = 0;  // within its platform
+  size_t global_index = 0;  // across all platforms
+  cl::Platform platform;
+  cl::Device device;
+  std::string platform_name, platform_vendor, platform_version;
+  std::string name, type, version, driver_version;
+  unsigned compute_units = 0;
+  unsigned long long global_memory = 0;
+
+  std::string selector() const;  // "P.D"
+  std::string description() const;  // "name (platform)"
+};
+
+// All devices of all platforms; platforms without devices are skipped.
+// Throws Error when no OpenCL platform is installed.
+std::vector<DeviceEntry> list_devices();
+
+// SEL: "" (first GPU, else first CPU), an index ("0"), "P.D", a type ("cpu", "gpu",
+// "accelerator") or a case-insensitive substring of the platform's name, vendor or
+// version or of the device's name. Throws Error naming the choices when nothing matches.
+DeviceEntry select_device(const std::string& selector);
+
+// Table printed by `candela devices`
+std::string format_device_table(const std::vector<DeviceEntry>& devices);
+
+}  // namespace candela

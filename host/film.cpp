@@ -1,0 +1,100 @@
+#include "film.hpp"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "error.hpp"
+
+namespace candela {
+
+glm::vec3 Film::variance_of_mean(size_t i) const {
+  float n = samples(i);
+  if (n < 2.0f) return glm::vec3(INFINITY);
+  glm::vec3 m(m2[4 * i], m2[4 * i + 1], m2[4 * i + 2]);
+  return m / (n - 1.0f) / n;
+}
+
+uint64_t Film::dropped_samples() const {
+  double total = 0.0;
+  for (size_t i = 0; i < pixels(); ++i) total += m2[4 * i + 3];
+  return uint64_t(total);
+}
+
+Film merge_films(const Film& a, const Film& b) {
+  if (a.width != b.width || a.height != b.height) throw Error("cannot merge films of different sizes");
+  Film out(a.width, a.height);
+  for (size_t i = 0; i < a.pixels(); ++i) {
+    double na = a.mean[4 * i + 3], nb = b.mean[4 * i + 3], n = na + nb;
+    for (int c = 0; c < 3; ++c) {
+      double ma = a.mean[4 * i + c], mb = b.mean[4 * i + c];
+      double delta = mb - ma;
+      out.mean[4 * i + c] = n > 0 ? float(ma + delta * nb / n) : 0.0f;
+      out.m2[4 * i + c] = n > 0 ? float(a.m2[4 * i + c] + b.m2[4 * i + c] + delta * delta * na * nb / n) : 0.0f;
+    }
+    out.mean[4 * i + 3] = float(n);
+    out.m2[4 * i + 3] = a.m2[4 * i + 3] + b.m2[4 * i + 3];
+  }
+  return out;
+}
+
+namespace {
+
+float linear_to_srgb(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+  return ext;
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const Film& film,
+                 const std::map<std::string, std::string>& metadata, float exposure) {
+  std::string ext = lower_extension(path);
+  bool exr = ext == ".exr";
+  if (!exr && ext != ".png") throw Error("output must end in .exr or .png: " + path);
+
+  OIIO::ImageSpec spec(film.width, film.height, 3, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
+  spec.attribute("Software", "candela " CANDELA_VERSION);
+
+  std::vector<float> rgb(film.pixels() * 3);
+  float scale = std::exp2(exposure);
+  for (size_t i = 0; i < film.pixels(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      float v = film.mean[4 * i + c];
+      rgb[3 * i + c] = exr ? v : linear_to_srgb(v * scale);
+    }
+
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw Error("cannot write " + path + ": " + OIIO::geterror());
+  if (!out->open(path, spec)) throw Error("cannot write " + path + ": " + out->geterror());
+  bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
+  ok = out->close() && ok;
+  if (!ok) throw Error("cannot write " + path + ": " + out->geterror());
+}
+
+std::vector<float> read_exr_rgb(const std::string& path, int* width, int* height,
+                                std::map<std::string, std::string>* metadata) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error("cannot read " + path + ": " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  *width = spec.width;
+  *height = spec.height;
+  std::vector<float> rgb(size_t(spec.width) * spec.height * 3);
+  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, rgb.data()))
+    throw Error("cannot read " + path + ": " + in->geterror());
+  if (metadata)
+    for (const auto& p : spec.extra_attribs) (*metadata)[p.name().string()] = p.get_string();
+  return rgb;
+}
+
+}  // namespace candela

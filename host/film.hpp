@@ -1,0 +1,40 @@
+// The film: per-pixel running mean and squared deviations (Welford), and image output.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace candela {
+
+struct Film {
+  int width = 0, height = 0;
+  std::vector<float> mean;  // 4 per pixel: rgb mean, w = samples kept
+  std::vector<float> m2;  // 4 per pixel: rgb sum of squared deviations, w = samples dropped
+
+  Film() = default;
+  Film(int w, int h) : width(w), height(h), mean(size_t(w) * h * 4, 0.0f), m2(size_t(w) * h * 4, 0.0f) {}
+  size_t pixels() const { return size_t(width) * height; }
+  glm::vec3 pixel(size_t i) const { return {mean[4 * i], mean[4 * i + 1], mean[4 * i + 2]}; }
+  float samples(size_t i) const { return mean[4 * i + 3]; }
+  // Variance of the pixel's mean estimate (sample variance / n)
+  glm::vec3 variance_of_mean(size_t i) const;
+  uint64_t dropped_samples() const;
+};
+
+// Combines films of disjoint sample ranges of the same image, weighted by sample count
+// (Chan, Golub and LeVeque 1979, parallel variance update).
+Film merge_films(const Film& a, const Film& b);
+
+// Writes OUT.exr (linear float RGB + metadata) or OUT.png (exposure-scaled, clamped,
+// sRGB, 8 bit). Other extensions throw Error.
+void write_image(const std::string& path, const Film& film,
+                 const std::map<std::string, std::string>& metadata, float exposure = 0.0f);
+
+// Linear RGB float image read back from an EXR, for tests and tools
+std::vector<float> read_exr_rgb(const std::string& path, int* width, int* height,
+                                std::map<std::string, std::string>* metadata = nullptr);
+
+}  // namespace candela

@@ -1,0 +1,445 @@
+#include "gltf_loader.hpp"
+
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <map>
+#include <set>
+
+#include "error.hpp"
+
+namespace candela {
+namespace {
+
+// Extensions this loader implements fully; any other one is named in a warning
+const std::set<std::string> kSupportedExtensions = {"KHR_materials_emissive_strength"};
+
+class Warnings {
+ public:
+  explicit Warnings(std::vector<std::string>* out) : out_(out) {}
+  void add(const std::string& w) {
+    if (seen_.insert(w).second) out_->push_back(w);
+  }
+
+ private:
+  std::vector<std::string>* out_;
+  std::set<std::string> seen_;
+};
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// Accessor elements as floats (normalized integers mapped to [0,1] / [-1,1]), sparse
+// substitution applied. Returns count * components values.
+std::vector<float> read_accessor(const tinygltf::Model& model, int index, int want_components) {
+  if (index < 0 || index >= (int)model.accessors.size())
+    throw Error("glTF accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& acc = model.accessors[index];
+  int comps = tinygltf::GetNumComponentsInType(acc.type);
+  int comp_size = tinygltf::GetComponentSizeInBytes(acc.componentType);
+  if (comps <= 0 || comp_size <= 0)
+    throw Error("glTF accessor " + std::to_string(index) + " has an invalid type");
+  if (want_components > 0 && comps != want_components)
+    throw Error("glTF accessor " + std::to_string(index) + " has " + std::to_string(comps) +
+                " components, expected " + std::to_string(want_components));
+
+  auto decode = [&](const unsigned char* p, int ctype, bool normalized) -> float {
+    switch (ctype) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        std::memcpy(&f, p, 4);
+        return f;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return normalized ? *p / 255.0f : float(*p);
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t v = int8_t(*p);
+        return normalized ? std::max(v / 127.0f, -1.0f) : float(v);
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? v / 65535.0f : float(v);
+      }
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? std::max(v / 32767.0f, -1.0f) : float(v);
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return float(v);
+      }
+      default:
+        throw Error("glTF accessor has an unsupported component type");
+    }
+  };
+
+  // Reads `count` elements of `ncomp` components from a buffer view at `offset`
+  auto read_view = [&](int view_index, size_t offset, size_t count, int ncomp, int ctype,
+                       bool normalized, std::vector<float>* out) {
+    if (view_index < 0 || view_index >= (int)model.bufferViews.size())
+      throw Error("glTF accessor refers to a missing bufferView");
+    const tinygltf::BufferView& view = model.bufferViews[view_index];
+    if (view.buffer < 0 || view.buffer >= (int)model.buffers.size())
+      throw Error("glTF bufferView refers to a missing buffer");
+    const tinygltf::Buffer& buf = model.buffers[view.buffer];
+    int csize = tinygltf::GetComponentSizeInBytes(ctype);
+    size_t elem = size_t(ncomp) * csize;
+    size_t stride = view.byteStride ? view.byteStride : elem;
+    size_t begin = view.byteOffset + offset;
+    if (count > 0 && (begin + stride * (count - 1) + elem > buf.data.size() ||
+                      offset + stride * (count - 1) + elem > view.byteLength))
+      throw Error("glTF accessor reads past the end of its buffer");
+    out->resize(count * ncomp);
+    for (size_t i = 0; i < count; ++i)
+      for (int c = 0; c < ncomp; ++c)
+        (*out)[i * ncomp + c] = decode(&buf.data[begin + i * stride + c * csize], ctype, normalized);
+  };
+
+  std::vector<float> values;
+  if (acc.bufferView >= 0)
+    read_view(acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType, acc.normalized,
+              &values);
+  else
+    values.assign(acc.count * comps, 0.0f);
+
+  if (acc.sparse.isSparse) {
+    std::vector<float> idx, vals;
+    read_view(acc.sparse.indices.bufferView, acc.sparse.indices.byteOffset, acc.sparse.count, 1,
+              acc.sparse.indices.componentType, false, &idx);
+    read_view(acc.sparse.values.bufferView, acc.sparse.values.byteOffset, acc.sparse.count, comps,
+              acc.componentType, acc.normalized, &vals);
+    for (int i = 0; i < acc.sparse.count; ++i) {
+      size_t target = size_t(idx[i]);
+      if (target >= acc.count) throw Error("glTF sparse accessor index out of range");
+      for (int c = 0; c < comps; ++c) values[target * comps + c] = vals[size_t(i) * comps + c];
+    }
+  }
+  return values;
+}
+
+glm::mat4 local_transform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    glm::mat4 m;
+    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = float(node.matrix[i]);  // column-major
+    return m;
+  }
+  glm::mat4 m(1.0f);
+  if (node.translation.size() == 3)
+    m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) {
+    glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
+                float(node.rotation[2]));
+    m *= glm::mat4_cast(glm::normalize(q));
+  }
+  if (node.scale.size() == 3)
+    m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+  return m;
+}
+
+class Loader {
+ public:
+  Loader(const tinygltf::Model& model, Scene* scene)
+      : model_(model), scene_(scene), warn_(&scene->warnings) {}
+
+  void load() {
+    for (const auto& ext : model_.extensionsUsed)
+      if (!kSupportedExtensions.count(ext)) warn_.add("glTF extension " + ext + " is not supported yet and is ignored");
+    if (!model_.animations.empty()) warn_.add("animations are ignored (the first frame is rendered)");
+    if (!model_.skins.empty()) warn_.add("skins are ignored (meshes render in their bind pose)");
+    load_materials();
+    load_scene_roots();
+    if (scene_->triangles.empty()) throw Error("the scene has no triangles to render");
+  }
+
+ private:
+  void load_materials() {
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+      const tinygltf::Material& gm = model_.materials[i];
+      std::string name = "material '" + (gm.name.empty() ? std::to_string(i) : gm.name) + "'";
+      const auto& pbr = gm.pbrMetallicRoughness;
+      dev::Material m = default_material();
+      for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
+      if (pbr.baseColorTexture.index >= 0) {
+        m.base_color_texture = texture_index(pbr.baseColorTexture.index, true);
+        texcoords_.push_back(pbr.baseColorTexture.texCoord);
+        if (pbr.baseColorTexture.extensions.count("KHR_texture_transform"))
+          warn_.add("KHR_texture_transform is not supported yet: texture transforms are ignored");
+      } else {
+        texcoords_.push_back(0);
+      }
+      float strength = 1.0f;
+      auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+      if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
+        strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+      for (int c = 0; c < 3; ++c) m.emission[c] = float(gm.emissiveFactor[c]) * strength;
+      m.double_sided = gm.doubleSided ? 1u : 0u;
+
+      if (pbr.metallicFactor > 0.0)
+        warn_.add("metallic materials are not supported yet: rendered as diffuse with their base color (" + name + ", metallicFactor " + std::to_string(pbr.metallicFactor) + ")");
+      if (pbr.metallicRoughnessTexture.index >= 0)
+        warn_.add("metallicRoughnessTexture is not supported yet and is ignored");
+      if (gm.normalTexture.index >= 0) warn_.add("normalTexture is not supported yet and is ignored");
+      if (gm.emissiveTexture.index >= 0)
+        warn_.add("emissiveTexture is not supported yet: emission uses emissiveFactor alone");
+      if (gm.occlusionTexture.index >= 0)
+        warn_.add("occlusionTexture is ignored (a path tracer computes occlusion itself)");
+      if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+        warn_.add("alphaMode " + gm.alphaMode + " is not supported yet: surfaces are opaque");
+      for (const auto& e : gm.extensions)
+        if (!kSupportedExtensions.count(e.first))
+          warn_.add("glTF extension " + e.first + " is not supported yet and is ignored");
+      scene_->materials.push_back(m);
+    }
+    // Default material (glTF: white, metallic 1, roughness 1) for primitives without one
+    default_material_index_ = uint32_t(scene_->materials.size());
+    scene_->materials.push_back(default_material());
+    texcoords_.push_back(0);
+  }
+
+  static dev::Material default_material() {
+    dev::Material m{};
+    m.type = MATERIAL_DIFFUSE;
+    m.base_color_texture = NO_TEXTURE;
+    for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
+    return m;
+  }
+
+  // Uploads the glTF texture's image once, returning its TextureInfo index
+  int texture_index(int gltf_texture, bool srgb) {
+    auto key = std::make_pair(gltf_texture, srgb);
+    if (auto it = texture_cache_.find(key); it != texture_cache_.end()) return it->second;
+    if (gltf_texture < 0 || gltf_texture >= (int)model_.textures.size())
+      throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
+    const tinygltf::Texture& tex = model_.textures[gltf_texture];
+    if (tex.source < 0 || tex.source >= (int)model_.images.size())
+      throw Error("glTF texture " + std::to_string(gltf_texture) + " has no usable image (only PNG and JPEG sources are supported)");
+    const tinygltf::Image& img = model_.images[tex.source];
+    if (img.width <= 0 || img.height <= 0 || img.image.empty())
+      throw Error("glTF image " + std::to_string(tex.source) + " ('" + img.uri + "') could not be decoded");
+
+    dev::TextureInfo info{};
+    info.offset = uint32_t(scene_->texels.size() / 4);
+    info.width = uint32_t(img.width);
+    info.height = uint32_t(img.height);
+    uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
+    if (tex.sampler >= 0 && tex.sampler < (int)model_.samplers.size()) {
+      auto mode = [](int w) {
+        return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ? WRAP_CLAMP
+               : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
+                                                            : WRAP_REPEAT;
+      };
+      wrap_s = mode(model_.samplers[tex.sampler].wrapS);
+      wrap_t = mode(model_.samplers[tex.sampler].wrapT);
+    }
+    info.wrap = wrap_s | (wrap_t << 8);
+
+    size_t n = size_t(img.width) * img.height;
+    int comps = img.component;
+    bool sixteen = img.bits == 16;
+    scene_->texels.reserve(scene_->texels.size() + 4 * n);
+    for (size_t i = 0; i < n; ++i) {
+      float rgba[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+      for (int c = 0; c < comps && c < 4; ++c) {
+        float v = sixteen ? (img.image[2 * (i * comps + c)] | (img.image[2 * (i * comps + c) + 1] << 8)) / 65535.0f
+                          : img.image[i * comps + c] / 255.0f;
+        rgba[c] = v;
+      }
+      if (comps <= 2) rgba[1] = rgba[2] = rgba[0];  // grey (+ alpha)
+      if (comps == 2) rgba[3] = sixteen ? 1.0f : img.image[i * comps + 1] / 255.0f;
+      for (int c = 0; c < 4; ++c)
+        scene_->texels.push_back(srgb && c < 3 ? srgb_to_linear(rgba[c]) : rgba[c]);
+    }
+    int index = int(scene_->textures.size());
+    scene_->textures.push_back(info);
+    texture_cache_[key] = index;
+    return index;
+  }
+
+  void load_scene_roots() {
+    std::vector<int> roots;
+    int scene_index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (scene_index < (int)model_.scenes.size()) {
+      const tinygltf::Scene& s = model_.scenes[scene_index];
+      roots = s.nodes;
+      read_scene_extras(s.extras);
+    } else {
+      // No scene: render every root node
+      std::vector<bool> is_child(model_.nodes.size(), false);
+      for (const auto& n : model_.nodes)
+        for (int c : n.children)
+          if (c >= 0 && c < (int)is_child.size()) is_child[c] = true;
+      for (size_t i = 0; i < model_.nodes.size(); ++i)
+        if (!is_child[i]) roots.push_back(int(i));
+    }
+    for (int r : roots) visit_node(r, glm::mat4(1.0f), 0);
+  }
+
+  void read_scene_extras(const tinygltf::Value& extras) {
+    if (!extras.Has("candela")) return;
+    const tinygltf::Value& c = extras.Get("candela");
+    if (c.Has("background")) {
+      const tinygltf::Value& bg = c.Get("background");
+      if (!bg.IsArray() || bg.ArrayLen() != 3)
+        throw Error("scene extras candela.background must be an array of 3 numbers");
+      for (int i = 0; i < 3; ++i) {
+        if (!bg.Get(i).IsNumber()) throw Error("scene extras candela.background must hold numbers");
+        scene_->background[i] = float(bg.Get(i).GetNumberAsDouble());
+      }
+    }
+  }
+
+  void visit_node(int index, const glm::mat4& parent, int depth) {
+    if (index < 0 || index >= (int)model_.nodes.size())
+      throw Error("glTF node " + std::to_string(index) + " does not exist");
+    if (depth > 256) throw Error("glTF node hierarchy is cyclic or too deep");
+    const tinygltf::Node& node = model_.nodes[index];
+    glm::mat4 world = parent * local_transform(node);
+    if (node.mesh >= 0) {
+      if (node.mesh >= (int)model_.meshes.size())
+        throw Error("glTF node " + std::to_string(index) + " refers to a missing mesh");
+      load_mesh(model_.meshes[node.mesh], world);
+      if (!node.weights.empty() || !model_.meshes[node.mesh].weights.empty())
+        warn_.add("morph targets are not supported yet: base geometry is rendered");
+    }
+    if (node.camera >= 0 && !scene_->camera) load_camera(node.camera, world);
+    if (node.extensions.count("KHR_lights_punctual"))
+      warn_.add("KHR_lights_punctual lights are not supported yet and are ignored");
+    for (int child : node.children) visit_node(child, world, depth + 1);
+  }
+
+  void load_camera(int index, const glm::mat4& world) {
+    if (index >= (int)model_.cameras.size()) throw Error("glTF camera " + std::to_string(index) + " does not exist");
+    const tinygltf::Camera& c = model_.cameras[index];
+    if (c.type != "perspective") {
+      warn_.add("camera type '" + c.type + "' is not supported yet; it is skipped");
+      return;
+    }
+    CameraDesc cam;
+    cam.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
+    cam.forward = glm::normalize(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
+    cam.up = glm::normalize(glm::vec3(world * glm::vec4(0, 1, 0, 0)));
+    cam.yfov = float(c.perspective.yfov);
+    cam.aspect = float(c.perspective.aspectRatio);
+    if (!(cam.yfov > 0.0f && cam.yfov < 3.14159f)) throw Error("glTF camera has an invalid yfov");
+    scene_->camera = cam;
+  }
+
+  void load_mesh(const tinygltf::Mesh& mesh, const glm::mat4& world) {
+    glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(world)));
+    bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
+    for (const auto& prim : mesh.primitives) {
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+          prim.mode != TINYGLTF_MODE_TRIANGLE_FAN && prim.mode != -1) {
+        warn_.add("point and line primitives are not rendered");
+        continue;
+      }
+      if (!prim.targets.empty()) warn_.add("morph targets are not supported yet: base geometry is rendered");
+      auto pos_it = prim.attributes.find("POSITION");
+      if (pos_it == prim.attributes.end()) {
+        warn_.add("a primitive without POSITION was skipped");
+        continue;
+      }
+      uint32_t material = prim.material >= 0 && prim.material < (int)model_.materials.size()
+                              ? uint32_t(prim.material)
+                              : default_material_index_;
+      std::vector<float> pos = read_accessor(model_, pos_it->second, 3);
+      size_t nverts = pos.size() / 3;
+      std::vector<float> nrm, uv;
+      if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end())
+        nrm = read_accessor(model_, it->second, 3);
+      std::string uv_name = "TEXCOORD_" + std::to_string(texcoords_[material]);
+      if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end())
+        uv = read_accessor(model_, it->second, 2);
+      if ((!nrm.empty() && nrm.size() != pos.size()) || (!uv.empty() && uv.size() / 2 != nverts))
+        throw Error("glTF primitive attributes have different vertex counts");
+
+      std::vector<uint32_t> indices;
+      if (prim.indices >= 0) {
+        for (float f : read_accessor(model_, prim.indices, 1)) indices.push_back(uint32_t(f));
+      } else {
+        for (uint32_t i = 0; i < nverts; ++i) indices.push_back(i);
+      }
+      for (uint32_t i : indices)
+        if (i >= nverts) throw Error("glTF primitive index out of range");
+
+      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+        if (mirrored) std::swap(b, c);  // a mirroring transform flips the winding
+        SceneTriangle t;
+        uint32_t idx[3] = {a, b, c};
+        for (int k = 0; k < 3; ++k) {
+          uint32_t v = idx[k];
+          t.p[k] = glm::vec3(world * glm::vec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0f));
+          t.n[k] = nrm.empty() ? glm::vec3(0.0f)
+                               : normal_matrix * glm::vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
+          float nl = glm::length(t.n[k]);
+          t.n[k] = nl > 0.0f && std::isfinite(nl) ? t.n[k] / nl : glm::vec3(0.0f);
+          t.uv[k] = uv.empty() ? glm::vec2(0.0f) : glm::vec2(uv[2 * v], uv[2 * v + 1]);
+        }
+        t.material = material;
+        for (const auto& p : t.p)
+          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            throw Error("glTF mesh has non-finite vertex positions");
+        scene_->triangles.push_back(t);
+      };
+      int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+      if (mode == TINYGLTF_MODE_TRIANGLES) {
+        for (size_t i = 0; i + 2 < indices.size(); i += 3) emit(indices[i], indices[i + 1], indices[i + 2]);
+      } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        for (size_t i = 0; i + 2 < indices.size(); ++i) {
+          if (i % 2 == 0)
+            emit(indices[i], indices[i + 1], indices[i + 2]);
+          else
+            emit(indices[i + 1], indices[i], indices[i + 2]);
+        }
+      } else {
+        for (size_t i = 1; i + 1 < indices.size(); ++i) emit(indices[i], indices[i + 1], indices[0]);
+      }
+    }
+  }
+
+  const tinygltf::Model& model_;
+  Scene* scene_;
+  Warnings warn_;
+  std::map<std::pair<int, bool>, int> texture_cache_;
+  std::vector<int> texcoords_;  // per material: TEXCOORD_n set of its base color texture
+  uint32_t default_material_index_ = 0;
+};
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
+  if (fs::is_directory(path, ec)) throw Error("scene path is a directory, not a glTF file: " + path);
+
+  tinygltf::TinyGLTF gltf;
+  tinygltf::Model model;
+  std::string err, warn;
+  std::string ext = fs::path(path).extension().string();
+  for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+  bool ok = ext == ".glb" ? gltf.LoadBinaryFromFile(&model, &err, &warn, path)
+                          : gltf.LoadASCIIFromFile(&model, &err, &warn, path);
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    throw Error("cannot load glTF scene " + path + ": " + (err.empty() ? "malformed file" : err));
+  }
+  Scene scene;
+  if (!warn.empty()) {
+    while (!warn.empty() && warn.back() == '\n') warn.pop_back();
+    scene.warnings.push_back("glTF loader: " + warn);
+  }
+  Loader(model, &scene).load();
+  return scene;
+}
+
+}  // namespace candela

@@ -1,0 +1,26 @@
+// Kernel sources: embedded at build time (cmake/embed_kernels.cmake) or, while
+// developing, read from disk (--kernel-dir or CANDELA_KERNEL_DIR).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace candela {
+
+struct EmbeddedKernelFile {
+  const char* path;  // relative to the repository root, e.g. "cl/rng.cl"
+  const char* text;
+};
+
+const std::vector<EmbeddedKernelFile>& embedded_kernel_files();
+
+// Where kernel sources come from: empty = embedded; else the cl/ directory on disk
+void set_kernel_source_root(const std::string& root);
+
+// The renderer program: every cl/ file in order, each starting with a #line marker
+std::string renderer_program_source();
+
+// The renderer program followed by the test kernels of tests/cl/
+std::string test_program_source();
+
+}  // namespace candela

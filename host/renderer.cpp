@@ -1,0 +1,181 @@
+#include "renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "bvh_builder.hpp"
+#include "error.hpp"
+#include "kernel_sources.hpp"
+#include "light_table.hpp"
+#include "program_cache.hpp"
+
+namespace candela {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::vector<dev::TriangleShading> shading_data(const std::vector<SceneTriangle>& tris) {
+  std::vector<dev::TriangleShading> out(tris.size());
+  for (size_t i = 0; i < tris.size(); ++i) {
+    const SceneTriangle& t = tris[i];
+    dev::TriangleShading& s = out[i];
+    s = dev::TriangleShading{};
+    for (int a = 0; a < 3; ++a) {
+      s.n0[a] = t.n[0][a];
+      s.n1[a] = t.n[1][a];
+      s.n2[a] = t.n[2][a];
+    }
+    s.uv0_u = t.uv[0].x;
+    s.uv0_v = t.uv[0].y;
+    s.uv1_u = t.uv[1].x;
+    s.uv1_v = t.uv[1].y;
+    s.uv2_u = t.uv[2].x;
+    s.uv2_v = t.uv[2].y;
+  }
+  return out;
+}
+
+// A read-only buffer holding `data`, or one dummy element when it is empty
+template <typename T>
+cl::Buffer upload(const cl::Context& ctx, const std::vector<T>& data, const char* what) {
+  std::vector<T> one(1);
+  const std::vector<T>& src = data.empty() ? one : data;
+  try {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T),
+                      const_cast<T*>(src.data()));
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
+  }
+}
+
+}  // namespace
+
+Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
+    : device_(device), settings_(settings) {
+  if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 ||
+      settings.height > 65536)
+    throw Error("image size must be between 1x1 and 65536x65536");
+
+  auto bvh_start = Clock::now();
+  Bvh bvh = build_bvh(scene.triangles);
+  std::vector<dev::Triangle> tris = bvh_ordered_triangles(scene.triangles, bvh);
+  LightTable table = build_light_table(tris, scene.materials, scene.background, scene.bounds());
+  bvh_build_seconds_ = seconds_since(bvh_start);
+  triangles_ = tris.size();
+  num_lights_ = table.lights.size();
+
+  try {
+    context_ = cl::Context(device_.device);
+    queue_ = cl::CommandQueue(context_, device_.device);
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
+  }
+  build_options_ = "-cl-std=CL1.2 " + scene.features().build_options();
+  ProgramBuild build = build_program(context_, device_, renderer_program_source(), build_options_);
+  kernel_build_seconds_ = build.seconds;
+  kernel_from_cache_ = build.from_cache;
+  kernel_ = cl::Kernel(build.program, "render_paths");
+
+  nodes_ = upload(context_, bvh.nodes, "the BVH");
+  tris_ = upload(context_, tris, "triangles");
+  shading_ = upload(context_, shading_data(scene.triangles), "vertex normals and UVs");
+  materials_ = upload(context_, scene.materials, "materials");
+  textures_ = upload(context_, scene.textures, "texture descriptors");
+  texels_ = upload(context_, scene.texels, "textures");
+  lights_ = upload(context_, table.lights, "lights");
+  light_cdf_ = upload(context_, table.cdf, "the light table");
+
+  CameraDesc cam = resolve_camera(scene);
+  params_host_.camera = make_device_camera(cam, settings.width, settings.height);
+  for (int c = 0; c < 3; ++c) params_host_.background[c] = scene.background[c];
+  params_host_.width = uint32_t(settings.width);
+  params_host_.height = uint32_t(settings.height);
+  params_host_.seed = settings.seed;
+  params_host_.max_depth = settings.max_depth;
+  params_host_.rr_depth = settings.rr_depth;
+  params_host_.strategy = uint32_t(settings.strategy);
+  params_host_.num_lights = uint32_t(table.lights.size());
+
+  size_t film_bytes = size_t(settings.width) * settings.height * 4 * sizeof(float);
+  try {
+    params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
+    film_mean_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
+    film_m2_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
+    queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
+    queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
+    int arg = 0;
+    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &materials_, &textures_, &texels_, &lights_,
+                          &light_cdf_, &params_, &film_mean_, &film_m2_})
+      kernel_.setArg(arg++, *b);
+    queue_.finish();
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("allocating the film", e.err()));
+  }
+}
+
+void Renderer::launch(uint32_t sample_begin, uint32_t count) {
+  params_host_.sample_begin = sample_begin;
+  params_host_.sample_count = count;
+  try {
+    queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
+    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange,
+                                cl::NDRange(size_t(settings_.width) * settings_.height),
+                                cl::NullRange);
+    queue_.finish();
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("running the path tracing kernel", e.err()));
+  }
+}
+
+RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_limit,
+                              const std::function<void(const RenderProgress&)>& progress,
+                              const std::function<bool()>& stop) {
+  if (spp == 0 && !(time_limit > 0.0)) throw Error("render needs a sample count or a time limit");
+  auto start = Clock::now();
+  RenderProgress p;
+  p.spp_target = spp;
+  p.time_limit = time_limit;
+  RenderResult result;
+  uint32_t batch = 1;
+  while (spp == 0 || p.spp_done < spp) {
+    if (stop && stop()) {
+      result.interrupted = true;
+      break;
+    }
+    if (spp > 0) batch = std::min(batch, spp - p.spp_done);
+    auto t0 = Clock::now();
+    launch(sample_begin + p.spp_done, batch);
+    double dt = seconds_since(t0);
+    p.spp_done += batch;
+    p.seconds = seconds_since(start);
+    if (progress) progress(p);
+    if (spp == 0 && p.seconds >= time_limit) break;
+    // Size the next launch to take about launch_seconds (at most doubling each time)
+    double per_sample = dt / batch;
+    double want = settings_.launch_seconds / std::max(per_sample, 1e-9);
+    batch = uint32_t(std::clamp(want, 1.0, std::min(2.0 * batch, 4096.0)));
+    if (spp == 0) {
+      double left = time_limit - p.seconds;
+      batch = uint32_t(std::clamp(left / std::max(per_sample, 1e-9), 1.0, double(batch)));
+    }
+  }
+  result.spp = p.spp_done;
+  result.seconds = seconds_since(start);
+
+  Film film(settings_.width, settings_.height);
+  try {
+    queue_.enqueueReadBuffer(film_mean_, CL_TRUE, 0, film.mean.size() * sizeof(float), film.mean.data());
+    queue_.enqueueReadBuffer(film_m2_, CL_TRUE, 0, film.m2.size() * sizeof(float), film.m2.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("reading back the film", e.err()));
+  }
+  result.film = std::move(film);
+  return result;
+}
+
+}  // namespace candela

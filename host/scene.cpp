@@ -1,0 +1,60 @@
+#include "scene.hpp"
+
+#include <cmath>
+
+namespace candela {
+
+std::string SceneFeatures::build_options() const {
+  return std::string("-DCD_FEATURE_TEXTURES=") + (textures ? "1" : "0");
+}
+
+Bounds Scene::bounds() const {
+  Bounds b;
+  for (const auto& t : triangles)
+    for (const auto& p : t.p) b.grow(p);
+  return b;
+}
+
+SceneFeatures Scene::features() const {
+  SceneFeatures f;
+  for (const auto& m : materials) f.textures |= m.base_color_texture != NO_TEXTURE;
+  return f;
+}
+
+bool Scene::has_emission() const {
+  for (const auto& m : materials)
+    if (m.emission[0] > 0.0f || m.emission[1] > 0.0f || m.emission[2] > 0.0f) return true;
+  return false;
+}
+
+CameraDesc resolve_camera(const Scene& scene) {
+  if (scene.camera) return *scene.camera;
+  // Look at the bounds from +z, far enough to see the whole bounding sphere
+  Bounds b = scene.bounds();
+  CameraDesc cam;
+  float r = std::max(b.radius(), 1e-3f);
+  float dist = r / std::sin(0.5f * cam.yfov) * 1.05f;
+  cam.position = b.center() + glm::vec3(0.0f, 0.0f, dist);
+  cam.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+  return cam;
+}
+
+dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
+  glm::vec3 f = glm::normalize(cam.forward);
+  glm::vec3 r = glm::cross(f, cam.up);
+  if (glm::length(r) < 1e-6f) r = glm::cross(f, glm::vec3(1.0f, 0.0f, 0.0f));
+  r = glm::normalize(r);
+  glm::vec3 u = glm::cross(r, f);
+  float tan_y = std::tan(0.5f * cam.yfov);
+  float tan_x = tan_y * float(width) / float(height);
+  dev::Camera c{};
+  for (int i = 0; i < 3; ++i) {
+    c.origin[i] = cam.position[i];
+    c.forward[i] = f[i];
+    c.right[i] = r[i] * tan_x;
+    c.up[i] = u[i] * tan_y;
+  }
+  return c;
+}
+
+}  // namespace candela

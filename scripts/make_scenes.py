@@ -1,0 +1,517 @@
+#!/usr/bin/env python3
+"""Write candela's test scenes as self-contained glTF 2.0 files.
+
+Run from the repository root:  python3 scripts/make_scenes.py
+
+Outputs (deterministic, byte-identical on every run):
+  scenes/cornell-box/cornell-box.gltf   Cornell Box (published measured data)
+  scenes/furnace/closed-sphere.gltf     emissive+diffuse sphere seen from inside
+  scenes/furnace/white-objects.gltf     albedo-1 objects under a white background
+
+Every file embeds its binary buffer as a base64 data URI.  Meshes use flat
+(per-face) normals with vertices duplicated per triangle.  After writing, each
+file is read back from disk and checked (accessors, bounds, winding vs normals,
+watertightness where expected).
+"""
+
+import base64
+import json
+import math
+import os
+import struct
+
+GENERATOR = "candela scripts/make_scenes.py"
+ARRAY_BUFFER = 34962
+ELEMENT_ARRAY_BUFFER = 34963
+FLOAT = 5126
+UNSIGNED_INT = 5125
+TRIANGLES = 4
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+# ---------------------------------------------------------------------------
+# Small vector helpers (tuples of Python floats)
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def scale(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0])
+
+
+def normalize(a):
+    return scale(a, 1.0 / math.sqrt(dot(a, a)))
+
+
+def centroid(points):
+    s = (0.0, 0.0, 0.0)
+    for p in points:
+        s = add(s, p)
+    return scale(s, 1.0 / len(points))
+
+
+def f32(x):
+    """Round a Python float to the nearest float32 value."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def f32v(v):
+    return tuple(f32(c) for c in v)
+
+
+def tri_normal(a, b, c):
+    """Unit normal of triangle (a, b, c) from its counter-clockwise winding."""
+    return normalize(cross(sub(b, a), sub(c, a)))
+
+
+# ---------------------------------------------------------------------------
+# Triangle soups -> flat-shaded vertex arrays
+
+def flat_mesh(triangles):
+    """Turn a list of (a, b, c) float32 triangles into flat-shaded arrays.
+
+    Each triangle gets its own three vertices so its normal is exactly the
+    normal of its own winding.  Returns (positions, normals, indices).
+    """
+    positions, normals, indices = [], [], []
+    for a, b, c in triangles:
+        n = f32v(tri_normal(a, b, c))
+        for p in (a, b, c):
+            indices.append(len(positions))
+            positions.append(p)
+            normals.append(n)
+    return positions, normals, indices
+
+
+def orient_quad(quad, wanted):
+    """Return quad vertices ordered so the front faces direction `wanted`.
+
+    Uses the Newell normal of the (possibly slightly non-planar) quad.
+    """
+    n = (0.0, 0.0, 0.0)
+    for i, p in enumerate(quad):
+        q = quad[(i + 1) % len(quad)]
+        n = add(n, ((p[1] - q[1]) * (p[2] + q[2]),
+                    (p[2] - q[2]) * (p[0] + q[0]),
+                    (p[0] - q[0]) * (p[1] + q[1])))
+    return list(quad) if dot(n, wanted) > 0 else list(reversed(quad))
+
+
+def quad_triangles(quad):
+    """Split a counter-clockwise quad (a, b, c, d) into two triangles."""
+    a, b, c, d = quad
+    return [(a, b, c), (a, c, d)]
+
+
+# ---------------------------------------------------------------------------
+# glTF document builder
+
+class GltfBuilder:
+    """Accumulates binary data and JSON objects for one glTF file."""
+
+    def __init__(self):
+        self.blob = bytearray()
+        self.doc = {
+            "asset": {"version": "2.0", "generator": GENERATOR},
+            "scene": 0,
+            "scenes": [{"nodes": []}],
+            "nodes": [],
+            "meshes": [],
+            "materials": [],
+            "cameras": [],
+            "accessors": [],
+            "bufferViews": [],
+            "buffers": [],
+        }
+
+    def _view(self, data, target):
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.blob),
+                "byteLength": len(data), "target": target}
+        self.blob.extend(data)
+        self.doc["bufferViews"].append(view)
+        return len(self.doc["bufferViews"]) - 1
+
+    def _accessor(self, acc):
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def vec3_accessor(self, vectors, with_bounds):
+        data = b"".join(struct.pack("<3f", *v) for v in vectors)
+        acc = {"bufferView": self._view(data, ARRAY_BUFFER),
+               "componentType": FLOAT, "count": len(vectors), "type": "VEC3"}
+        if with_bounds:
+            acc["min"] = [min(v[i] for v in vectors) for i in range(3)]
+            acc["max"] = [max(v[i] for v in vectors) for i in range(3)]
+        return self._accessor(acc)
+
+    def index_accessor(self, indices):
+        data = struct.pack("<%dI" % len(indices), *indices)
+        return self._accessor({
+            "bufferView": self._view(data, ELEMENT_ARRAY_BUFFER),
+            "componentType": UNSIGNED_INT, "count": len(indices),
+            "type": "SCALAR"})
+
+    def material(self, name, base_color, emissive=None, strength=None,
+                 double_sided=True):
+        mat = {"name": name,
+               "pbrMetallicRoughness": {"baseColorFactor": list(base_color),
+                                        "metallicFactor": 0.0,
+                                        "roughnessFactor": 1.0}}
+        if emissive is not None:
+            mat["emissiveFactor"] = list(emissive)
+        if strength is not None:
+            mat["extensions"] = {"KHR_materials_emissive_strength":
+                                 {"emissiveStrength": strength}}
+            used = self.doc.setdefault("extensionsUsed", [])
+            if "KHR_materials_emissive_strength" not in used:
+                used.append("KHR_materials_emissive_strength")
+        mat["doubleSided"] = double_sided
+        self.doc["materials"].append(mat)
+        return len(self.doc["materials"]) - 1
+
+    def mesh(self, name, triangles, material):
+        """Add a flat-shaded triangle mesh; returns the mesh index."""
+        positions, normals, indices = flat_mesh(triangles)
+        prim = {"attributes": {
+                    "POSITION": self.vec3_accessor(positions, True),
+                    "NORMAL": self.vec3_accessor(normals, False)},
+                "indices": self.index_accessor(indices),
+                "material": material,
+                "mode": TRIANGLES}
+        self.doc["meshes"].append({"name": name, "primitives": [prim]})
+        return len(self.doc["meshes"]) - 1
+
+    def camera(self, name, yfov, aspect, znear=0.01, zfar=100.0):
+        self.doc["cameras"].append({
+            "name": name, "type": "perspective",
+            "perspective": {"yfov": yfov, "aspectRatio": aspect,
+                            "znear": znear, "zfar": zfar}})
+        return len(self.doc["cameras"]) - 1
+
+    def node(self, name, root=True, **fields):
+        """Add a node (fields: mesh, camera, children, translation, ...)."""
+        node = {"name": name}
+        node.update(fields)
+        self.doc["nodes"].append(node)
+        index = len(self.doc["nodes"]) - 1
+        if root:
+            self.doc["scenes"][0]["nodes"].append(index)
+        return index
+
+    def write(self, path):
+        uri = ("data:application/octet-stream;base64,"
+               + base64.b64encode(bytes(self.blob)).decode("ascii"))
+        self.doc["buffers"] = [{"byteLength": len(self.blob), "uri": uri}]
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w", encoding="utf-8", newline="\n") as f:
+            f.write(json.dumps(self.doc, indent=2))
+            f.write("\n")
+
+
+# ---------------------------------------------------------------------------
+# Cornell Box (Cornell University Program of Computer Graphics data, in mm)
+
+CORNELL_ROOM = {
+    "floor": [(552.8, 0, 0), (0, 0, 0), (0, 0, 559.2), (549.6, 0, 559.2)],
+    "ceiling": [(556, 548.8, 0), (556, 548.8, 559.2), (0, 548.8, 559.2),
+                (0, 548.8, 0)],
+    "back_wall": [(549.6, 0, 559.2), (0, 0, 559.2), (0, 548.8, 559.2),
+                  (556, 548.8, 559.2)],
+    "right_wall_green": [(0, 0, 559.2), (0, 0, 0), (0, 548.8, 0),
+                         (0, 548.8, 559.2)],
+    "left_wall_red": [(552.8, 0, 0), (549.6, 0, 559.2), (556, 548.8, 559.2),
+                      (556, 548.8, 0)],
+}
+CORNELL_ROOM_CENTRE = (278.0, 274.0, 280.0)
+
+# Light quad, lowered 0.1 mm below the ceiling.
+CORNELL_LIGHT = [(343, 548.7, 227), (343, 548.7, 332), (213, 548.7, 332),
+                 (213, 548.7, 227)]
+
+CORNELL_SHORT_BLOCK = [
+    [(130, 165, 65), (82, 165, 225), (240, 165, 272), (290, 165, 114)],
+    [(290, 0, 114), (290, 165, 114), (240, 165, 272), (240, 0, 272)],
+    [(130, 0, 65), (130, 165, 65), (290, 165, 114), (290, 0, 114)],
+    [(82, 0, 225), (82, 165, 225), (130, 165, 65), (130, 0, 65)],
+    [(240, 0, 272), (240, 165, 272), (82, 165, 225), (82, 0, 225)],
+]
+CORNELL_TALL_BLOCK = [
+    [(423, 330, 247), (265, 330, 296), (314, 330, 456), (472, 330, 406)],
+    [(423, 0, 247), (423, 330, 247), (472, 330, 406), (472, 0, 406)],
+    [(472, 0, 406), (472, 330, 406), (314, 330, 456), (314, 0, 456)],
+    [(314, 0, 456), (314, 330, 456), (265, 330, 296), (265, 0, 296)],
+    [(265, 0, 296), (265, 330, 296), (423, 330, 247), (423, 0, 247)],
+]
+
+
+def mm_to_m(quad):
+    """Convert a quad from millimetres (floats) to float32 metres."""
+    return [f32v(scale(tuple(float(c) for c in p), 0.001)) for p in quad]
+
+
+def oriented_triangles(quads, wanted_dir):
+    """Orient each mm quad with wanted_dir(quad) and return metre triangles."""
+    tris = []
+    for quad in quads:
+        q = orient_quad([tuple(float(c) for c in p) for p in quad],
+                        wanted_dir(quad))
+        tris.extend(quad_triangles(mm_to_m(q)))
+    return tris
+
+
+def block_triangles(quads):
+    """Block faces point away from the centroid of the block's vertices."""
+    unique = sorted({tuple(float(c) for c in p) for q in quads for p in q})
+    centre = centroid(unique)
+    return oriented_triangles(
+        quads, lambda q: sub(centroid([tuple(map(float, p)) for p in q]),
+                             centre))
+
+
+def make_cornell_box(path):
+    g = GltfBuilder()
+    white = g.material("white", (0.725, 0.71, 0.68, 1.0))
+    red = g.material("red", (0.63, 0.065, 0.05, 1.0))
+    green = g.material("green", (0.14, 0.45, 0.091, 1.0))
+    # Emitted radiance = emissiveFactor * strength = (17, 12, 4).
+    light = g.material("light", (0.78, 0.78, 0.78, 1.0),
+                       emissive=(1.0, 12.0 / 17.0, 4.0 / 17.0), strength=17.0,
+                       double_sided=False)
+    room_materials = {"floor": white, "ceiling": white, "back_wall": white,
+                      "left_wall_red": red, "right_wall_green": green}
+
+    def toward_room_centre(quad):
+        return sub(CORNELL_ROOM_CENTRE,
+                   centroid([tuple(map(float, p)) for p in quad]))
+
+    objects = []
+    for name in ("floor", "ceiling", "back_wall", "left_wall_red",
+                 "right_wall_green"):
+        tris = oriented_triangles([CORNELL_ROOM[name]], toward_room_centre)
+        objects.append((name, tris, room_materials[name]))
+    objects.append(("light", oriented_triangles(
+        [CORNELL_LIGHT], lambda q: (0.0, -1.0, 0.0)), light))
+    objects.append(("short_block", block_triangles(CORNELL_SHORT_BLOCK),
+                    white))
+    objects.append(("tall_block", block_triangles(CORNELL_TALL_BLOCK), white))
+
+    for name, tris, mat in objects:
+        g.node(name, mesh=g.mesh(name, tris, mat))
+
+    # 35 mm lens on 25 mm film; look toward +Z (180 degrees about Y).
+    cam = g.camera("camera", 2.0 * math.atan(12.5 / 35.0), 1.0)
+    g.node("camera", camera=cam, translation=[0.278, 0.273, -0.8],
+           rotation=[0.0, 1.0, 0.0, 0.0])
+    g.write(path)
+
+
+# ---------------------------------------------------------------------------
+# Icosphere and cube
+
+def icosphere(subdivisions, radius=1.0, inward=False):
+    """Triangles of a watertight icosphere centred at the origin.
+
+    Vertices are shared via an edge-midpoint cache, so neighbouring triangles
+    use bit-identical float32 positions.  Fronts face outward unless inward.
+    """
+    t = (1.0 + math.sqrt(5.0)) / 2.0
+    verts = [normalize(v) for v in (
+        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
+        (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+        (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1))]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
+             (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
+             (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
+             (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+
+    for _ in range(subdivisions):
+        cache = {}
+
+        def midpoint(i, j):
+            key = (min(i, j), max(i, j))
+            if key not in cache:
+                verts.append(normalize(scale(add(verts[i], verts[j]), 0.5)))
+                cache[key] = len(verts) - 1
+            return cache[key]
+
+        new_faces = []
+        for a, b, c in faces:
+            ab, bc, ca = midpoint(a, b), midpoint(b, c), midpoint(c, a)
+            new_faces += [(a, ab, ca), (b, bc, ab), (c, ca, bc),
+                          (ab, bc, ca)]
+        faces = new_faces
+
+    points = [f32v(scale(v, radius)) for v in verts]
+    tris = []
+    for a, b, c in faces:
+        tri = (points[a], points[b], points[c])
+        # Orient explicitly: outward means normal along the face centroid.
+        outward = dot(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])),
+                      centroid(tri)) > 0
+        if outward == inward:
+            tri = (tri[0], tri[2], tri[1])
+        tris.append(tri)
+    return tris
+
+
+def cube(side):
+    """Twelve outward-facing triangles of an origin-centred cube."""
+    h = side / 2.0
+    tris = []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+            corners = []
+            for du, dv in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[v] = sign * h, du * h, dv * h
+                corners.append(f32v(p))
+            normal = [0.0, 0.0, 0.0]
+            normal[axis] = sign
+            tris += quad_triangles(orient_quad(corners, tuple(normal)))
+    return tris
+
+
+# ---------------------------------------------------------------------------
+# Furnace scenes
+
+def make_closed_sphere(path):
+    """Sphere with albedo 0.5, emission 0.5, seen from inside: L = 1."""
+    g = GltfBuilder()
+    mat = g.material("furnace", (0.5, 0.5, 0.5, 1.0),
+                     emissive=(0.5, 0.5, 0.5))
+    g.node("sphere", mesh=g.mesh("sphere", icosphere(3, inward=True), mat))
+    g.node("camera", camera=g.camera("camera", 1.2, 1.0))
+    g.doc["scenes"][0]["extras"] = {"candela": {"background": [0, 0, 0]}}
+    g.write(path)
+
+
+def make_white_objects(path):
+    """Albedo-1 objects under a white background: L = 1 everywhere."""
+    g = GltfBuilder()
+    white = g.material("white", (1.0, 1.0, 1.0, 1.0))
+    # Hierarchy: parent translation, child uniform scale holding unit sphere.
+    sphere_mesh = g.mesh("sphere", icosphere(3), white)
+    parent = g.node("sphere", translation=[-0.35, 0.0, 0.0])
+    child = g.node("sphere_scaled", root=False, mesh=sphere_mesh,
+                   scale=[0.5, 0.5, 0.5])
+    g.doc["nodes"][parent]["children"] = [child]
+    half = math.radians(30.0) / 2.0
+    g.node("cube", mesh=g.mesh("cube", cube(0.6), white),
+           translation=[0.4, 0.0, 0.1],
+           rotation=[0.0, math.sin(half), 0.0, math.cos(half)])
+    g.node("camera", camera=g.camera("camera", 0.8, 1.0),
+           translation=[0.0, 0.0, 3.0])
+    g.doc["scenes"][0]["extras"] = {"candela": {"background": [1, 1, 1]}}
+    g.write(path)
+
+
+# ---------------------------------------------------------------------------
+# Read-back checks
+
+def read_vec3s(doc, blob, index):
+    acc = doc["accessors"][index]
+    view = doc["bufferViews"][acc["bufferView"]]
+    assert acc["componentType"] == FLOAT and acc["type"] == "VEC3"
+    assert view["byteLength"] == 12 * acc["count"]
+    start = view["byteOffset"] + acc.get("byteOffset", 0)
+    return [struct.unpack_from("<3f", blob, start + 12 * i)
+            for i in range(acc["count"])]
+
+
+def read_indices(doc, blob, index):
+    acc = doc["accessors"][index]
+    view = doc["bufferViews"][acc["bufferView"]]
+    assert acc["componentType"] == UNSIGNED_INT and acc["type"] == "SCALAR"
+    assert view["byteLength"] == 4 * acc["count"]
+    assert view["target"] == ELEMENT_ARRAY_BUFFER
+    start = view["byteOffset"] + acc.get("byteOffset", 0)
+    return list(struct.unpack_from("<%dI" % acc["count"], blob, start))
+
+
+def check_watertight(positions, indices):
+    """Every directed edge must be matched by exactly one reversed edge."""
+    edges = {}
+    for k in range(0, len(indices), 3):
+        tri = [struct.pack("<3f", *positions[i]) for i in indices[k:k + 3]]
+        for e in range(3):
+            key = (tri[e], tri[(e + 1) % 3])
+            edges[key] = edges.get(key, 0) + 1
+    for (a, b), n in edges.items():
+        assert n == 1 and edges.get((b, a)) == 1, "mesh is not watertight"
+
+
+def check_gltf(path):
+    """Load a written file back and validate it; returns triangles per mesh."""
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    assert doc["asset"]["version"] == "2.0" and doc["scene"] == 0
+    prefix = "data:application/octet-stream;base64,"
+    buf = doc["buffers"][0]
+    assert len(doc["buffers"]) == 1 and buf["uri"].startswith(prefix)
+    blob = base64.b64decode(buf["uri"][len(prefix):])
+    assert len(blob) == buf["byteLength"]
+    counts = {}
+    for mesh in doc["meshes"]:
+        for prim in mesh["primitives"]:
+            attrs = prim["attributes"]
+            pos_acc = doc["accessors"][attrs["POSITION"]]
+            positions = read_vec3s(doc, blob, attrs["POSITION"])
+            normals = read_vec3s(doc, blob, attrs["NORMAL"])
+            indices = read_indices(doc, blob, prim["indices"])
+            assert len(positions) == len(normals)
+            assert len(indices) % 3 == 0
+            assert all(i < len(positions) for i in indices)
+            for i in range(3):
+                assert pos_acc["min"][i] == min(p[i] for p in positions)
+                assert pos_acc["max"][i] == max(p[i] for p in positions)
+            for k in range(0, len(indices), 3):
+                a, b, c = (positions[i] for i in indices[k:k + 3])
+                n = tri_normal(a, b, c)
+                for i in indices[k:k + 3]:
+                    assert dot(n, normals[i]) > 0.999, "winding/normal mismatch"
+            if mesh["name"] in ("sphere", "cube"):
+                check_watertight(positions, indices)
+            counts[mesh["name"]] = len(indices) // 3
+    return counts
+
+
+# ---------------------------------------------------------------------------
+
+SCENES = [
+    ("scenes/cornell-box/cornell-box.gltf", make_cornell_box),
+    ("scenes/furnace/closed-sphere.gltf", make_closed_sphere),
+    ("scenes/furnace/white-objects.gltf", make_white_objects),
+]
+
+
+def main():
+    for rel_path, make in SCENES:
+        path = os.path.join(REPO_ROOT, rel_path)
+        make(path)
+        counts = check_gltf(path)
+        total = sum(counts.values())
+        detail = ", ".join("%s %d" % kv for kv in counts.items())
+        print("wrote %s: %d triangles (%s)" % (rel_path, total, detail))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,83 @@
+// Test kernels: thin wrappers that run the real cl/ routines on inputs from the host.
+
+// Sizes and offsets of the shared structs as the device compiler lays them out
+#define OFFSET_OF(type, field) ((uint)(size_t)&(((type*)0)->field))
+__kernel void test_struct_layout(__global uint* out) {
+  if (get_global_id(0) != 0) return;
+  out[0] = sizeof(BvhNode);
+  out[1] = sizeof(Triangle);
+  out[2] = sizeof(TriangleShading);
+  out[3] = sizeof(Material);
+  out[4] = sizeof(TextureInfo);
+  out[5] = sizeof(Light);
+  out[6] = sizeof(Camera);
+  out[7] = sizeof(RenderParams);
+  out[8] = OFFSET_OF(BvhNode, right);
+  out[9] = OFFSET_OF(Triangle, v2);
+  out[10] = OFFSET_OF(TriangleShading, uv2_v);
+  out[11] = OFFSET_OF(Material, emission);
+  out[12] = OFFSET_OF(Light, radiance);
+  out[13] = OFFSET_OF(RenderParams, background);
+  out[14] = OFFSET_OF(RenderParams, strategy);
+  out[15] = OFFSET_OF(RenderParams, rr_depth);
+}
+
+__kernel void test_rng_uniform(uint seed, __global float* out) {
+  uint i = get_global_id(0);
+  Rng rng = rng_init(i, 7u, seed);
+  for (int k = 0; k < 4; ++k) out[4 * i + k] = rng_next(&rng);
+}
+
+// which: 0 cosine hemisphere, 1 uniform sphere; out: xyz direction, w pdf
+__kernel void test_sample_direction(uint which, uint seed, __global float4* out) {
+  uint i = get_global_id(0);
+  Rng rng = rng_init(i, 0u, seed);
+  float u = rng_next(&rng), v = rng_next(&rng);
+  float3 d = which == 0u ? sample_cosine_hemisphere(u, v) : sample_uniform_sphere(u, v);
+  float pdf = which == 0u ? sample_cosine_hemisphere_pdf(d.z) : sample_uniform_sphere_pdf();
+  out[i] = (float4)(d, pdf);
+}
+
+// Uniform point on triangle v0 v1 v2, written as a 3D point
+__kernel void test_sample_triangle(uint seed, float4 v1, float4 v2, float4 v3,
+                                   __global float4* out) {
+  uint i = get_global_id(0);
+  Rng rng = rng_init(i, 0u, seed);
+  float u = rng_next(&rng), v = rng_next(&rng);
+  float2 st = sample_triangle(u, v);
+  out[i] = st.x * v1 + st.y * v2 + (1.0f - st.x - st.y) * v3;
+}
+
+// rays: (org, tmax) then (dir, 0); out: (t, b1, b2, tri) closest hit, occluded flag
+__kernel void test_trace_bvh(__global const BvhNode* nodes, __global const Triangle* tris,
+                             __global const float4* rays, __global float4* out,
+                             __global int* occluded) {
+  uint i = get_global_id(0);
+  Ray r;
+  r.org = rays[2 * i].xyz;
+  r.dir = rays[2 * i + 1].xyz;
+  float tmax = rays[2 * i].w;
+  Hit h = bvh_intersect(nodes, tris, r, tmax, false);
+  out[i] = (float4)(h.t, h.b1, h.b2, (float)h.tri);
+  occluded[i] = bvh_occluded(nodes, tris, r, tmax) ? 1 : 0;
+}
+
+// The same rays against every triangle, without the BVH
+__kernel void test_trace_brute(__global const Triangle* tris, uint num_tris,
+                               __global const float4* rays, __global float4* out) {
+  uint i = get_global_id(0);
+  Ray r;
+  r.org = rays[2 * i].xyz;
+  r.dir = rays[2 * i + 1].xyz;
+  WatertightRay wr = watertight_ray(r);
+  float best = rays[2 * i].w;
+  float4 result = (float4)(best, 0.0f, 0.0f, -1.0f);
+  for (uint k = 0; k < num_tris; ++k) {
+    float t, b1, b2;
+    if (intersect_triangle_at(&wr, &tris[k], best, &t, &b1, &b2)) {
+      best = t;
+      result = (float4)(t, b1, b2, (float)k);
+    }
+  }
+  out[i] = result;
+}
