@@ -38,6 +38,8 @@ WatertightRay watertight_ray(Ray ray) {
 // Hit in (0, tmax)? On a hit sets *t and the barycentric weights of v1 and v2.
 bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax,
                         float* t, float* b1, float* b2) {
+  // Fused multiply-adds would give the two triangles of an edge different edge values
+#pragma OPENCL FP_CONTRACT OFF
   float3 a = permute3(v0 - r->org, r->perm);
   float3 b = permute3(v1 - r->org, r->perm);
   float3 c = permute3(v2 - r->org, r->perm);

@@ -1,9 +1,15 @@
 // Test kernels: thin wrappers that run the real cl/ routines on inputs from the host.
 
 // Sizes and offsets of the shared structs as the device compiler lays them out
-#define OFFSET_OF(type, field) ((uint)(size_t)&(((type*)0)->field))
+#define OFFSET_OF(object, field) ((uint)((char*)&(object).field - (char*)&(object)))
 __kernel void test_struct_layout(__global uint* out) {
   if (get_global_id(0) != 0) return;
+  BvhNode node;
+  Triangle tri;
+  TriangleShading shading;
+  Material material;
+  Light light;
+  RenderParams params;
   out[0] = sizeof(BvhNode);
   out[1] = sizeof(Triangle);
   out[2] = sizeof(TriangleShading);
@@ -12,14 +18,14 @@ __kernel void test_struct_layout(__global uint* out) {
   out[5] = sizeof(Light);
   out[6] = sizeof(Camera);
   out[7] = sizeof(RenderParams);
-  out[8] = OFFSET_OF(BvhNode, right);
-  out[9] = OFFSET_OF(Triangle, v2);
-  out[10] = OFFSET_OF(TriangleShading, uv2_v);
-  out[11] = OFFSET_OF(Material, emission);
-  out[12] = OFFSET_OF(Light, radiance);
-  out[13] = OFFSET_OF(RenderParams, background);
-  out[14] = OFFSET_OF(RenderParams, strategy);
-  out[15] = OFFSET_OF(RenderParams, rr_depth);
+  out[8] = OFFSET_OF(node, right);
+  out[9] = OFFSET_OF(tri, v2);
+  out[10] = OFFSET_OF(shading, uv2_v);
+  out[11] = OFFSET_OF(material, emission);
+  out[12] = OFFSET_OF(light, radiance);
+  out[13] = OFFSET_OF(params, background);
+  out[14] = OFFSET_OF(params, strategy);
+  out[15] = OFFSET_OF(params, rr_depth);
 }
 
 __kernel void test_rng_uniform(uint seed, __global float* out) {

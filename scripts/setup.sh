@@ -1,0 +1,36 @@
+# Shared set-up for scripts/demo, scripts/test and scripts/bench (sourced, not run):
+# installs missing Debian packages, then configures and builds Release into build/.
+set -euo pipefail
+
+CANDELA_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+CANDELA_PACKAGES=(
+  cmake g++ make pkg-config python3
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
+  mesa-opencl-icd
+  libtinygltf-dev nlohmann-json3-dev
+  libopenimageio-dev openimageio-tools libglm-dev libcli11-dev
+  googletest libgtest-dev
+)
+
+candela_install_packages() {
+  local missing=()
+  for p in "${CANDELA_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "candela: installing ${missing[*]}" >&2
+  local sudo=()
+  [ "$(id -u)" -ne 0 ] && sudo=(sudo)
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+candela_build() {
+  local jobs
+  jobs=$(nproc 2>/dev/null || echo 2)
+  cmake -S "$CANDELA_ROOT" -B "$CANDELA_ROOT/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$CANDELA_ROOT/build" -j "$jobs"
+}
+
+candela_install_packages
+candela_build

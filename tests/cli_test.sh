@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# CLI behaviour: bad input gives one clear message and a non-zero exit; a good render
+# writes EXR (with metadata), PNG and stats; Ctrl-C keeps the samples already done.
+# Usage: cli_test.sh path/to/candela repo_root
+set -u
+bin=$1
+root=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+passes=0
+scene=$root/scenes/cornell-box/cornell-box.gltf
+
+pass() { passes=$((passes + 1)); echo "ok: $1"; }
+fail() { fails=$((fails + 1)); echo "FAIL: $1"; }
+
+# expect_error NAME PATTERN -- command...: non-zero exit, no crash, stderr matches PATTERN
+expect_error() {
+  local name=$1 pattern=$2
+  shift 3
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  if [ $rc -eq 0 ]; then
+    fail "$name: exit 0"
+  elif [ $rc -ge 128 ]; then
+    fail "$name: killed by signal (exit $rc)"
+  elif ! grep -q -- "$pattern" "$tmp/err"; then
+    fail "$name: stderr lacks '$pattern':"; cat "$tmp/err"
+  elif [ "$(grep -c '^candela: error' "$tmp/err")" -ne 1 ]; then
+    fail "$name: expected one error line:"; cat "$tmp/err"
+  else
+    pass "$name"
+  fi
+}
+
+expect_error "missing scene" "scene file not found" -- "$bin" render "$tmp/nope.gltf" -o "$tmp/x.png" --device pocl
+echo '{ "asset": {"version": "2.0"}, "nodes": [ {' >"$tmp/bad.gltf"
+expect_error "malformed glTF" "cannot load glTF scene" -- "$bin" render "$tmp/bad.gltf" -o "$tmp/x.png" --device pocl
+printf 'glTF\x02\x00\x00\x00junk' >"$tmp/bad.glb"
+expect_error "malformed GLB" "cannot load glTF scene" -- "$bin" render "$tmp/bad.glb" -o "$tmp/x.png" --device pocl
+expect_error "unknown device" "no OpenCL device matches --device 'quantum'" -- "$bin" render "$scene" -o "$tmp/x.png" --device quantum
+mkdir -p "$tmp/no-vendors"
+expect_error "no OpenCL platform" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$scene" -o "$tmp/x.png"
+expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" devices
+expect_error "bad output extension" "must end in .exr or .png" -- "$bin" render "$scene" -o "$tmp/x.jpg" --device pocl
+expect_error "bad strategy" "strategy must be nee or bsdf" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
+expect_error "bad background" "three comma-separated numbers" -- "$bin" render "$scene" -o "$tmp/x.png" --background 1,2 --device pocl
+mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights.cl"
+expect_error "kernel build failure shows the log" "cl/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
+
+# devices lists PoCL with a selector
+if "$bin" devices | grep -q "Portable Computing Language"; then pass "devices lists PoCL"; else fail "devices lists PoCL"; fi
+
+# A good render: EXR with metadata, PNG, stats JSON
+if "$bin" render "$scene" -o "$tmp/cb.exr" -o "$tmp/cb.png" --spp 4 --width 64 --height 48 --device pocl --seed 3 \
+    --stats "$tmp/stats.json" -q >"$tmp/out" 2>"$tmp/err"; then
+  pass "render exits 0"
+else
+  fail "render exits 0"; cat "$tmp/err"
+fi
+[ -s "$tmp/cb.png" ] && pass "PNG written" || fail "PNG written"
+if python3 - "$tmp/stats.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+need = ["spp", "seconds", "samples_per_second", "kernel_build_seconds", "bvh_build_seconds",
+        "triangles", "device", "dropped_samples"]
+missing = [k for k in need if k not in s]
+assert not missing, missing
+assert s["spp"] == 4 and s["triangles"] == 32 and s["samples_per_second"] > 0, s
+assert s["width"] == 64 and s["height"] == 48, s
+PY
+then pass "stats JSON fields"; else fail "stats JSON fields"; fi
+if command -v oiiotool >/dev/null; then
+  if oiiotool --info -v "$tmp/cb.exr" | grep -q 'candela:spp: "4"'; then pass "EXR metadata"; else fail "EXR metadata"; fi
+fi
+
+# Ctrl-C during a long render writes what was rendered and exits 130
+"$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \
+  --stats "$tmp/int.json" >"$tmp/int.out" 2>"$tmp/int.err" &
+pid=$!
+# Wait until the kernel is built (the scene summary is printed), then let samples run
+for i in $(seq 1 300); do
+  grep -q "^scene:" "$tmp/int.err" 2>/dev/null && break
+  [ -d "/proc/$pid" ] || break
+  sleep 0.2
+done
+sleep 1
+kill -INT $pid
+wait $pid
+rc=$?
+if [ $rc -eq 130 ] && [ -s "$tmp/int.exr" ] && python3 -c "import json,sys; s=json.load(open('$tmp/int.json')); assert s['interrupted'] and s['spp'] > 0" 2>/dev/null; then
+  pass "Ctrl-C keeps the samples done"
+else
+  fail "Ctrl-C keeps the samples done (exit $rc)"; cat "$tmp/int.err"
+fi
+
+echo "$passes passed, $fails failed"
+[ $fails -eq 0 ]

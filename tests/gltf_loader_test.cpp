@@ -1,0 +1,238 @@
+// glTF loading: transforms, winding, materials, textures, cameras, errors and warnings.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "error.hpp"
+#include "gltf_loader.hpp"
+#include "renderer.hpp"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace candela::test {
+namespace {
+
+std::string base64(const std::string& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8) | uint8_t(in[i + 2]);
+    for (int k = 3; k >= 0; --k) out += t[(v >> (6 * k)) & 63];
+  }
+  if (i + 1 == in.size()) {
+    uint32_t v = uint8_t(in[i]) << 16;
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += "==";
+  } else if (i + 2 == in.size()) {
+    uint32_t v = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8);
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += t[(v >> 6) & 63];
+    out += '=';
+  }
+  return out;
+}
+
+// A glTF with one quad (two triangles, z = 0, facing +z, UVs with v down) as mesh 0
+json quad_gltf(float half = 1.0f) {
+  std::vector<float> pos = {-half, -half, 0, half, -half, 0, half, half, 0, -half, half, 0};
+  std::vector<float> uv = {0, 1, 1, 1, 1, 0, 0, 0};
+  std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+  std::string bin(reinterpret_cast<const char*>(pos.data()), pos.size() * 4);
+  bin += std::string(reinterpret_cast<const char*>(uv.data()), uv.size() * 4);
+  bin += std::string(reinterpret_cast<const char*>(idx.data()), idx.size() * 2);
+  json j;
+  j["asset"] = {{"version", "2.0"}};
+  j["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
+  j["bufferViews"] = {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
+                      {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 32}},
+                      {{"buffer", 0}, {"byteOffset", 80}, {"byteLength", 12}}};
+  j["accessors"] = {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"},
+                     {"min", {-half, -half, 0}}, {"max", {half, half, 0}}},
+                    {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}},
+                    {{"bufferView", 2}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}};
+  j["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"indices", 2}, {"material", 0}}}}}};
+  j["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}}}}};
+  j["nodes"] = {{{"mesh", 0}}};
+  j["scenes"] = {{{"nodes", {0}}}};
+  j["scene"] = 0;
+  return j;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    path = fs::temp_directory_path() / ("candela-gltf-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::string p = (path / name).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path path;
+
+ private:
+  static inline int counter_ = 0;
+};
+
+glm::vec3 winding_normal(const SceneTriangle& t) { return glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]); }
+
+}  // namespace
+
+TEST(GltfLoader, CornellBoxHasPublishedLightCameraAndSize) {
+  Scene s = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  EXPECT_EQ(s.triangles.size(), 32u);
+  ASSERT_TRUE(s.camera.has_value());
+  EXPECT_NEAR(s.camera->position.z, -0.8f, 1e-6f);
+  EXPECT_NEAR(s.camera->forward.z, 1.0f, 1e-6f);
+  EXPECT_NEAR(s.camera->yfov, 2.0 * std::atan(12.5 / 35.0), 1e-6);
+  bool found_light = false;
+  for (const auto& m : s.materials)
+    if (m.emission[0] > 0) {
+      found_light = true;
+      EXPECT_FLOAT_EQ(m.emission[0], 17.0f);
+      EXPECT_NEAR(m.emission[1], 12.0f, 1e-5f);
+      EXPECT_NEAR(m.emission[2], 4.0f, 1e-5f);
+      EXPECT_EQ(m.double_sided, 0u);
+    }
+  EXPECT_TRUE(found_light);
+  Bounds b = s.bounds();
+  EXPECT_NEAR(b.hi.x, 0.556f, 1e-5f);
+  EXPECT_NEAR(b.hi.y, 0.5488f, 1e-5f);
+  EXPECT_NEAR(b.hi.z, 0.5592f, 1e-5f);
+}
+
+TEST(GltfLoader, NodeHierarchyTransformsApply) {
+  Scene s = load_gltf(scene_path("furnace/white-objects.gltf"));
+  // The sphere: parent translation (-0.35,0,0), child scale 0.5 of a unit sphere
+  Bounds sphere;
+  for (const auto& t : s.triangles)
+    if (t.p[0].x < -0.2f && t.p[1].x < -0.2f && t.p[2].x < -0.2f)
+      for (const auto& p : t.p) sphere.grow(p);
+  EXPECT_NEAR(sphere.lo.x, -0.85f, 1e-3f);
+  EXPECT_NEAR(sphere.hi.y, 0.5f, 1e-3f);
+  EXPECT_NEAR(s.background.x, 1.0f, 0.0f);
+}
+
+TEST(GltfLoader, MirroringTransformKeepsFrontFacesFront) {
+  TempDir dir;
+  json j = quad_gltf();
+  j["nodes"][0]["scale"] = {-1, 1, 1};
+  Scene s = load_gltf(dir.write("mirror.gltf", j.dump()));
+  ASSERT_EQ(s.triangles.size(), 2u);
+  // Unmirrored the quad faces +z; mirroring in x must not turn it around
+  for (const auto& t : s.triangles) EXPECT_GT(winding_normal(t).z, 0.0f);
+}
+
+TEST(GltfLoader, MatrixTransformAndTriangleStrip) {
+  TempDir dir;
+  json j = quad_gltf();
+  j["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 6, 7, 1};  // translate (5,6,7)
+  j["accessors"][2]["count"] = 4;  // indices 0 1 3 2 as a strip
+  j["meshes"][0]["primitives"][0]["mode"] = 5;
+  std::vector<uint16_t> strip = {0, 1, 3, 2};
+  std::vector<float> pos = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  std::vector<float> uv(8, 0.0f);
+  std::string bin(reinterpret_cast<const char*>(pos.data()), 48);
+  bin += std::string(reinterpret_cast<const char*>(uv.data()), 32);
+  bin += std::string(reinterpret_cast<const char*>(strip.data()), 8);
+  j["buffers"][0] = {{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}};
+  j["bufferViews"][2]["byteLength"] = 8;
+  Scene s = load_gltf(dir.write("strip.gltf", j.dump()));
+  ASSERT_EQ(s.triangles.size(), 2u);
+  for (const auto& t : s.triangles) {
+    EXPECT_GT(winding_normal(t).z, 0.0f) << "strip winding alternates";
+    for (const auto& p : t.p) EXPECT_FLOAT_EQ(p.z, 7.0f);
+  }
+  EXPECT_FLOAT_EQ(s.bounds().lo.x, 4.0f);
+}
+
+TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
+  TempDir dir;
+  json j = quad_gltf();
+  j["extensionsUsed"] = {"KHR_materials_clearcoat"};
+  j["materials"][0]["extensions"] = {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}}};
+  j["materials"].push_back(j["materials"][0]);
+  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
+  Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
+  int clearcoat = 0, metallic = 0;
+  for (const auto& w : s.warnings) {
+    clearcoat += w.find("KHR_materials_clearcoat") != std::string::npos;
+    metallic += w.find("metallic") != std::string::npos;
+  }
+  EXPECT_EQ(clearcoat, 1);
+  EXPECT_EQ(metallic, 1);
+}
+
+TEST(GltfLoader, MissingAndMalformedFilesFailClearly) {
+  TempDir dir;
+  EXPECT_THROW(load_gltf((dir.path / "nope.gltf").string()), Error);
+  EXPECT_THROW(load_gltf(dir.write("bad.gltf", "{ this is not json")), Error);
+  json j = quad_gltf();
+  j["accessors"][0]["count"] = 400;  // reads past the buffer
+  EXPECT_THROW(load_gltf(dir.write("short.gltf", j.dump())), Error);
+  json empty = {{"asset", {{"version", "2.0"}}}, {"scenes", {{{"nodes", json::array()}}}}};
+  try {
+    load_gltf(dir.write("empty.gltf", empty.dump()));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no triangles"), std::string::npos);
+  }
+}
+
+// A textured diffuse quad facing a camera under a white background of radiance 1 reflects
+// exactly its albedo: the sRGB-decoded texel colour times baseColorFactor.
+TEST(GltfLoader, BaseColorTextureIsSrgbDecodedAndRendered) {
+  TempDir dir;
+  // 2x1 PNG: left texel sRGB 188 red-ish, right sRGB 100 blue-ish
+  unsigned char px[6] = {188, 60, 20, 20, 60, 100};
+  std::string png = (dir.path / "tex.png").string();
+  auto out = OIIO::ImageOutput::create(png);
+  ASSERT_TRUE(out && out->open(png, OIIO::ImageSpec(2, 1, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
+  out->close();
+  json j = quad_gltf();
+  j["images"] = {{{"uri", "tex.png"}}};
+  j["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33071}}};  // clamp to edge
+  j["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 1};
+  j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  j["materials"][0]["doubleSided"] = true;
+  j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.01}}}}};
+  j["nodes"].push_back({{"camera", 0}, {"translation", {0, 0, 3}}});
+  j["scenes"][0]["nodes"] = {0, 1};
+  j["scenes"][0]["extras"] = {{"candela", {{"background", {1, 1, 1}}}}};
+  Scene s = load_gltf(dir.write("textured.gltf", j.dump()));
+  ASSERT_EQ(s.textures.size(), 1u);
+  auto srgb = [](double c) { c /= 255.0; return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+  EXPECT_NEAR(s.texels[0], srgb(188), 1e-5);
+  EXPECT_NEAR(s.texels[6], srgb(100), 1e-5);
+  EXPECT_TRUE(s.features().textures);
+
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  settings.max_depth = 4;
+  Renderer r(pocl_device(), s, settings);
+  Film f = r.render(0, 16).film;
+  // Quad spans the whole view; the left and right quarters see only their texel (clamped)
+  for (int y = 4; y < 12; ++y) {
+    glm::vec3 left = f.pixel(size_t(y) * 16 + 1), right = f.pixel(size_t(y) * 16 + 14);
+    EXPECT_NEAR(left.x, srgb(188), 1e-3);
+    EXPECT_NEAR(left.z, srgb(20), 1e-3);
+    EXPECT_NEAR(right.x, srgb(20), 1e-3);
+    EXPECT_NEAR(right.z, srgb(100), 1e-3);
+  }
+}
+
+}  // namespace candela::test

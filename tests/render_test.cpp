@@ -1,0 +1,183 @@
+// Whole renders with known answers, checked within measured standard errors, on PoCL
+// and (when installed) on Mesa's rusticl.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gltf_loader.hpp"
+#include "renderer.hpp"
+#include "test_support.hpp"
+
+namespace candela::test {
+namespace {
+
+struct Estimate {
+  double mean = 0.0;
+  double standard_error = 0.0;
+};
+
+// Mean over pixels [x0,x1) x [y0,y1) of channel c, with its standard error from the
+// per-pixel sample variances
+Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1) {
+  double sum = 0.0, var = 0.0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      size_t i = size_t(y) * f.width + x;
+      sum += f.pixel(i)[c];
+      var += f.variance_of_mean(i)[c];
+      ++n;
+    }
+  return {sum / n, std::sqrt(var) / n};
+}
+
+Estimate image_mean(const Film& f) {
+  Estimate e;
+  double var = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    Estimate ec = region_mean(f, c, 0, f.width, 0, f.height);
+    e.mean += ec.mean / 3.0;
+    var += ec.standard_error * ec.standard_error / 9.0;  // channels treated as independent: conservative enough for a z-test
+  }
+  e.standard_error = std::sqrt(var);
+  return e;
+}
+
+RenderResult render_scene(const DeviceEntry& device, const std::string& scene_file, Strategy s,
+                          int size, uint32_t spp, uint32_t max_depth = 1000, uint32_t seed = 1) {
+  Scene scene = load_gltf(scene_path(scene_file));
+  RenderSettings settings;
+  settings.width = settings.height = size;
+  settings.strategy = s;
+  settings.max_depth = max_depth;
+  settings.seed = seed;
+  Renderer r(device, scene, settings);
+  return r.render(0, spp);
+}
+
+const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : "bsdf"; }
+
+using DeviceStrategy = std::tuple<std::string, Strategy>;
+
+class FurnaceTest : public ::testing::TestWithParam<DeviceStrategy> {};
+
+}  // namespace
+
+// Camera inside a closed sphere of albedo a = 0.5 emitting Le = 0.5: L = Le / (1 - a) = 1
+TEST_P(FurnaceTest, ClosedEmissiveSphereGivesLeOverOneMinusAlbedo) {
+  DeviceEntry device;
+  CANDELA_DEVICE_OR_SKIP(std::get<0>(GetParam()), device);
+  Strategy s = std::get<1>(GetParam());
+  RenderResult r = render_scene(device, "furnace/closed-sphere.gltf", s, 24, 256);
+  Estimate e = image_mean(r.film);
+  EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error) << name(s) << " SE " << e.standard_error;
+  EXPECT_EQ(r.film.dropped_samples(), 0u);
+}
+
+// Objects of albedo 1 under a constant background of 1 are invisible: L = 1 everywhere
+TEST_P(FurnaceTest, WhiteObjectsUnderWhiteBackgroundAreInvisible) {
+  DeviceEntry device;
+  CANDELA_DEVICE_OR_SKIP(std::get<0>(GetParam()), device);
+  Strategy s = std::get<1>(GetParam());
+  RenderResult r = render_scene(device, "furnace/white-objects.gltf", s, 24, 128);
+  Estimate e = image_mean(r.film);
+  EXPECT_LT(e.standard_error, 0.01);
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error) << name(s) << " SE " << e.standard_error;
+  // And pixel by pixel, over 4x4 blocks
+  for (int by = 0; by < 24; by += 4)
+    for (int bx = 0; bx < 24; bx += 4) {
+      Estimate b = region_mean(r.film, 1, bx, bx + 4, by, by + 4);
+      EXPECT_NEAR(b.mean, 1.0, 5.0 * b.standard_error + 1e-5) << "block " << bx << "," << by;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, FurnaceTest,
+                         ::testing::Combine(::testing::Values("pocl", "rusticl"),
+                                            ::testing::Values(Strategy::Nee, Strategy::Bsdf)),
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + "_" + name(std::get<1>(info.param));
+                         });
+
+class CornellTest : public ::testing::TestWithParam<std::string> {};
+
+// Next-event estimation and BSDF sampling estimate the same image: compare 8x8 blocks
+TEST_P(CornellTest, StrategiesAgreeWithinStandardError) {
+  DeviceEntry device;
+  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
+  const int size = 32;
+  RenderResult nee = render_scene(device, "cornell-box/cornell-box.gltf", Strategy::Nee, size, 128, 8);
+  RenderResult bsdf = render_scene(device, "cornell-box/cornell-box.gltf", Strategy::Bsdf, size, 512, 8, 2);
+  double max_z = 0.0;
+  double chi2 = 0.0;
+  int blocks = 0;
+  for (int by = 0; by < size; by += 8)
+    for (int bx = 0; bx < size; bx += 8)
+      for (int c = 0; c < 3; ++c) {
+        Estimate a = region_mean(nee.film, c, bx, bx + 8, by, by + 8);
+        Estimate b = region_mean(bsdf.film, c, bx, bx + 8, by, by + 8);
+        double se = std::sqrt(a.standard_error * a.standard_error + b.standard_error * b.standard_error);
+        double z = (a.mean - b.mean) / se;
+        max_z = std::max(max_z, std::fabs(z));
+        chi2 += z * z;
+        ++blocks;
+        EXPECT_LT(std::fabs(z), 4.5) << "block " << bx << "," << by << " channel " << c << ": nee "
+                                    << a.mean << " bsdf " << b.mean << " se " << se;
+      }
+  // The sum of squared z-scores is chi-square with `blocks` dof: mean 48, sd ~10
+  EXPECT_LT(chi2, blocks + 5.0 * std::sqrt(2.0 * blocks)) << "max |z| " << max_z;
+  Estimate whole_nee = image_mean(nee.film), whole_bsdf = image_mean(bsdf.film);
+  EXPECT_GT(whole_nee.mean, 0.05) << "the Cornell box must not be black";
+  EXPECT_LT(whole_nee.standard_error, 0.02 * whole_nee.mean);
+  EXPECT_LT(whole_bsdf.standard_error, 0.05 * whole_bsdf.mean);
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, CornellTest, ::testing::Values("pocl", "rusticl"),
+                         [](const auto& info) { return std::string(info.param); });
+
+TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderSettings settings;
+  settings.width = settings.height = 24;
+  settings.seed = 42;
+  Renderer one(device, scene, settings);
+  Film a = one.render(0, 12).film;
+  Renderer two(device, scene, settings);
+  two.render(0, 5);
+  two.render(5, 4);
+  Film b = two.render(9, 3).film;
+  EXPECT_EQ(a.mean, b.mean);
+  EXPECT_EQ(a.m2, b.m2);
+
+  settings.seed = 43;
+  Renderer other(device, scene, settings);
+  Film c = other.render(0, 12).film;
+  EXPECT_NE(a.mean, c.mean) << "a different seed must give a different image";
+}
+
+TEST(Determinism, FilmsOfDisjointSampleRangesMergeToTheWholeRender) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  Film whole = Renderer(device, scene, settings).render(0, 16).film;
+  Film first = Renderer(device, scene, settings).render(0, 6).film;
+  Film second = Renderer(device, scene, settings).render(6, 10).film;
+  Film merged = merge_films(first, second);
+  for (size_t i = 0; i < whole.mean.size(); ++i) {
+    EXPECT_NEAR(merged.mean[i], whole.mean[i], 1e-4f * (1.0f + std::fabs(whole.mean[i])));
+    EXPECT_NEAR(merged.m2[i], whole.m2[i], 1e-3f * (1.0f + std::fabs(whole.m2[i])));
+  }
+}
+
+TEST(Render, DirectLightingOnlyAtMaxDepthOneIsDarkerThanFullTransport) {
+  DeviceEntry device = pocl_device();
+  Estimate direct = image_mean(render_scene(device, "cornell-box/cornell-box.gltf", Strategy::Nee, 16, 64, 1).film);
+  Estimate full = image_mean(render_scene(device, "cornell-box/cornell-box.gltf", Strategy::Nee, 16, 64, 16).film);
+  Estimate emitted = image_mean(render_scene(device, "cornell-box/cornell-box.gltf", Strategy::Nee, 16, 4, 0).film);
+  EXPECT_LT(emitted.mean, direct.mean);
+  EXPECT_LT(direct.mean + 5 * direct.standard_error, full.mean);
+}
+
+}  // namespace candela::test

@@ -1,0 +1,38 @@
+// Shared helpers for kernel tests: devices, the test program, scene paths.
+#pragma once
+
+#include <CL/opencl.hpp>
+#include <optional>
+#include <string>
+
+#include "device.hpp"
+
+namespace candela::test {
+
+// PoCL, the device every test runs on (a missing PoCL fails the test)
+DeviceEntry pocl_device();
+
+// Mesa's rusticl device, if one is installed and enabled
+std::optional<DeviceEntry> rusticl_device();
+
+// Device by test-parameter name: "pocl" or "rusticl"; skips the test when absent
+#define CANDELA_DEVICE_OR_SKIP(name, out)                                          \
+  do {                                                                            \
+    auto candela_dev_ = ::candela::test::device_by_name(name);                    \
+    if (!candela_dev_) GTEST_SKIP() << name << " OpenCL device is not available"; \
+    out = *candela_dev_;                                                          \
+  } while (0)
+std::optional<DeviceEntry> device_by_name(const std::string& name);
+
+// Context, queue and the test program (real cl/ sources + tests/cl/) on one device
+struct KernelRig {
+  DeviceEntry device;
+  cl::Context context;
+  cl::CommandQueue queue;
+  cl::Program program;
+  explicit KernelRig(const DeviceEntry& d);
+};
+
+std::string scene_path(const std::string& relative);  // relative to scenes/
+
+}  // namespace candela::test
