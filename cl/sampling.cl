@@ -7,8 +7,8 @@
 float3 sample_cosine_hemisphere(float u, float v) {
   float cos_theta = sqrt(v);
   float sin_theta = sqrt(1.0f - v);
-  float phi = 2.0f * PI_F * u;
-  return (float3)(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+  float cos_phi, sin_phi = sincos(2.0f * PI_F * u, &cos_phi);
+  return (float3)(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
 }
 
 float sample_cosine_hemisphere_pdf(float cos_theta) { return fmax(cos_theta, 0.0f) * INV_PI_F; }
@@ -17,8 +17,8 @@ float sample_cosine_hemisphere_pdf(float cos_theta) { return fmax(cos_theta, 0.0
 float3 sample_uniform_sphere(float u, float v) {
   float z = 1.0f - 2.0f * v;
   float r = sqrt(fmax(0.0f, 1.0f - z * z));
-  float phi = 2.0f * PI_F * u;
-  return (float3)(r * cos(phi), r * sin(phi), z);
+  float cos_phi, sin_phi = sincos(2.0f * PI_F * u, &cos_phi);
+  return (float3)(r * cos_phi, r * sin_phi, z);
 }
 
 float sample_uniform_sphere_pdf(void) { return 0.25f * INV_PI_F; }
