@@ -2,17 +2,31 @@
 
 #define BVH_STACK_SIZE 64
 
-// Slab test; returns the entry distance or INFINITY on a miss.
-float bvh_box_entry(__global const BvhNode* node, float3 org, float3 inv_dir, float tmax) {
-  float3 t0 = (load3(node->bmin) - org) * inv_dir;
-  float3 t1 = (load3(node->bmax) - org) * inv_dir;
-  float3 lo = fmin(t0, t1), hi = fmax(t0, t1);
-  float enter = fmax(fmax(lo.x, lo.y), fmax(lo.z, 0.0f));
-  // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3)
-  float exit = fmin(fmin(hi.x, hi.y), fmin(hi.z, tmax)) * 1.00000036f;
-  return enter <= exit ? enter : INFINITY;
+// Plain compares instead of fmin/fmax: the slab distances below are never NaN
+float max4_f(float a, float b, float c, float d) {
+  float ab = a > b ? a : b, cd = c > d ? c : d;
+  return ab > cd ? ab : cd;
 }
 
+float min4_f(float a, float b, float c, float d) {
+  float ab = a < b ? a : b, cd = c < d ? c : d;
+  return ab < cd ? ab : cd;
+}
+
+// Slab test with org_scaled = org * inv_dir; returns the entry distance or INFINITY
+float bvh_box_entry(__global const BvhNode* node, float3 org_scaled, float3 inv_dir, float tmax) {
+  float3 t0 = load3(node->bmin) * inv_dir - org_scaled;
+  float3 t1 = load3(node->bmax) * inv_dir - org_scaled;
+  float enter = max4_f(t0.x < t1.x ? t0.x : t1.x, t0.y < t1.y ? t0.y : t1.y,
+                       t0.z < t1.z ? t0.z : t1.z, 0.0f);
+  float exit = min4_f(t0.x > t1.x ? t0.x : t1.x, t0.y > t1.y ? t0.y : t1.y,
+                      t0.z > t1.z ? t0.z : t1.z, tmax);
+  // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), plus the
+  // rounding of the scaled origin
+  return enter <= exit * 1.0000005f ? enter : INFINITY;
+}
+
+// 1/d with zero components replaced by a tiny value of the same sign: finite, never NaN
 float3 safe_inverse(float3 d) {
   const float tiny = 1e-30f;
   return (float3)(1.0f / (fabs(d.x) > tiny ? d.x : copysign(tiny, d.x)),
@@ -29,9 +43,11 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
   hit.b1 = hit.b2 = 0.0f;
   WatertightRay wr = watertight_ray(ray);
   float3 inv_dir = safe_inverse(ray.dir);
-  if (bvh_box_entry(&nodes[0], ray.org, inv_dir, tmax) == INFINITY) return hit;
+  float3 org_scaled = ray.org * inv_dir;
+  if (bvh_box_entry(&nodes[0], org_scaled, inv_dir, tmax) == INFINITY) return hit;
 
   int stack[BVH_STACK_SIZE];
+  float stack_entry[BVH_STACK_SIZE];
   int sp = 0;
   int index = 0;
   while (true) {
@@ -49,24 +65,24 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
         }
       }
     } else {
-      float d0 = bvh_box_entry(&nodes[node->left], ray.org, inv_dir, hit.t);
-      float d1 = bvh_box_entry(&nodes[node->right], ray.org, inv_dir, hit.t);
-      int near = d0 <= d1 ? node->left : node->right;
-      int far = d0 <= d1 ? node->right : node->left;
-      float d_near = fmin(d0, d1), d_far = fmax(d0, d1);
+      float d0 = bvh_box_entry(&nodes[node->left], org_scaled, inv_dir, hit.t);
+      float d1 = bvh_box_entry(&nodes[node->right], org_scaled, inv_dir, hit.t);
+      bool left_first = d0 <= d1;
+      float d_near = left_first ? d0 : d1, d_far = left_first ? d1 : d0;
       if (d_near != INFINITY) {
-        if (d_far != INFINITY && sp < BVH_STACK_SIZE) stack[sp++] = far;
-        index = near;
+        if (d_far != INFINITY) {
+          stack[sp] = left_first ? node->right : node->left;
+          stack_entry[sp++] = d_far;
+        }
+        index = left_first ? node->left : node->right;
         continue;
       }
     }
-    // Pop, skipping nodes whose box now starts beyond the closest hit
-    bool found = false;
-    while (sp > 0 && !found) {
+    // Pop, skipping nodes that start beyond the closest hit found since the push
+    do {
+      if (sp == 0) return hit;
       index = stack[--sp];
-      found = bvh_box_entry(&nodes[index], ray.org, inv_dir, hit.t) != INFINITY;
-    }
-    if (!found) return hit;
+    } while (stack_entry[sp] > hit.t);
   }
 }
 
