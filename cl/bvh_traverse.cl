@@ -13,17 +13,17 @@ float min4_f(float a, float b, float c, float d) {
   return ab < cd ? ab : cd;
 }
 
-// Slab test with org_scaled = org * inv_dir; returns the entry distance or INFINITY
-float bvh_box_entry(__global const BvhNode* node, float3 org_scaled, float3 inv_dir, float tmax) {
-  float3 t0 = load3(node->bmin) * inv_dir - org_scaled;
-  float3 t1 = load3(node->bmax) * inv_dir - org_scaled;
+// Slab test; returns the entry distance or INFINITY on a miss
+float bvh_box_entry(__global const BvhNode* node, float3 org, float3 inv_dir, float tmax) {
+  float3 t0 = (load3(node->bmin) - org) * inv_dir;
+  float3 t1 = (load3(node->bmax) - org) * inv_dir;
   float enter = max4_f(t0.x < t1.x ? t0.x : t1.x, t0.y < t1.y ? t0.y : t1.y,
                        t0.z < t1.z ? t0.z : t1.z, 0.0f);
   float exit = min4_f(t0.x > t1.x ? t0.x : t1.x, t0.y > t1.y ? t0.y : t1.y,
                       t0.z > t1.z ? t0.z : t1.z, tmax);
-  // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), plus the
-  // rounding of the scaled origin
-  return enter <= exit * 1.0000005f ? enter : INFINITY;
+  // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), with room
+  // for OpenCL's 2.5 ulp division in inv_dir
+  return enter <= exit * 1.000001f ? enter : INFINITY;
 }
 
 // 1/d with zero components replaced by a tiny value of the same sign: finite, never NaN
@@ -43,8 +43,7 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
   hit.b1 = hit.b2 = 0.0f;
   WatertightRay wr = watertight_ray(ray);
   float3 inv_dir = safe_inverse(ray.dir);
-  float3 org_scaled = ray.org * inv_dir;
-  if (bvh_box_entry(&nodes[0], org_scaled, inv_dir, tmax) == INFINITY) return hit;
+  if (bvh_box_entry(&nodes[0], ray.org, inv_dir, tmax) == INFINITY) return hit;
 
   int stack[BVH_STACK_SIZE];
   float stack_entry[BVH_STACK_SIZE];
@@ -65,8 +64,8 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
         }
       }
     } else {
-      float d0 = bvh_box_entry(&nodes[node->left], org_scaled, inv_dir, hit.t);
-      float d1 = bvh_box_entry(&nodes[node->right], org_scaled, inv_dir, hit.t);
+      float d0 = bvh_box_entry(&nodes[node->left], ray.org, inv_dir, hit.t);
+      float d1 = bvh_box_entry(&nodes[node->right], ray.org, inv_dir, hit.t);
       bool left_first = d0 <= d1;
       float d_near = left_first ? d0 : d1, d_far = left_first ? d1 : d0;
       if (d_near != INFINITY) {
