@@ -63,29 +63,36 @@ std::string format_duration(double s) {
   return buf;
 }
 
+// A bar redrawn in place on a terminal; elsewhere (logs, CI) a line every 10 seconds
 class ProgressBar {
  public:
-  ProgressBar(bool enabled, double pixels) : enabled_(enabled), pixels_(pixels) {}
+  ProgressBar(bool enabled, double pixels)
+      : enabled_(enabled), terminal_(isatty(STDERR_FILENO)), pixels_(pixels) {}
   void update(const RenderProgress& p) {
     if (!enabled_) return;
+    if (!terminal_) {
+      if (p.seconds < next_line_) return;
+      next_line_ = p.seconds + 10.0;
+    }
     double frac = p.spp_target ? double(p.spp_done) / p.spp_target : std::min(1.0, p.seconds / p.time_limit);
     double rate = p.seconds > 0 ? p.spp_done * pixels_ / p.seconds : 0.0;
     double eta = frac > 0 ? p.seconds * (1.0 - frac) / frac : 0.0;
     int width = 30, filled = int(frac * width + 0.5);
     std::string bar = std::string(filled, '#') + std::string(width - filled, '-');
-    std::fprintf(stderr, "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s   ", bar.c_str(), p.spp_done,
+    std::fprintf(stderr, terminal_ ? "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s   " : "[%s] %u%s spp  %.2f Msamples/s  ETA %s\n", bar.c_str(), p.spp_done,
                  p.spp_target ? ("/" + std::to_string(p.spp_target)).c_str() : "", rate * 1e-6,
                  format_duration(eta).c_str());
     std::fflush(stderr);
     drawn_ = true;
   }
   void finish() {
-    if (drawn_) std::fprintf(stderr, "\n");
+    if (drawn_ && terminal_) std::fprintf(stderr, "\n");
   }
 
  private:
-  bool enabled_;
+  bool enabled_, terminal_;
   double pixels_;
+  double next_line_ = 10.0;
   bool drawn_ = false;
 };
 
@@ -158,7 +165,7 @@ int run_render(const RenderArgs& a) {
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
   std::signal(SIGINT, on_sigint);
   double pixels = double(settings.width) * settings.height;
-  ProgressBar bar(!a.quiet && isatty(STDERR_FILENO), pixels);
+  ProgressBar bar(!a.quiet, pixels);
   RenderResult r = renderer.render(
       0, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
       [] { return g_interrupted.load(); });

@@ -17,7 +17,8 @@ namespace candela {
 namespace {
 
 // Extensions this loader implements fully; any other one is named in a warning
-const std::set<std::string> kSupportedExtensions = {"KHR_materials_emissive_strength"};
+const std::set<std::string> kSupportedExtensions = {
+    "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization"};
 
 class Warnings {
  public:
@@ -145,6 +146,34 @@ glm::mat4 local_transform(const tinygltf::Node& node) {
   return m;
 }
 
+// Which TEXCOORD_n a material's texture reads, and its KHR_texture_transform
+struct UvSet {
+  int texcoord = 0;
+  glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
+};
+
+double number_or(const tinygltf::Value& obj, const char* key, int index, double fallback) {
+  if (!obj.Has(key)) return fallback;
+  const tinygltf::Value& v = obj.Get(key);
+  if (index >= 0) {
+    if (!v.IsArray() || int(v.ArrayLen()) <= index || !v.Get(index).IsNumber()) return fallback;
+    return v.Get(index).GetNumberAsDouble();
+  }
+  return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+// KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv
+void read_texture_transform(const tinygltf::Value& ext, UvSet* set) {
+  float ox = float(number_or(ext, "offset", 0, 0.0)), oy = float(number_or(ext, "offset", 1, 0.0));
+  float r = float(number_or(ext, "rotation", -1, 0.0));
+  float sx = float(number_or(ext, "scale", 0, 1.0)), sy = float(number_or(ext, "scale", 1, 1.0));
+  float c = std::cos(r), s = std::sin(r);
+  // Column-major: columns are the images of (1,0,0), (0,1,0), (0,0,1)
+  set->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
+                             glm::vec3(ox, oy, 1.0f));
+  if (ext.Has("texCoord")) set->texcoord = int(number_or(ext, "texCoord", -1, set->texcoord));
+}
+
 class Loader {
  public:
   Loader(const tinygltf::Model& model, Scene* scene)
@@ -153,6 +182,9 @@ class Loader {
   void load() {
     for (const auto& ext : model_.extensionsUsed)
       if (!kSupportedExtensions.count(ext)) warn_.add("glTF extension " + ext + " is not supported yet and is ignored");
+    for (const auto& ext : model_.extensionsRequired)
+      if (!kSupportedExtensions.count(ext))
+        warn_.add("the scene requires glTF extension " + ext + ", which candela does not support: the image may be wrong");
     if (!model_.animations.empty()) warn_.add("animations are ignored (the first frame is rendered)");
     if (!model_.skins.empty()) warn_.add("skins are ignored (meshes render in their bind pose)");
     load_materials();
@@ -168,14 +200,14 @@ class Loader {
       const auto& pbr = gm.pbrMetallicRoughness;
       dev::Material m = default_material();
       for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
+      UvSet uv_set;
       if (pbr.baseColorTexture.index >= 0) {
         m.base_color_texture = texture_index(pbr.baseColorTexture.index, true);
-        texcoords_.push_back(pbr.baseColorTexture.texCoord);
-        if (pbr.baseColorTexture.extensions.count("KHR_texture_transform"))
-          warn_.add("KHR_texture_transform is not supported yet: texture transforms are ignored");
-      } else {
-        texcoords_.push_back(0);
+        uv_set.texcoord = pbr.baseColorTexture.texCoord;
+        auto tt = pbr.baseColorTexture.extensions.find("KHR_texture_transform");
+        if (tt != pbr.baseColorTexture.extensions.end()) read_texture_transform(tt->second, &uv_set);
       }
+      uv_sets_.push_back(uv_set);
       float strength = 1.0f;
       auto ext = gm.extensions.find("KHR_materials_emissive_strength");
       if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
@@ -202,7 +234,7 @@ class Loader {
     // Default material (glTF: white, metallic 1, roughness 1) for primitives without one
     default_material_index_ = uint32_t(scene_->materials.size());
     scene_->materials.push_back(default_material());
-    texcoords_.push_back(0);
+    uv_sets_.push_back(UvSet());
   }
 
   static dev::Material default_material() {
@@ -343,6 +375,12 @@ class Loader {
         continue;
       }
       if (!prim.targets.empty()) warn_.add("morph targets are not supported yet: base geometry is rendered");
+      if (prim.extensions.count("KHR_draco_mesh_compression")) {
+        warn_.add("Draco-compressed primitives (KHR_draco_mesh_compression) are not supported: they are skipped");
+        continue;
+      }
+      if (prim.attributes.count("COLOR_0"))
+        warn_.add("vertex colors (COLOR_0) are not supported yet and are ignored");
       auto pos_it = prim.attributes.find("POSITION");
       if (pos_it == prim.attributes.end()) {
         warn_.add("a primitive without POSITION was skipped");
@@ -356,7 +394,8 @@ class Loader {
       std::vector<float> nrm, uv;
       if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end())
         nrm = read_accessor(model_, it->second, 3);
-      std::string uv_name = "TEXCOORD_" + std::to_string(texcoords_[material]);
+      const UvSet& uv_set = uv_sets_[material];
+      std::string uv_name = "TEXCOORD_" + std::to_string(uv_set.texcoord);
       if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end())
         uv = read_accessor(model_, it->second, 2);
       if ((!nrm.empty() && nrm.size() != pos.size()) || (!uv.empty() && uv.size() / 2 != nverts))
@@ -382,7 +421,8 @@ class Loader {
                                : normal_matrix * glm::vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
           float nl = glm::length(t.n[k]);
           t.n[k] = nl > 0.0f && std::isfinite(nl) ? t.n[k] / nl : glm::vec3(0.0f);
-          t.uv[k] = uv.empty() ? glm::vec2(0.0f) : glm::vec2(uv[2 * v], uv[2 * v + 1]);
+          t.uv[k] = uv.empty() ? glm::vec2(0.0f)
+                               : glm::vec2(uv_set.transform * glm::vec3(uv[2 * v], uv[2 * v + 1], 1.0f));
         }
         t.material = material;
         for (const auto& p : t.p)
@@ -410,7 +450,7 @@ class Loader {
   Scene* scene_;
   Warnings warn_;
   std::map<std::pair<int, bool>, int> texture_cache_;
-  std::vector<int> texcoords_;  // per material: TEXCOORD_n set of its base color texture
+  std::vector<UvSet> uv_sets_;  // per material: the UVs of its base color texture
   uint32_t default_material_index_ = 0;
 };
 

@@ -158,6 +158,32 @@ TEST(GltfLoader, MatrixTransformAndTriangleStrip) {
   EXPECT_FLOAT_EQ(s.bounds().lo.x, 4.0f);
 }
 
+TEST(GltfLoader, TextureTransformAppliesToUvs) {
+  TempDir dir;
+  json j = quad_gltf();
+  j["images"] = {{{"uri", "missing-is-not-read.png"}}};
+  j["textures"] = {{{"source", 0}}};
+  j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {
+      {"index", 0},
+      {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}, {"scale", {2, 2}}, {"rotation", 1.5707963267948966}}}}}};
+  // The image cannot be decoded: the loader must say so, not render garbage
+  EXPECT_THROW(load_gltf(dir.write("tt.gltf", j.dump())), Error);
+
+  unsigned char px[3] = {255, 255, 255};
+  std::string png = (dir.path / "white.png").string();
+  auto out = OIIO::ImageOutput::create(png);
+  ASSERT_TRUE(out && out->open(png, OIIO::ImageSpec(1, 1, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
+  out->close();
+  j["images"][0]["uri"] = "white.png";
+  Scene s = load_gltf(dir.write("tt.gltf", j.dump()));
+  // Vertex 1 has uv (1, 1): scaled (2, 2), rotated by pi/2 (u' = u cos + v sin, v' = -u sin + v cos)
+  // to (2, -2), offset to (2.5, -2)
+  glm::vec2 uv = s.triangles[0].uv[1];
+  EXPECT_NEAR(uv.x, 2.5f, 1e-5f);
+  EXPECT_NEAR(uv.y, -2.0f, 1e-5f);
+}
+
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf();
