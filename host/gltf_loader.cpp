@@ -189,6 +189,8 @@ class Loader {
     if (!model_.skins.empty()) warn_.add("skins are ignored (meshes render in their bind pose)");
     load_materials();
     load_scene_roots();
+    if (degenerate_ > 0)
+      warn_.add(std::to_string(degenerate_) + " zero-area triangles were skipped");
     if (scene_->triangles.empty()) throw Error("the scene has no triangles to render");
   }
 
@@ -428,6 +430,10 @@ class Loader {
         for (const auto& p : t.p)
           if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             throw Error("glTF mesh has non-finite vertex positions");
+        if (!(glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) > 0.0f)) {
+          ++degenerate_;  // zero area: invisible, and it has no normal
+          return;
+        }
         scene_->triangles.push_back(t);
       };
       int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
@@ -452,6 +458,7 @@ class Loader {
   std::map<std::pair<int, bool>, int> texture_cache_;
   std::vector<UvSet> uv_sets_;  // per material: the UVs of its base color texture
   uint32_t default_material_index_ = 0;
+  size_t degenerate_ = 0;
 };
 
 }  // namespace
