@@ -76,12 +76,15 @@ typedef struct {
   unsigned int wrap;  // wrap_s | wrap_t << 8
 } TextureInfo;
 
-// One entry of the light-selection table, 32 bytes.
+// One entry of the light-selection table, 32 bytes. Light i is selected when a uniform
+// 32-bit integer x satisfies threshold[i-1] <= x < threshold[i] (threshold[n-1] is 2^32,
+// not stored); `pmf` is exactly that probability, so the estimator divides by what the
+// kernel realizes.
 typedef struct {
   unsigned int type;  // LIGHT_*
   unsigned int index;  // LIGHT_TRIANGLE: index into Triangle array
   float area;  // LIGHT_TRIANGLE: triangle area (world units)
-  float pad0;
+  float pmf;  // selection probability
   float radiance[4];  // emitted radiance, rgb
 } Light;
 

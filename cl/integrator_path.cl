@@ -12,18 +12,18 @@ typedef struct {
   __global const TextureInfo* textures;
   __global const float4* texels;
   __global const Light* lights;
-  __global const float* light_cdf;
+  __global const uint* light_thresholds;
   __global const RenderParams* params;
 } SceneData;
 
 // Next-event estimate of light arriving at s and scattered toward wo
 float3 path_direct_light(const SceneData* sc, const SurfaceHit* s, const Bsdf* bsdf, float3 wo,
                          Rng* rng) {
-  float u_select = rng_next(rng);
+  uint x_select = rng_next_uint(rng);
   float2 u = (float2)(rng_next(rng), rng_next(rng));
   LightSample ls;
-  if (!lights_sample(sc->lights, sc->light_cdf, sc->params->num_lights, sc->tris, sc->materials,
-                     s->p, s->ns, u_select, u, &ls))
+  if (!lights_sample(sc->lights, sc->light_thresholds, sc->params->num_lights, sc->tris,
+                     sc->materials, s->p, s->ns, x_select, u, &ls))
     return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi, s->ns, s->ng);
   float cos_i = fabs(dot(ls.wi, s->ns));
@@ -31,8 +31,15 @@ float3 path_direct_light(const SceneData* sc, const SurfaceHit* s, const Bsdf* b
   if (max_component(contrib) <= 0.0f) return (float3)(0.0f);
   Ray shadow;
   shadow.org = offset_ray_origin(s->p, s->ng);
+  float tmax = INFINITY;
   shadow.dir = ls.wi;
-  if (bvh_occluded(sc->nodes, sc->tris, shadow, ls.dist)) return (float3)(0.0f);
+  if (!ls.at_infinity) {
+    float3 d = ls.target - shadow.org;
+    tmax = length(d);
+    if (!(tmax > 0.0f)) return (float3)(0.0f);
+    shadow.dir = d / tmax;
+  }
+  if (bvh_occluded(sc->nodes, sc->tris, shadow, tmax)) return (float3)(0.0f);
   return contrib;
 }
 
@@ -81,12 +88,14 @@ __kernel void render_paths(__global const BvhNode* nodes, __global const Triangl
                            __global const TriangleShading* shading,
                            __global const Material* materials,
                            __global const TextureInfo* textures, __global const float4* texels,
-                           __global const Light* lights, __global const float* light_cdf,
+                           __global const Light* lights,
+                           __global const uint* light_thresholds,
                            __global const RenderParams* params, __global float4* film_mean,
                            __global float4* film_m2) {
   uint pixel = get_global_id(0);
   if (pixel >= params->width * params->height) return;
-  SceneData sc = {nodes, tris, shading, materials, textures, texels, lights, light_cdf, params};
+  SceneData sc = {nodes,  tris,   shading,          materials, textures,
+                  texels, lights, light_thresholds, params};
   uint px = pixel % params->width, py = pixel / params->width;
 
   // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones

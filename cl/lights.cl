@@ -1,10 +1,13 @@
 // Light sampling through one light-selection table (probability proportional to power).
+// Directions and pdfs are measured from the shading point p; the shadow ray runs from
+// p's offset origin to `target`, which sits off the light's surface on p's side.
 
 typedef struct {
   float3 wi;  // unit direction from the shading point toward the light
-  float dist;  // distance to the sampled point; INFINITY for the background
   float3 radiance;  // emitted radiance arriving along -wi
   float pdf;  // solid-angle pdf of wi, including the selection probability
+  bool at_infinity;  // shadow ray along wi without end (the background)
+  float3 target;  // finite lights: the sampled point, moved off the light toward p
 } LightSample;
 
 // Uniform point on an emissive triangle, converted to a solid-angle pdf at p
@@ -26,8 +29,8 @@ bool lights_sample_triangle(__global const Light* light, __global const Triangle
   ls->radiance = surface_emission(&materials[tri->material], front);
   // Area measure to solid angle: dw/dA = cos(theta_y) / r^2
   ls->pdf = dist2 / (fabs(cos_light) * light->area);
-  // Stop the shadow ray short of the light's surface
-  ls->dist = dist * (1.0f - 1e-4f);
+  ls->at_infinity = false;
+  ls->target = offset_ray_origin(y, front ? n : -n);
   return fabs(cos_light) > 0.0f && isfinite(ls->pdf);
 }
 
@@ -37,19 +40,18 @@ bool lights_sample_background(__global const Light* light, float3 ns, float2 u,
   float3 dir_local = sample_cosine_hemisphere(u.x, u.y);
   ls->wi = frame_to_world(dir_local, ns);
   ls->pdf = sample_cosine_hemisphere_pdf(dir_local.z);
-  ls->dist = INFINITY;
+  ls->at_infinity = true;
   ls->radiance = load3(light->radiance);
   return ls->pdf > 0.0f;
 }
 
-bool lights_sample(__global const Light* lights, __global const float* light_cdf,
+bool lights_sample(__global const Light* lights, __global const uint* light_thresholds,
                    uint num_lights, __global const Triangle* tris,
-                   __global const Material* materials, float3 p, float3 ns, float u_select,
+                   __global const Material* materials, float3 p, float3 ns, uint x_select,
                    float2 u, LightSample* ls) {
   if (num_lights == 0u) return false;
-  uint i = sample_discrete_cdf(light_cdf, num_lights, u_select);
-  float p_select = sample_discrete_pmf(light_cdf, i);
-  __global const Light* light = &lights[i];
+  __global const Light* light = &lights[sample_discrete_thresholds(light_thresholds, num_lights, x_select)];
+  float p_select = light->pmf;
   bool ok;
   switch (light->type) {
     case LIGHT_TRIANGLE:

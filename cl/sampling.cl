@@ -30,19 +30,16 @@ float2 sample_triangle(float u, float v) {
   return (float2)(1.0f - su, v * su);
 }
 
-// Index i with probability cdf[i] - cdf[i-1]; cdf is increasing with cdf[n-1] == 1.
-uint sample_discrete_cdf(__global const float* cdf, uint n, float u) {
+// Index i with threshold[i-1] <= x < threshold[i] for a uniform 32-bit x; the last
+// threshold (2^32) is implicit, so `threshold` holds n - 1 increasing values.
+uint sample_discrete_thresholds(__global const uint* threshold, uint n, uint x) {
   uint lo = 0u, hi = n - 1u;
   while (lo < hi) {
     uint mid = (lo + hi) / 2u;
-    if (u < cdf[mid])
+    if (x < threshold[mid])
       hi = mid;
     else
       lo = mid + 1u;
   }
   return lo;
-}
-
-float sample_discrete_pmf(__global const float* cdf, uint i) {
-  return i == 0u ? cdf[0] : cdf[i] - cdf[i - 1u];
 }

@@ -1,5 +1,6 @@
 #include "light_table.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace candela {
@@ -10,6 +11,31 @@ constexpr double kPi = 3.14159265358979323846;
 double luminance(const float* c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 }  // namespace
+
+std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
+                                           std::vector<double>* pmf) {
+  const uint64_t range = uint64_t(1) << 32;
+  size_t n = weights.size();
+  pmf->assign(n, 0.0);
+  if (n == 0) return {};
+  double total = 0.0;
+  for (double w : weights) total += w;
+  std::vector<uint32_t> thresholds;
+  uint64_t prev = 0;
+  double cum = 0.0;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    cum += weights[i];
+    uint64_t t = uint64_t(std::llround(cum / total * double(range)));
+    // At least one integer per light, and room for every light after this one
+    t = std::max(t, prev + 1);
+    t = std::min(t, range - (n - 1 - i));
+    thresholds.push_back(uint32_t(t));
+    (*pmf)[i] = double(t - prev) / double(range);
+    prev = t;
+  }
+  (*pmf)[n - 1] = double(range - prev) / double(range);
+  return thresholds;
+}
 
 LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
                              const std::vector<dev::Material>& materials,
@@ -44,14 +70,9 @@ LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
     double r = std::max(double(bounds.radius()), 1e-6);
     power.push_back(4.0 * kPi * kPi * r * r * luminance(bg));
   }
-  double total = 0.0;
-  for (double p : power) total += p;
-  double acc = 0.0;
-  for (double p : power) {
-    acc += p;
-    table.cdf.push_back(float(acc / total));
-  }
-  if (!table.cdf.empty()) table.cdf.back() = 1.0f;
+  std::vector<double> pmf;
+  table.thresholds = selection_thresholds(power, &pmf);
+  for (size_t i = 0; i < table.lights.size(); ++i) table.lights[i].pmf = float(pmf[i]);
   return table;
 }
 

@@ -1,5 +1,6 @@
 // The light-selection table: every light with a selection probability proportional to
-// its power, as a CDF the kernel searches (lights.cl).
+// its power, as 32-bit integer thresholds the kernel searches (lights.cl). Each light
+// gets at least one of the 2^32 integers, and Light::pmf is its exact share.
 #pragma once
 
 #include <vector>
@@ -10,10 +11,15 @@ namespace candela {
 
 struct LightTable {
   std::vector<dev::Light> lights;
-  std::vector<float> cdf;  // cdf[i] = P(light <= i); cdf.back() == 1
+  std::vector<uint32_t> thresholds;  // n - 1 increasing values; the last (2^32) is implicit
 };
 
 // `triangles` in BVH order (Light::index refers to them)
+// Thresholds for selecting index i with probability ~ weights[i] (all > 0); the exact
+// probabilities realized are written to *pmf
+std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
+                                           std::vector<double>* pmf);
+
 LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
                              const std::vector<dev::Material>& materials,
                              const glm::vec3& background, const Bounds& bounds);

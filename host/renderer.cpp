@@ -88,7 +88,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   textures_ = upload(context_, scene.textures, "texture descriptors");
   texels_ = upload(context_, scene.texels, "textures");
   lights_ = upload(context_, table.lights, "lights");
-  light_cdf_ = upload(context_, table.cdf, "the light table");
+  light_thresholds_ = upload(context_, table.thresholds, "the light table");
 
   CameraDesc cam = resolve_camera(scene);
   params_host_.camera = make_device_camera(cam, settings.width, settings.height);
@@ -110,7 +110,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
     queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
     int arg = 0;
     for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &materials_, &textures_, &texels_, &lights_,
-                          &light_cdf_, &params_, &film_mean_, &film_m2_})
+                          &light_thresholds_, &params_, &film_mean_, &film_m2_})
       kernel_.setArg(arg++, *b);
     queue_.finish();
   } catch (const cl::Error& e) {

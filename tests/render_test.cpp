@@ -135,6 +135,35 @@ TEST_P(CornellTest, StrategiesAgreeWithinStandardError) {
 INSTANTIATE_TEST_SUITE_P(Devices, CornellTest, ::testing::Values("pocl", "rusticl"),
                          [](const auto& info) { return std::string(info.param); });
 
+// A small light hovering just above a floor near the origin: shadow rays toward it must
+// not hit the light itself, so NEE and BSDF sampling agree there too
+TEST(Render, StrategiesAgreeForALightCloseToASurface) {
+  std::string path = ::testing::TempDir() + "near-light.gltf";
+  const float h = 0.01f, s = 0.05f;
+  std::vector<TestQuad> quads = {
+      {{{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0},  // floor, facing +y
+      {{{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1}};  // light, facing -y
+  const char* materials = R"([
+    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
+    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
+     "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}])";
+  const float eye[3] = {0.0f, 0.25f, 0.3f}, target[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
+  write_quads_gltf(path, quads, materials, eye, target, 0.5f, bg);
+  Scene scene = load_gltf(path);
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  settings.max_depth = 4;
+  Renderer nee(pocl_device(), scene, settings);
+  settings.strategy = Strategy::Bsdf;
+  settings.seed = 5;
+  Renderer bsdf(pocl_device(), scene, settings);
+  Film a = nee.render(0, 64).film, b = bsdf.render(0, 256).film;
+  Estimate ea = image_mean(a), eb = image_mean(b);
+  double se = std::sqrt(ea.standard_error * ea.standard_error + eb.standard_error * eb.standard_error);
+  EXPECT_GT(ea.mean, 0.01);
+  EXPECT_NEAR(ea.mean, eb.mean, 4.0 * se) << "nee " << ea.mean << " bsdf " << eb.mean;
+}
+
 TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
   DeviceEntry device = pocl_device();
   Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));

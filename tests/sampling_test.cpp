@@ -6,6 +6,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 
+#include "light_table.hpp"
 #include "stats.hpp"
 #include "test_support.hpp"
 
@@ -14,7 +15,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kSamples = 1 << 20;
-constexpr int kTestsInFile = 4;
+constexpr int kTestsInFile = 5;
 const double kAlpha = sidak_alpha(0.01, kTestsInFile);
 
 std::vector<cl_float4> run_direction_kernel(KernelRig& rig, cl_uint which, cl_uint seed) {
@@ -158,6 +159,42 @@ TEST_F(SamplingTest, RngIsUniform) {
     ASSERT_LT(u[2 * i], 1.0f);
     observed[int(u[2 * i] * g) * g + int(u[2 * i + 1] * g)] += 1.0;
   }
+  ChiSquare r = chi_square_test(observed, expected);
+  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+}
+
+// Light selection realizes exactly the pmf the estimator divides by, even for lights
+// whose power is far below 2^-24 of the total
+TEST_F(SamplingTest, LightSelectionMatchesItsPmf) {
+  std::vector<double> weights = {1e-12, 3.0, 0.5, 1e-9, 7.0, 2.0, 1e-3, 0.25, 4.0, 1e-15};
+  std::vector<double> pmf;
+  std::vector<uint32_t> thresholds = selection_thresholds(weights, &pmf);
+  ASSERT_EQ(thresholds.size(), weights.size() - 1);
+  double total = 0.0, wsum = 0.0;
+  for (double w : weights) wsum += w;
+  for (size_t i = 0; i < pmf.size(); ++i) {
+    EXPECT_GE(pmf[i], 0x1.0p-32) << "light " << i << " can never be picked";
+    if (weights[i] / wsum > 1e-6) EXPECT_NEAR(pmf[i], weights[i] / wsum, 1e-9);
+    total += pmf[i];
+  }
+  EXPECT_DOUBLE_EQ(total, 1.0);
+
+  cl::Buffer tb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, thresholds.size() * 4, thresholds.data());
+  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_uint));
+  cl::Kernel k(rig_->program, "test_light_select");
+  k.setArg(0, tb);
+  k.setArg(1, cl_uint(weights.size()));
+  k.setArg(2, cl_uint(17));
+  k.setArg(3, out);
+  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
+  std::vector<cl_uint> picks(kSamples);
+  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_uint), picks.data());
+  std::vector<double> observed(weights.size(), 0.0), expected(weights.size());
+  for (cl_uint p : picks) {
+    ASSERT_LT(p, weights.size());
+    observed[p] += 1.0;
+  }
+  for (size_t i = 0; i < weights.size(); ++i) expected[i] = pmf[i] * kSamples;
   ChiSquare r = chi_square_test(observed, expected);
   EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }

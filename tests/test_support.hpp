@@ -4,6 +4,7 @@
 #include <CL/opencl.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "device.hpp"
 
@@ -34,5 +35,19 @@ struct KernelRig {
 };
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
+
+std::string base64(const std::string& bytes);
+
+// A quad p0 p1 p2 p3 (counter-clockwise seen from its front) with a material index
+struct TestQuad {
+  float p[4][3];
+  int material;
+};
+
+// Writes a self-contained .gltf with the quads, the given materials (a JSON array text),
+// a perspective camera at `eye` looking at `target`, and a scene background
+void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quads,
+                      const std::string& materials_json, const float eye[3], const float target[3],
+                      float yfov, const float background[3]);
 
 }  // namespace candela::test

@@ -87,3 +87,11 @@ __kernel void test_trace_brute(__global const Triangle* tris, uint num_tris,
   }
   out[i] = result;
 }
+
+// Light-table selection: the index chosen for each of many uniform 32-bit integers
+__kernel void test_light_select(__global const uint* thresholds, uint n, uint seed,
+                                __global uint* out) {
+  uint i = get_global_id(0);
+  Rng rng = rng_init(i, 0u, seed);
+  out[i] = sample_discrete_thresholds(thresholds, n, rng_next_uint(&rng));
+}
