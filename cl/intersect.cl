@@ -35,10 +35,21 @@ WatertightRay watertight_ray(Ray ray) {
   return w;
 }
 
+// 2D edge function q x p (Woop et al.'s U = Cx By - Cy Bx for p = B, q = C), evaluated
+// with its two vertices in a canonical order so that the two triangles sharing an edge
+// get exactly opposite values even where the compiler fuses multiply-adds.
+float edge_function(float px, float py, float qx, float qy) {
+  bool swap = px < qx || (px == qx && py < qy);
+  float ax = swap ? qx : px, ay = swap ? qy : py;
+  float bx = swap ? px : qx, by = swap ? py : qy;
+  float e = bx * ay - by * ax;
+  return swap ? -e : e;
+}
+
 // Hit in (0, tmax)? On a hit sets *t and the barycentric weights of v1 and v2.
 bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax,
                         float* t, float* b1, float* b2) {
-  // Fused multiply-adds would give the two triangles of an edge different edge values
+  // No fused multiply-adds: keeps the edge values and t as the paper rounds them
 #pragma OPENCL FP_CONTRACT OFF
   float3 a = permute3(v0 - r->org, r->perm);
   float3 b = permute3(v1 - r->org, r->perm);
@@ -47,9 +58,9 @@ bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2,
   float bx = b.x - r->shear.x * b.z, by = b.y - r->shear.y * b.z;
   float cx = c.x - r->shear.x * c.z, cy = c.y - r->shear.y * c.z;
   // Edge functions (2D cross products); U, V, W weight v0, v1, v2
-  float u = cx * by - cy * bx;
-  float v = ax * cy - ay * cx;
-  float w = bx * ay - by * ax;
+  float u = edge_function(bx, by, cx, cy);
+  float v = edge_function(cx, cy, ax, ay);
+  float w = edge_function(ax, ay, bx, by);
   if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
   float det = u + v + w;
   if (det == 0.0f) return false;
