@@ -8,13 +8,14 @@ typedef struct {
 } Bsdf;
 
 Bsdf bsdf_at(__global const Material* m, __global const TextureInfo* textures,
-             __global const float4* texels, float2 uv) {
+             __global const uchar4* texels, __global const float* srgb_to_linear, float2 uv) {
   Bsdf b;
   b.type = m->type;
   b.base_color = load3(m->base_color);
 #if CD_FEATURE_TEXTURES
   if (m->base_color_texture != NO_TEXTURE)
-    b.base_color *= texture_sample(&textures[m->base_color_texture], texels, uv).xyz;
+    b.base_color *=
+        texture_sample(&textures[m->base_color_texture], texels, srgb_to_linear, uv).xyz;
 #endif
   return b;
 }

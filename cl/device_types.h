@@ -17,10 +17,12 @@
 #define STRATEGY_NEE 0u
 #define STRATEGY_BSDF 1u
 
-// Texture wrap modes (glTF sampler wrapS / wrapT)
+// Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15)
+// and colour encoding
 #define WRAP_REPEAT 0u
 #define WRAP_CLAMP 1u
 #define WRAP_MIRROR 2u
+#define TEXTURE_SRGB 0x10000u
 
 #define NO_TEXTURE (-1)
 
@@ -68,12 +70,12 @@ typedef struct {
   float params[4];  // reserved: roughness, metallic, ior, anisotropy
 } Material;
 
-// A texture inside the shared texel array (linear RGBA float4 texels), 16 bytes.
+// A texture inside the shared texel array (RGBA8 texels), 16 bytes.
 typedef struct {
   unsigned int offset;  // first texel
   unsigned int width;
   unsigned int height;
-  unsigned int wrap;  // wrap_s | wrap_t << 8
+  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB
 } TextureInfo;
 
 // One entry of the light-selection table, 32 bytes. Light i is selected when a uniform

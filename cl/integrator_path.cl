@@ -10,7 +10,8 @@ typedef struct {
   __global const TriangleShading* shading;
   __global const Material* materials;
   __global const TextureInfo* textures;
-  __global const float4* texels;
+  __global const uchar4* texels;
+  __global const float* srgb_to_linear;
   __global const Light* lights;
   __global const uint* light_thresholds;
   __global const RenderParams* params;
@@ -62,7 +63,7 @@ float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
     if (depth >= params->max_depth) break;
 
     float3 wo = -ray.dir;
-    Bsdf bsdf = bsdf_at(m, sc->textures, sc->texels, s.uv);
+    Bsdf bsdf = bsdf_at(m, sc->textures, sc->texels, sc->srgb_to_linear, s.uv);
     if (nee) radiance += beta * path_direct_light(sc, &s, &bsdf, wo, rng);
 
     // Continue the path by sampling the BSDF
@@ -87,15 +88,16 @@ float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
 __kernel void render_paths(__global const BvhNode* nodes, __global const Triangle* tris,
                            __global const TriangleShading* shading,
                            __global const Material* materials,
-                           __global const TextureInfo* textures, __global const float4* texels,
+                           __global const TextureInfo* textures, __global const uchar4* texels,
+                           __global const float* srgb_to_linear,
                            __global const Light* lights,
                            __global const uint* light_thresholds,
                            __global const RenderParams* params, __global float4* film_mean,
                            __global float4* film_m2) {
   uint pixel = get_global_id(0);
   if (pixel >= params->width * params->height) return;
-  SceneData sc = {nodes,  tris,   shading,          materials, textures,
-                  texels, lights, light_thresholds, params};
+  SceneData sc = {nodes,  tris,           shading, materials,        textures,
+                  texels, srgb_to_linear, lights,  light_thresholds, params};
   uint px = pixel % params->width, py = pixel / params->width;
 
   // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones

@@ -76,6 +76,8 @@ std::vector<DeviceEntry> list_devices() {
       e.driver_version = trim(devices[d].getInfo<CL_DRIVER_VERSION>());
       e.compute_units = devices[d].getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
       e.global_memory = devices[d].getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      e.max_alloc = devices[d].getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+      e.opencl_c_version = trim(devices[d].getInfo<CL_DEVICE_OPENCL_C_VERSION>());
       out.push_back(e);
     }
   }

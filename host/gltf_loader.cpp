@@ -32,99 +32,139 @@ class Warnings {
   std::set<std::string> seen_;
 };
 
-float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+// Limit on the elements of one accessor without a bufferView (zero-filled)
+constexpr size_t kMaxZeroFilledElements = size_t(1) << 28;
+
+// One component as a float: normalized integers map to [0,1] / [-1,1] (glTF 3.11)
+float decode_float(const unsigned char* p, int ctype, bool normalized) {
+  switch (ctype) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float f;
+      std::memcpy(&f, p, 4);
+      return f;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return normalized ? *p / 255.0f : float(*p);
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v = int8_t(*p);
+      return normalized ? std::max(v / 127.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0f : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return float(v);
+    }
+    default:
+      throw Error("glTF accessor has an unsupported component type");
+  }
 }
 
-// Accessor elements as floats (normalized integers mapped to [0,1] / [-1,1]), sparse
-// substitution applied. Returns count * components values.
-std::vector<float> read_accessor(const tinygltf::Model& model, int index, int want_components) {
+// One unsigned integer component (indices)
+uint32_t decode_uint(const unsigned char* p, int ctype, bool) {
+  switch (ctype) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return *p;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default:
+      throw Error("glTF indices must be unsigned bytes, shorts or ints");
+  }
+}
+
+// Reads `count` elements of `ncomp` components from a bufferView, `offset` bytes in,
+// after checking every byte lies inside the view and the buffer (no overflow possible:
+// only subtractions of checked values and one division).
+template <typename T, typename Decode>
+void read_view(const tinygltf::Model& model, int view_index, size_t offset, size_t count, int ncomp,
+               int ctype, bool normalized, Decode decode, std::vector<T>* out) {
+  if (view_index < 0 || view_index >= (int)model.bufferViews.size())
+    throw Error("glTF accessor refers to a missing bufferView");
+  const tinygltf::BufferView& view = model.bufferViews[view_index];
+  if (view.buffer < 0 || view.buffer >= (int)model.buffers.size())
+    throw Error("glTF bufferView refers to a missing buffer");
+  const std::vector<unsigned char>& buf = model.buffers[view.buffer].data;
+  int csize = tinygltf::GetComponentSizeInBytes(ctype);
+  if (csize <= 0) throw Error("glTF accessor has an unsupported component type");
+  size_t elem = size_t(ncomp) * size_t(csize);
+  size_t stride = view.byteStride ? view.byteStride : elem;
+  if (stride < elem) throw Error("glTF bufferView byteStride is smaller than its elements");
+  if (view.byteOffset > buf.size() || view.byteLength > buf.size() - view.byteOffset)
+    throw Error("glTF bufferView lies outside its buffer (is the .bin file complete?)");
+  out->clear();
+  if (count == 0) return;
+  if (offset > view.byteLength || elem > view.byteLength - offset ||
+      count - 1 > (view.byteLength - offset - elem) / stride)
+    throw Error("glTF accessor reads past the end of its bufferView");
+  out->resize(count * ncomp);
+  const unsigned char* base = buf.data() + view.byteOffset + offset;
+  for (size_t i = 0; i < count; ++i)
+    for (int c = 0; c < ncomp; ++c)
+      (*out)[i * ncomp + c] = decode(base + i * stride + size_t(c) * csize, ctype, normalized);
+}
+
+// Accessor elements as T (count * components values), sparse substitution applied
+template <typename T, typename Decode>
+std::vector<T> read_accessor_as(const tinygltf::Model& model, int index, int want_components,
+                                Decode decode) {
   if (index < 0 || index >= (int)model.accessors.size())
     throw Error("glTF accessor " + std::to_string(index) + " does not exist");
   const tinygltf::Accessor& acc = model.accessors[index];
   int comps = tinygltf::GetNumComponentsInType(acc.type);
-  int comp_size = tinygltf::GetComponentSizeInBytes(acc.componentType);
-  if (comps <= 0 || comp_size <= 0)
-    throw Error("glTF accessor " + std::to_string(index) + " has an invalid type");
+  if (comps <= 0) throw Error("glTF accessor " + std::to_string(index) + " has an invalid type");
   if (want_components > 0 && comps != want_components)
     throw Error("glTF accessor " + std::to_string(index) + " has " + std::to_string(comps) +
                 " components, expected " + std::to_string(want_components));
-
-  auto decode = [&](const unsigned char* p, int ctype, bool normalized) -> float {
-    switch (ctype) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float f;
-        std::memcpy(&f, p, 4);
-        return f;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-        return normalized ? *p / 255.0f : float(*p);
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        int8_t v = int8_t(*p);
-        return normalized ? std::max(v / 127.0f, -1.0f) : float(v);
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? v / 65535.0f : float(v);
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? std::max(v / 32767.0f, -1.0f) : float(v);
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t v;
-        std::memcpy(&v, p, 4);
-        return float(v);
-      }
-      default:
-        throw Error("glTF accessor has an unsupported component type");
-    }
-  };
-
-  // Reads `count` elements of `ncomp` components from a buffer view at `offset`
-  auto read_view = [&](int view_index, size_t offset, size_t count, int ncomp, int ctype,
-                       bool normalized, std::vector<float>* out) {
-    if (view_index < 0 || view_index >= (int)model.bufferViews.size())
-      throw Error("glTF accessor refers to a missing bufferView");
-    const tinygltf::BufferView& view = model.bufferViews[view_index];
-    if (view.buffer < 0 || view.buffer >= (int)model.buffers.size())
-      throw Error("glTF bufferView refers to a missing buffer");
-    const tinygltf::Buffer& buf = model.buffers[view.buffer];
-    int csize = tinygltf::GetComponentSizeInBytes(ctype);
-    size_t elem = size_t(ncomp) * csize;
-    size_t stride = view.byteStride ? view.byteStride : elem;
-    size_t begin = view.byteOffset + offset;
-    if (count > 0 && (begin + stride * (count - 1) + elem > buf.data.size() ||
-                      offset + stride * (count - 1) + elem > view.byteLength))
-      throw Error("glTF accessor reads past the end of its buffer");
-    out->resize(count * ncomp);
-    for (size_t i = 0; i < count; ++i)
-      for (int c = 0; c < ncomp; ++c)
-        (*out)[i * ncomp + c] = decode(&buf.data[begin + i * stride + c * csize], ctype, normalized);
-  };
-
-  std::vector<float> values;
-  if (acc.bufferView >= 0)
-    read_view(acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType, acc.normalized,
-              &values);
-  else
-    values.assign(acc.count * comps, 0.0f);
-
+  std::vector<T> values;
+  if (acc.bufferView >= 0) {
+    read_view(model, acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType,
+              acc.normalized, decode, &values);
+  } else {
+    if (acc.count > kMaxZeroFilledElements)
+      throw Error("glTF accessor " + std::to_string(index) + " is too large");
+    values.assign(acc.count * comps, T(0));
+  }
   if (acc.sparse.isSparse) {
-    std::vector<float> idx, vals;
-    read_view(acc.sparse.indices.bufferView, acc.sparse.indices.byteOffset, acc.sparse.count, 1,
-              acc.sparse.indices.componentType, false, &idx);
-    read_view(acc.sparse.values.bufferView, acc.sparse.values.byteOffset, acc.sparse.count, comps,
-              acc.componentType, acc.normalized, &vals);
-    for (int i = 0; i < acc.sparse.count; ++i) {
-      size_t target = size_t(idx[i]);
-      if (target >= acc.count) throw Error("glTF sparse accessor index out of range");
-      for (int c = 0; c < comps; ++c) values[target * comps + c] = vals[size_t(i) * comps + c];
+    if (acc.sparse.count < 0 || size_t(acc.sparse.count) > acc.count || acc.sparse.indices.byteOffset < 0 ||
+        acc.sparse.values.byteOffset < 0)
+      throw Error("glTF sparse accessor " + std::to_string(index) + " is malformed");
+    std::vector<uint32_t> idx;
+    std::vector<T> vals;
+    read_view(model, acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset),
+              size_t(acc.sparse.count), 1, acc.sparse.indices.componentType, false, decode_uint, &idx);
+    read_view(model, acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset),
+              size_t(acc.sparse.count), comps, acc.componentType, acc.normalized, decode, &vals);
+    for (size_t i = 0; i < idx.size(); ++i) {
+      if (idx[i] >= acc.count) throw Error("glTF sparse accessor index out of range");
+      for (int c = 0; c < comps; ++c) values[size_t(idx[i]) * comps + c] = vals[i * comps + c];
     }
   }
   return values;
+}
+
+std::vector<float> read_accessor(const tinygltf::Model& model, int index, int want_components) {
+  return read_accessor_as<float>(model, index, want_components, decode_float);
+}
+
+std::vector<uint32_t> read_indices(const tinygltf::Model& model, int index) {
+  return read_accessor_as<uint32_t>(model, index, 1, decode_uint);
 }
 
 glm::mat4 local_transform(const tinygltf::Node& node) {
@@ -247,51 +287,52 @@ class Loader {
     return m;
   }
 
-  // Uploads the glTF texture's image once, returning its TextureInfo index
+  // Adds the glTF texture's image once, returning its TextureInfo index (or NO_TEXTURE)
   int texture_index(int gltf_texture, bool srgb) {
     auto key = std::make_pair(gltf_texture, srgb);
     if (auto it = texture_cache_.find(key); it != texture_cache_.end()) return it->second;
     if (gltf_texture < 0 || gltf_texture >= (int)model_.textures.size())
       throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
     const tinygltf::Texture& tex = model_.textures[gltf_texture];
-    if (tex.source < 0 || tex.source >= (int)model_.images.size())
-      throw Error("glTF texture " + std::to_string(gltf_texture) + " has no usable image (only PNG and JPEG sources are supported)");
+    if (tex.source < 0 || tex.source >= (int)model_.images.size()) {
+      warn_.add("glTF texture " + std::to_string(gltf_texture) +
+                " has no PNG or JPEG source (e.g. only KHR_texture_basisu): it is ignored");
+      return NO_TEXTURE;
+    }
     const tinygltf::Image& img = model_.images[tex.source];
     if (img.width <= 0 || img.height <= 0 || img.image.empty())
       throw Error("glTF image " + std::to_string(tex.source) + " ('" + img.uri + "') could not be decoded");
 
+    size_t n = size_t(img.width) * img.height;
+    if (scene_->texels.size() / 4 + n > size_t(UINT32_MAX))
+      throw Error("the scene's textures hold more than 2^32 texels");
     dev::TextureInfo info{};
     info.offset = uint32_t(scene_->texels.size() / 4);
     info.width = uint32_t(img.width);
     info.height = uint32_t(img.height);
     uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
     if (tex.sampler >= 0 && tex.sampler < (int)model_.samplers.size()) {
+      const tinygltf::Sampler& sampler = model_.samplers[tex.sampler];
       auto mode = [](int w) {
         return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ? WRAP_CLAMP
                : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
                                                             : WRAP_REPEAT;
       };
-      wrap_s = mode(model_.samplers[tex.sampler].wrapS);
-      wrap_t = mode(model_.samplers[tex.sampler].wrapT);
+      wrap_s = mode(sampler.wrapS);
+      wrap_t = mode(sampler.wrapT);
+      if (sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+        warn_.add("texture filter NEAREST is not supported yet: textures are filtered bilinearly");
     }
-    info.wrap = wrap_s | (wrap_t << 8);
+    info.flags = wrap_s | (wrap_t << 8) | (srgb ? TEXTURE_SRGB : 0u);
 
-    size_t n = size_t(img.width) * img.height;
-    int comps = img.component;
-    bool sixteen = img.bits == 16;
-    scene_->texels.reserve(scene_->texels.size() + 4 * n);
-    for (size_t i = 0; i < n; ++i) {
-      float rgba[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-      for (int c = 0; c < comps && c < 4; ++c) {
-        float v = sixteen ? (img.image[2 * (i * comps + c)] | (img.image[2 * (i * comps + c) + 1] << 8)) / 65535.0f
-                          : img.image[i * comps + c] / 255.0f;
-        rgba[c] = v;
-      }
-      if (comps <= 2) rgba[1] = rgba[2] = rgba[0];  // grey (+ alpha)
-      if (comps == 2) rgba[3] = sixteen ? 1.0f : img.image[i * comps + 1] / 255.0f;
-      for (int c = 0; c < 4; ++c)
-        scene_->texels.push_back(srgb && c < 3 ? srgb_to_linear(rgba[c]) : rgba[c]);
-    }
+    // tinygltf decodes every image to 4 channels of 8 or 16 bits; keep 8 bits
+    if (img.component != 4 || (img.bits != 8 && img.bits != 16) ||
+        img.image.size() < n * 4 * size_t(img.bits / 8))
+      throw Error("glTF image " + std::to_string(tex.source) + " has an unexpected pixel layout");
+    size_t first = scene_->texels.size();
+    scene_->texels.resize(first + 4 * n);
+    for (size_t i = 0; i < 4 * n; ++i)
+      scene_->texels[first + i] = img.bits == 8 ? img.image[i] : img.image[2 * i + 1];  // high byte (little-endian)
     int index = int(scene_->textures.size());
     scene_->textures.push_back(info);
     texture_cache_[key] = index;
@@ -405,7 +446,7 @@ class Loader {
 
       std::vector<uint32_t> indices;
       if (prim.indices >= 0) {
-        for (float f : read_accessor(model_, prim.indices, 1)) indices.push_back(uint32_t(f));
+        indices = read_indices(model_, prim.indices);
       } else {
         for (uint32_t i = 0; i < nverts; ++i) indices.push_back(i);
       }

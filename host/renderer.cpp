@@ -40,11 +40,27 @@ std::vector<dev::TriangleShading> shading_data(const std::vector<SceneTriangle>&
   return out;
 }
 
+// sRGB 8-bit code to linear value (IEC 61966-2-1), for texture decoding in the kernel
+std::vector<float> srgb_decode_table() {
+  std::vector<float> t(256);
+  for (int i = 0; i < 256; ++i) {
+    double c = i / 255.0;
+    t[i] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+  }
+  return t;
+}
+
 // A read-only buffer holding `data`, or one dummy element when it is empty
 template <typename T>
-cl::Buffer upload(const cl::Context& ctx, const std::vector<T>& data, const char* what) {
+cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data,
+                  const char* what) {
   std::vector<T> one(1);
   const std::vector<T>& src = data.empty() ? one : data;
+  size_t bytes = src.size() * sizeof(T);
+  if (bytes > device.max_alloc)
+    throw Error(std::string("the scene's ") + what + " need " + std::to_string(bytes >> 20) +
+                " MiB in one buffer, more than " + device.description() + " allows (" +
+                std::to_string(device.max_alloc >> 20) + " MiB)");
   try {
     return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T),
                       const_cast<T*>(src.data()));
@@ -81,14 +97,15 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
 
-  nodes_ = upload(context_, bvh.nodes, "the BVH");
-  tris_ = upload(context_, tris, "triangles");
-  shading_ = upload(context_, shading_data(scene.triangles), "vertex normals and UVs");
-  materials_ = upload(context_, scene.materials, "materials");
-  textures_ = upload(context_, scene.textures, "texture descriptors");
-  texels_ = upload(context_, scene.texels, "textures");
-  lights_ = upload(context_, table.lights, "lights");
-  light_thresholds_ = upload(context_, table.thresholds, "the light table");
+  nodes_ = upload(context_, device_, bvh.nodes, "the BVH");
+  tris_ = upload(context_, device_, tris, "triangles");
+  shading_ = upload(context_, device_, shading_data(scene.triangles), "vertex normals and UVs");
+  materials_ = upload(context_, device_, scene.materials, "materials");
+  textures_ = upload(context_, device_, scene.textures, "texture descriptors");
+  texels_ = upload(context_, device_, scene.texels, "textures");
+  srgb_table_ = upload(context_, device_, srgb_decode_table(), "sRGB table");
+  lights_ = upload(context_, device_, table.lights, "lights");
+  light_thresholds_ = upload(context_, device_, table.thresholds, "the light table");
 
   CameraDesc cam = resolve_camera(scene);
   params_host_.camera = make_device_camera(cam, settings.width, settings.height);
@@ -109,7 +126,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
     queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
     queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
     int arg = 0;
-    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &materials_, &textures_, &texels_, &lights_,
+    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &materials_, &textures_, &texels_, &srgb_table_, &lights_,
                           &light_thresholds_, &params_, &film_mean_, &film_m2_})
       kernel_.setArg(arg++, *b);
     queue_.finish();

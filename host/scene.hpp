@@ -50,7 +50,7 @@ struct Scene {
   std::vector<SceneTriangle> triangles;
   std::vector<dev::Material> materials;
   std::vector<dev::TextureInfo> textures;
-  std::vector<float> texels;  // linear RGBA, 4 floats per texel
+  std::vector<uint8_t> texels;  // RGBA8, 4 bytes per texel (TextureInfo::flags: encoding)
   std::optional<CameraDesc> camera;
   glm::vec3 background{0.0f};
   std::vector<std::string> warnings;  // each unsupported feature named once
