@@ -102,12 +102,13 @@ void resolve_size(const RenderArgs& a, const Scene& scene, int* w, int* h) {
   *w = a.width;
   *h = a.height;
   if (*w == 0 && *h == 0) *w = 512;
-  if (*h == 0) *h = aspect > 0 ? std::max(1, int(std::lround(*w / aspect))) : *w;
-  if (*w == 0) *w = aspect > 0 ? std::max(1, int(std::lround(*h * aspect))) : *h;
+  auto scaled = [](double v) { return int(std::clamp(std::round(v), 1.0, 65536.0)); };
+  if (*h == 0) *h = aspect > 0 ? scaled(*w / double(aspect)) : *w;
+  if (*w == 0) *w = aspect > 0 ? scaled(*h * double(aspect)) : *h;
 }
 
 void apply_camera_options(const RenderArgs& a, Scene* scene) {
-  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov > 0;
+  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov != 0;
   if (!any) return;
   CameraDesc cam = resolve_camera(*scene);
   if (!a.look_from.empty()) cam.position = parse_vec3(a.look_from, "--look-from");
@@ -117,8 +118,8 @@ void apply_camera_options(const RenderArgs& a, Scene* scene) {
     cam.forward = glm::normalize(target - cam.position);
   }
   if (!a.up.empty()) cam.up = parse_vec3(a.up, "--up");
-  if (a.fov > 0) {
-    if (a.fov >= 180) throw Error("--fov must be below 180 degrees");
+  if (a.fov != 0) {
+    if (!(a.fov > 0 && a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees");
     cam.yfov = a.fov * 3.14159265f / 180.0f;
   }
   scene->camera = cam;
@@ -140,7 +141,11 @@ int run_render(const RenderArgs& a) {
   }
 
   Scene scene = load_gltf(a.scene);
-  if (!a.background.empty()) scene.background = parse_vec3(a.background, "--background");
+  if (!a.background.empty()) {
+    scene.background = parse_vec3(a.background, "--background");
+    if (scene.background.x < 0 || scene.background.y < 0 || scene.background.z < 0)
+      throw Error("--background must not be negative");
+  }
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   float bg_max = std::max(scene.background.x, std::max(scene.background.y, scene.background.z));

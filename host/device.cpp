@@ -28,7 +28,7 @@ std::string type_name(cl_device_type t) {
 }
 
 bool parse_index(const std::string& s, size_t* out) {
-  if (s.empty() || !std::all_of(s.begin(), s.end(), ::isdigit)) return false;
+  if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), ::isdigit)) return false;
   *out = std::stoul(s);
   return true;
 }
@@ -99,14 +99,21 @@ DeviceEntry select_device(const std::string& selector) {
     if (auto d = first_of_type("cpu")) return *d;
     return devices.front();
   }
+  // Numbers select by position and never fall through to name matching
   size_t index = 0;
-  if (parse_index(sel, &index) && index < devices.size()) return devices[index];
+  if (parse_index(sel, &index)) {
+    if (index < devices.size()) return devices[index];
+    throw Error("--device " + selector + ": there are only " + std::to_string(devices.size()) +
+                " OpenCL devices:\n" + format_device_table(devices));
+  }
   auto dot = sel.find('.');
   size_t p = 0, d = 0;
   if (dot != std::string::npos && parse_index(sel.substr(0, dot), &p) &&
       parse_index(sel.substr(dot + 1), &d)) {
     for (const auto& e : devices)
       if (e.platform_index == p && e.device_index == d) return e;
+    throw Error("--device " + selector + ": no such platform.device; available devices:\n" +
+                format_device_table(devices));
   }
   if (sel == "cpu" || sel == "gpu" || sel == "accelerator") {
     if (auto e = first_of_type(sel)) return *e;

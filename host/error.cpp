@@ -47,7 +47,8 @@ std::string cl_error_message(const std::string& what, int code) {
                     std::to_string(code) + ")";
   if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_RESOURCES ||
       code == CL_OUT_OF_HOST_MEMORY || code == CL_INVALID_BUFFER_SIZE)
-    msg += ": the device ran out of memory; try a smaller image or scene, or another --device";
+    msg += ": the device ran out of memory or resources (or, on some GPUs, the kernel faulted "
+           "or hit a watchdog); try a smaller image or scene, or another --device";
   return msg;
 }
 

@@ -254,7 +254,11 @@ class Loader {
       auto ext = gm.extensions.find("KHR_materials_emissive_strength");
       if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
         strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
-      for (int c = 0; c < 3; ++c) m.emission[c] = float(gm.emissiveFactor[c]) * strength;
+      for (int c = 0; c < 3; ++c) {
+        m.emission[c] = float(gm.emissiveFactor[c]) * strength;
+        if (!(m.emission[c] >= 0.0f) || !std::isfinite(m.emission[c]))
+          throw Error(name + " has a negative or non-finite emission (emissiveFactor x emissiveStrength)");
+      }
       m.double_sided = gm.doubleSided ? 1u : 0u;
 
       if (pbr.metallicFactor > 0.0)
@@ -342,6 +346,8 @@ class Loader {
   void load_scene_roots() {
     std::vector<int> roots;
     int scene_index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (model_.defaultScene >= (int)model_.scenes.size())
+      throw Error("glTF 'scene' " + std::to_string(model_.defaultScene) + " does not exist");
     if (scene_index < (int)model_.scenes.size()) {
       const tinygltf::Scene& s = model_.scenes[scene_index];
       roots = s.nodes;
@@ -355,7 +361,8 @@ class Loader {
       for (size_t i = 0; i < model_.nodes.size(); ++i)
         if (!is_child[i]) roots.push_back(int(i));
     }
-    for (int r : roots) visit_node(r, glm::mat4(1.0f), 0);
+    visited_.assign(model_.nodes.size(), false);
+    for (int r : roots) visit_node(r, glm::mat4(1.0f));
   }
 
   void read_scene_extras(const tinygltf::Value& extras) {
@@ -368,14 +375,19 @@ class Loader {
       for (int i = 0; i < 3; ++i) {
         if (!bg.Get(i).IsNumber()) throw Error("scene extras candela.background must hold numbers");
         scene_->background[i] = float(bg.Get(i).GetNumberAsDouble());
+        if (!(scene_->background[i] >= 0.0f) || !std::isfinite(scene_->background[i]))
+          throw Error("scene extras candela.background must be finite and non-negative");
       }
     }
   }
 
-  void visit_node(int index, const glm::mat4& parent, int depth) {
+  void visit_node(int index, const glm::mat4& parent) {
     if (index < 0 || index >= (int)model_.nodes.size())
       throw Error("glTF node " + std::to_string(index) + " does not exist");
-    if (depth > 256) throw Error("glTF node hierarchy is cyclic or too deep");
+    // glTF 3.5.2: nodes form disjoint strict trees (no node has two parents, no cycles)
+    if (visited_[index])
+      throw Error("glTF node " + std::to_string(index) + " has two parents or is part of a cycle");
+    visited_[index] = true;
     const tinygltf::Node& node = model_.nodes[index];
     glm::mat4 world = parent * local_transform(node);
     if (node.mesh >= 0) {
@@ -388,7 +400,7 @@ class Loader {
     if (node.camera >= 0 && !scene_->camera) load_camera(node.camera, world);
     if (node.extensions.count("KHR_lights_punctual"))
       warn_.add("KHR_lights_punctual lights are not supported yet and are ignored");
-    for (int child : node.children) visit_node(child, world, depth + 1);
+    for (int child : node.children) visit_node(child, world);
   }
 
   void load_camera(int index, const glm::mat4& world) {
@@ -500,6 +512,7 @@ class Loader {
   std::vector<UvSet> uv_sets_;  // per material: the UVs of its base color texture
   uint32_t default_material_index_ = 0;
   size_t degenerate_ = 0;
+  std::vector<bool> visited_;  // nodes reached so far
 };
 
 }  // namespace

@@ -74,8 +74,12 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
 Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
     : device_(device), settings_(settings) {
   if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 ||
-      settings.height > 65536)
-    throw Error("image size must be between 1x1 and 65536x65536");
+      settings.height > 65536 || uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
+    throw Error("image size must be between 1x1 and 65536x65536 with at most 2^28 pixels");
+  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 ||
+      device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
+    throw Error(device.description() + " supports only " + device.opencl_c_version +
+                "; candela needs OpenCL C 1.2");
 
   auto bvh_start = Clock::now();
   Bvh bvh = build_bvh(scene.triangles);
@@ -96,6 +100,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
+  local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
 
   nodes_ = upload(context_, device_, bvh.nodes, "the BVH");
   tris_ = upload(context_, device_, tris, "triangles");
@@ -140,9 +145,11 @@ void Renderer::launch(uint32_t sample_begin, uint32_t count) {
   params_host_.sample_count = count;
   try {
     queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
-    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange,
-                                cl::NDRange(size_t(settings_.width) * settings_.height),
-                                cl::NullRange);
+    // Work-groups of local_size_ work-items; the kernel skips the padding at the end
+    size_t pixels = size_t(settings_.width) * settings_.height;
+    size_t global = (pixels + local_size_ - 1) / local_size_ * local_size_;
+    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global),
+                                cl::NDRange(local_size_));
     queue_.finish();
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("running the path tracing kernel", e.err()));
@@ -159,12 +166,14 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
   p.time_limit = time_limit;
   RenderResult result;
   uint32_t batch = 1;
-  while (spp == 0 || p.spp_done < spp) {
+  // The film counts samples in floats: a time-limited render stops at 2^24 per pixel
+  const uint32_t limit = spp > 0 ? spp : kMaxSamplesPerPixel;
+  while (p.spp_done < limit) {
     if (stop && stop()) {
       result.interrupted = true;
       break;
     }
-    if (spp > 0) batch = std::min(batch, spp - p.spp_done);
+    batch = std::min(batch, limit - p.spp_done);
     auto t0 = Clock::now();
     launch(sample_begin + p.spp_done, batch);
     double dt = seconds_since(t0);

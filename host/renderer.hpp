@@ -15,6 +15,9 @@ namespace candela {
 
 enum class Strategy : uint32_t { Nee = STRATEGY_NEE, Bsdf = STRATEGY_BSDF };
 
+// The film's per-pixel sample count is a float: exact up to 2^24
+constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
+
 struct RenderSettings {
   int width = 512, height = 512;
   uint32_t seed = 0;
@@ -70,6 +73,7 @@ class Renderer {
       light_thresholds_;
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
+  size_t local_size_ = 1;
   std::string build_options_;
   double kernel_build_seconds_ = 0.0, bvh_build_seconds_ = 0.0;
   bool kernel_from_cache_ = false;

@@ -42,7 +42,14 @@ CameraDesc resolve_camera(const Scene& scene) {
 dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
   glm::vec3 f = glm::normalize(cam.forward);
   glm::vec3 r = glm::cross(f, cam.up);
-  if (glm::length(r) < 1e-6f) r = glm::cross(f, glm::vec3(1.0f, 0.0f, 0.0f));
+  if (!(glm::length(r) > 1e-6f)) {
+    // Up is parallel to the view: use the world axis least aligned with it
+    glm::vec3 a = glm::abs(f);
+    glm::vec3 axis = a.x <= a.y && a.x <= a.z ? glm::vec3(1, 0, 0)
+                     : a.y <= a.z            ? glm::vec3(0, 1, 0)
+                                             : glm::vec3(0, 0, 1);
+    r = glm::cross(f, axis);
+  }
   r = glm::normalize(r);
   glm::vec3 u = glm::cross(r, f);
   float tan_y = std::tan(0.5f * cam.yfov);

@@ -39,6 +39,7 @@ expect_error "malformed glTF" "cannot load glTF scene" -- "$bin" render "$tmp/ba
 printf 'glTF\x02\x00\x00\x00junk' >"$tmp/bad.glb"
 expect_error "malformed GLB" "cannot load glTF scene" -- "$bin" render "$tmp/bad.glb" -o "$tmp/x.png" --device pocl
 expect_error "unknown device" "no OpenCL device matches --device 'quantum'" -- "$bin" render "$scene" -o "$tmp/x.png" --device quantum
+expect_error "device index out of range" "there are only" -- "$bin" render "$scene" -o "$tmp/x.png" --device 7
 mkdir -p "$tmp/no-vendors"
 expect_error "no OpenCL platform" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$scene" -o "$tmp/x.png"
 expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" devices

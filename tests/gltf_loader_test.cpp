@@ -185,6 +185,19 @@ TEST(GltfLoader, MissingAndMalformedFilesFailClearly) {
   json j = quad_gltf();
   j["accessors"][0]["count"] = 400;  // reads past the buffer
   EXPECT_THROW(load_gltf(dir.write("short.gltf", j.dump())), Error);
+  json cyclic = quad_gltf();
+  cyclic["nodes"] = {{{"mesh", 0}, {"children", {1, 1}}}, {{"children", {0}}}};
+  EXPECT_THROW(load_gltf(dir.write("cyclic.gltf", cyclic.dump())), Error);
+  json negative = quad_gltf();
+  negative["materials"][0]["emissiveFactor"] = {1, 1, 1};
+  negative["materials"][0]["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", -2}}}};
+  EXPECT_THROW(load_gltf(dir.write("negative.gltf", negative.dump())), Error);
+  json bad_scene = quad_gltf();
+  bad_scene["scene"] = 3;
+  EXPECT_THROW(load_gltf(dir.write("bad-scene.gltf", bad_scene.dump())), Error);
+  json huge = quad_gltf();
+  huge["accessors"][1]["count"] = 4611686018427387905ull;  // 2^62 + 1: wraps naive bounds checks
+  EXPECT_THROW(load_gltf(dir.write("huge.gltf", huge.dump())), Error);
   json empty = {{"asset", {{"version", "2.0"}}}, {"scenes", {{{"nodes", json::array()}}}}};
   try {
     load_gltf(dir.write("empty.gltf", empty.dump()));
