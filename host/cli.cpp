@@ -266,6 +266,11 @@ int main(int argc, char** argv) {
     if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
     if (*devices_cmd) {
       std::printf("%s", format_device_table(list_devices()).c_str());
+      for (const auto& p : list_empty_platforms()) {
+        std::printf("platform %s has no devices\n", p.c_str());
+        if (p.find("rusticl") != std::string::npos)
+          std::printf("  (rusticl shows its CPU device with RUSTICL_ENABLE=llvmpipe)\n");
+      }
       return 0;
     }
     return run_render(a);

@@ -84,6 +84,23 @@ std::vector<DeviceEntry> list_devices() {
   return out;
 }
 
+std::vector<std::string> list_empty_platforms() {
+  std::vector<cl::Platform> platforms;
+  cl::Platform::get(&platforms);
+  std::vector<std::string> out;
+  for (size_t p = 0; p < platforms.size(); ++p) {
+    std::vector<cl::Device> devices;
+    try {
+      platforms[p].getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+    }
+    if (devices.empty())
+      out.push_back(std::to_string(p) + ": " + trim(platforms[p].getInfo<CL_PLATFORM_NAME>()) + " (" +
+                    trim(platforms[p].getInfo<CL_PLATFORM_VERSION>()) + ")");
+  }
+  return out;
+}
+
 DeviceEntry select_device(const std::string& selector) {
   std::vector<DeviceEntry> devices = list_devices();
   if (devices.empty()) throw Error("OpenCL platforms are installed but none has a device");

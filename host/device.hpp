@@ -33,6 +33,9 @@ std::vector<DeviceEntry> list_devices();
 // version or of the device's name. Throws Error naming the choices when nothing matches.
 DeviceEntry select_device(const std::string& selector);
 
+// Platforms that expose no device (e.g. Mesa Clover without a GPU), as "P: name (version)"
+std::vector<std::string> list_empty_platforms();
+
 // Table printed by `candela devices`
 std::string format_device_table(const std::vector<DeviceEntry>& devices);
 
