@@ -115,7 +115,9 @@ typedef struct {
   unsigned int sample_begin;  // first sample index of this launch
   unsigned int sample_count;  // samples per pixel in this launch
   unsigned int rr_depth;  // Russian roulette starts after this many bounces
-  unsigned int pad[3];
+  unsigned int pixel_begin;  // first pixel of this launch (row-major)
+  unsigned int pixel_end;  // one past the last pixel of this launch
+  unsigned int pad0;
 } RenderParams;
 
 #endif  // CANDELA_DEVICE_TYPES_H

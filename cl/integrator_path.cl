@@ -94,8 +94,8 @@ __kernel void render_paths(__global const BvhNode* nodes, __global const Triangl
                            __global const uint* light_thresholds,
                            __global const RenderParams* params, __global float4* film_mean,
                            __global float4* film_m2) {
-  uint pixel = get_global_id(0);
-  if (pixel >= params->width * params->height) return;
+  uint pixel = params->pixel_begin + (uint)get_global_id(0);
+  if (pixel >= params->pixel_end) return;
   SceneData sc = {nodes,  tris,           shading, materials,        textures,
                   texels, srgb_to_linear, lights,  light_thresholds, params};
   uint px = pixel % params->width, py = pixel / params->width;

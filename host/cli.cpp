@@ -195,6 +195,8 @@ int run_render(const RenderArgs& a) {
   }
   std::printf("%u spp in %.2fs: %.3f Msamples/s on %s%s\n", r.spp, r.seconds, samples_per_second * 1e-6,
               device.description().c_str(), r.interrupted ? " (interrupted)" : "");
+  if (r.partial_pass)
+    std::fprintf(stderr, "note: stopped inside a pass; some pixels hold more than %u samples\n", r.spp);
   if (dropped) std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)dropped);
 
   if (!a.stats.empty()) {

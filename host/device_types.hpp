@@ -39,4 +39,5 @@ static_assert(offsetof(Camera, up) == 48);
 static_assert(sizeof(RenderParams) == 128);
 static_assert(offsetof(RenderParams, background) == 64 && offsetof(RenderParams, width) == 80);
 static_assert(offsetof(RenderParams, strategy) == 96 && offsetof(RenderParams, rr_depth) == 112);
+static_assert(offsetof(RenderParams, pixel_begin) == 116 && offsetof(RenderParams, pixel_end) == 120);
 }  // namespace candela::dev

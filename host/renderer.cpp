@@ -140,14 +140,15 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   }
 }
 
-void Renderer::launch(uint32_t sample_begin, uint32_t count) {
+void Renderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end) {
   params_host_.sample_begin = sample_begin;
   params_host_.sample_count = count;
+  params_host_.pixel_begin = uint32_t(pixel_begin);
+  params_host_.pixel_end = uint32_t(pixel_end);
   try {
     queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
     // Work-groups of local_size_ work-items; the kernel skips the padding at the end
-    size_t pixels = size_t(settings_.width) * settings_.height;
-    size_t global = (pixels + local_size_ - 1) / local_size_ * local_size_;
+    size_t global = (pixel_end - pixel_begin + local_size_ - 1) / local_size_ * local_size_;
     queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global),
                                 cl::NDRange(local_size_));
     queue_.finish();
@@ -165,30 +166,44 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
   p.spp_target = spp;
   p.time_limit = time_limit;
   RenderResult result;
-  uint32_t batch = 1;
+  const size_t pixels = size_t(settings_.width) * settings_.height;
   // The film counts samples in floats: a time-limited render stops at 2^24 per pixel
   const uint32_t limit = spp > 0 ? spp : kMaxSamplesPerPixel;
-  while (p.spp_done < limit) {
-    if (stop && stop()) {
-      result.interrupted = true;
-      break;
-    }
+  // A pass adds `batch` samples to every pixel, in launches of at most `chunk` pixels,
+  // each sized to take about launch_seconds (GPU watchdogs, progress, Ctrl-C)
+  uint32_t batch = 1;
+  size_t chunk = std::min(pixels, std::max<size_t>(local_size_, 4096));
+  double cost = 0.0;  // seconds per pixel sample, from the last launch
+  auto out_of_time = [&] { return spp == 0 && seconds_since(start) >= time_limit; };
+  while (p.spp_done < limit && !result.interrupted) {
     batch = std::min(batch, limit - p.spp_done);
-    auto t0 = Clock::now();
-    launch(sample_begin + p.spp_done, batch);
-    double dt = seconds_since(t0);
+    for (size_t begin = 0; begin < pixels; begin += chunk) {
+      bool stopped = stop && stop();
+      if (stopped || (begin > 0 && out_of_time())) {
+        // Pixels before `begin` keep one batch more than the others (exact per-pixel
+        // counts live in the film)
+        result.interrupted = stopped;
+        result.partial_pass = begin > 0;
+        break;
+      }
+      size_t end = std::min(pixels, begin + chunk);
+      auto t0 = Clock::now();
+      launch(sample_begin + p.spp_done, batch, begin, end);
+      cost = seconds_since(t0) / (double(end - begin) * batch);
+      size_t want = size_t(settings_.launch_seconds / std::max(cost * batch, 1e-12));
+      chunk = std::clamp((want + local_size_ - 1) / local_size_ * local_size_, local_size_, pixels);
+    }
+    if (result.interrupted || result.partial_pass) break;
     p.spp_done += batch;
     p.seconds = seconds_since(start);
     if (progress) progress(p);
-    if (spp == 0 && p.seconds >= time_limit) break;
-    // Size the next launch to take about launch_seconds (at most doubling each time)
-    double per_sample = dt / batch;
-    double want = settings_.launch_seconds / std::max(per_sample, 1e-9);
+    if (out_of_time()) break;
+    // Next pass: whole-image launches of several samples once one sample is cheap enough
+    double pass = cost * double(pixels);
+    double want = settings_.launch_seconds / std::max(pass, 1e-12);
     batch = uint32_t(std::clamp(want, 1.0, std::min(2.0 * batch, 4096.0)));
-    if (spp == 0) {
-      double left = time_limit - p.seconds;
-      batch = uint32_t(std::clamp(left / std::max(per_sample, 1e-9), 1.0, double(batch)));
-    }
+    if (spp == 0) batch = uint32_t(std::clamp((time_limit - p.seconds) / std::max(pass, 1e-12), 1.0, double(batch)));
+    if (want >= 1.0) chunk = pixels;
   }
   result.spp = p.spp_done;
   result.seconds = seconds_since(start);

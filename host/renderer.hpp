@@ -36,9 +36,10 @@ struct RenderProgress {
 
 struct RenderResult {
   Film film;
-  uint32_t spp = 0;
+  uint32_t spp = 0;  // samples every pixel received
   double seconds = 0.0;
-  bool interrupted = false;
+  bool interrupted = false;  // stopped by the caller
+  bool partial_pass = false;  // stopped inside a pass: some pixels hold one batch more
 };
 
 class Renderer {
@@ -62,7 +63,7 @@ class Renderer {
   std::string build_options() const { return build_options_; }
 
  private:
-  void launch(uint32_t sample_begin, uint32_t count);
+  void launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end);
 
   DeviceEntry device_;
   RenderSettings settings_;

@@ -179,6 +179,13 @@ TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
   EXPECT_EQ(a.mean, b.mean);
   EXPECT_EQ(a.m2, b.m2);
 
+  // Tiny launches: every launch covers one work-group of pixels and one sample
+  RenderSettings tiny = settings;
+  tiny.launch_seconds = 1e-9;
+  Film d = Renderer(device, scene, tiny).render(0, 12).film;
+  EXPECT_EQ(a.mean, d.mean);
+  EXPECT_EQ(a.m2, d.m2);
+
   settings.seed = 43;
   Renderer other(device, scene, settings);
   Film c = other.render(0, 12).film;
