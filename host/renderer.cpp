@@ -177,7 +177,7 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
   auto out_of_time = [&] { return spp == 0 && seconds_since(start) >= time_limit; };
   while (p.spp_done < limit && !result.interrupted) {
     batch = std::min(batch, limit - p.spp_done);
-    for (size_t begin = 0; begin < pixels; begin += chunk) {
+    for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
       bool stopped = stop && stop();
       if (stopped || (begin > 0 && out_of_time())) {
         // Pixels before `begin` keep one batch more than the others (exact per-pixel
@@ -186,7 +186,7 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
         result.partial_pass = begin > 0;
         break;
       }
-      size_t end = std::min(pixels, begin + chunk);
+      end = std::min(pixels, begin + chunk);
       auto t0 = Clock::now();
       launch(sample_begin + p.spp_done, batch, begin, end);
       cost = seconds_since(t0) / (double(end - begin) * batch);
