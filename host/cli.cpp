@@ -74,8 +74,9 @@ class ProgressBar {
       if (p.seconds < next_line_) return;
       next_line_ = p.seconds + 10.0;
     }
-    double frac = p.spp_target ? double(p.spp_done) / p.spp_target : std::min(1.0, p.seconds / p.time_limit);
-    double rate = p.seconds > 0 ? p.spp_done * pixels_ / p.seconds : 0.0;
+    double spp = p.spp_done + p.spp_partial;
+    double frac = p.spp_target ? spp / p.spp_target : std::min(1.0, p.seconds / p.time_limit);
+    double rate = p.seconds > 0 ? spp * pixels_ / p.seconds : 0.0;
     double eta = frac > 0 ? p.seconds * (1.0 - frac) / frac : 0.0;
     int width = 30, filled = int(frac * width + 0.5);
     std::string bar = std::string(filled, '#') + std::string(width - filled, '-');

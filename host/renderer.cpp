@@ -191,8 +191,15 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
       launch(sample_begin + p.spp_done, batch, begin, end);
       cost = seconds_since(t0) / (double(end - begin) * batch);
       size_t want = size_t(settings_.launch_seconds / std::max(cost * batch, 1e-12));
-      chunk = std::clamp((want + local_size_ - 1) / local_size_ * local_size_, local_size_, pixels);
+      chunk = std::clamp((want + local_size_ - 1) / local_size_ * local_size_,
+                         std::min(local_size_, pixels), pixels);
+      if (end < pixels && progress) {
+        p.spp_partial = batch * double(end) / double(pixels);
+        p.seconds = seconds_since(start);
+        progress(p);
+      }
     }
+    p.spp_partial = 0.0;
     if (result.interrupted || result.partial_pass) break;
     p.spp_done += batch;
     p.seconds = seconds_since(start);

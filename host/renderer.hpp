@@ -29,6 +29,7 @@ struct RenderSettings {
 
 struct RenderProgress {
   uint32_t spp_done = 0;
+  double spp_partial = 0.0;  // fraction of the pass under way, in samples per pixel
   uint32_t spp_target = 0;  // 0 when rendering for a time budget
   double seconds = 0.0;
   double time_limit = 0.0;
