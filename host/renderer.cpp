@@ -50,6 +50,12 @@ std::vector<float> srgb_decode_table() {
   return t;
 }
 
+std::string format_mib(uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f MiB", bytes / 1048576.0);
+  return buf;
+}
+
 // A read-only buffer holding `data`, or one dummy element when it is empty
 template <typename T>
 cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data,
@@ -58,9 +64,9 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
   const std::vector<T>& src = data.empty() ? one : data;
   size_t bytes = src.size() * sizeof(T);
   if (bytes > device.max_alloc)
-    throw Error(std::string("the scene's ") + what + " need " + std::to_string(bytes >> 20) +
-                " MiB in one buffer, more than " + device.description() + " allows (" +
-                std::to_string(device.max_alloc >> 20) + " MiB)");
+    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) +
+                " in one buffer, more than " + device.description() + " allows (" +
+                format_mib(device.max_alloc) + ")");
   try {
     return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T),
                       const_cast<T*>(src.data()));

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "error.hpp"
 #include "gltf_loader.hpp"
 #include "renderer.hpp"
 #include "test_support.hpp"
@@ -162,6 +163,24 @@ TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   double se = std::sqrt(ea.standard_error * ea.standard_error + eb.standard_error * eb.standard_error);
   EXPECT_GT(ea.mean, 0.01);
   EXPECT_NEAR(ea.mean, eb.mean, 4.0 * se) << "nee " << ea.mean << " bsdf " << eb.mean;
+}
+
+// A scene too large for the device's biggest buffer fails with a message naming the
+// buffer and both sizes, before anything is launched
+TEST(Render, BufferLargerThanTheDeviceAllowsIsAClearError) {
+  DeviceEntry device = pocl_device();
+  device.max_alloc = 1024;  // pretend the device takes at most 1 KiB per buffer
+  Scene scene = load_gltf(scene_path("furnace/closed-sphere.gltf"));
+  RenderSettings settings;
+  settings.width = settings.height = 8;
+  try {
+    Renderer r(device, scene, settings);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    EXPECT_NE(msg.find("MiB"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("allows"), std::string::npos) << msg;
+  }
 }
 
 TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
