@@ -135,11 +135,7 @@ int run_render(const RenderArgs& a) {
   else
     throw Error("--strategy must be nee or bsdf, not '" + a.strategy + "'");
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
-  for (const auto& out : a.outputs) {
-    std::string ext = out.size() >= 4 ? out.substr(out.size() - 4) : "";
-    for (auto& c : ext) c = char(std::tolower((unsigned char)c));
-    if (ext != ".exr" && ext != ".png") throw Error("output must end in .exr or .png: " + out);
-  }
+  for (const auto& out : a.outputs) check_output_path(out);
 
   Scene scene = load_gltf(a.scene);
   if (!a.background.empty()) {

@@ -56,11 +56,15 @@ std::string lower_extension(const std::string& path) {
 
 }  // namespace
 
+void check_output_path(const std::string& path) {
+  std::string ext = lower_extension(path);
+  if (ext != ".exr" && ext != ".png") throw Error("output must end in .exr or .png: " + path);
+}
+
 void write_image(const std::string& path, const Film& film,
                  const std::map<std::string, std::string>& metadata, float exposure) {
-  std::string ext = lower_extension(path);
-  bool exr = ext == ".exr";
-  if (!exr && ext != ".png") throw Error("output must end in .exr or .png: " + path);
+  check_output_path(path);
+  bool exr = lower_extension(path) == ".exr";
 
   OIIO::ImageSpec spec(film.width, film.height, 3, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);

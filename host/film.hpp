@@ -28,6 +28,9 @@ struct Film {
 // (Chan, Golub and LeVeque 1979, parallel variance update).
 Film merge_films(const Film& a, const Film& b);
 
+// Throws Error unless the path ends in .exr or .png (case-insensitive)
+void check_output_path(const std::string& path);
+
 // Writes OUT.exr (linear float RGB + metadata) or OUT.png (exposure-scaled, clamped,
 // sRGB, 8 bit). Other extensions throw Error.
 void write_image(const std::string& path, const Film& film,
