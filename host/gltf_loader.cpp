@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -526,10 +527,12 @@ Scene load_gltf(const std::string& path) {
   tinygltf::TinyGLTF gltf;
   tinygltf::Model model;
   std::string err, warn;
-  std::string ext = fs::path(path).extension().string();
-  for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
-  bool ok = ext == ".glb" ? gltf.LoadBinaryFromFile(&model, &err, &warn, path)
-                          : gltf.LoadASCIIFromFile(&model, &err, &warn, path);
+  // Binary glTF starts with the magic "glTF", whatever the file is called
+  char magic[4] = {};
+  std::ifstream(path, std::ios::binary).read(magic, 4);
+  bool binary = std::memcmp(magic, "glTF", 4) == 0;
+  bool ok = binary ? gltf.LoadBinaryFromFile(&model, &err, &warn, path)
+                   : gltf.LoadASCIIFromFile(&model, &err, &warn, path);
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     throw Error("cannot load glTF scene " + path + ": " + (err.empty() ? "malformed file" : err));
