@@ -1,5 +1,6 @@
 // candela command line: `candela devices`, `candela render SCENE -o OUT ...`.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -260,6 +261,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+
+  // Mesa's rusticl exposes its CPU device only when asked, before the ICD loader starts
+  std::string wanted = a.device;
+  std::transform(wanted.begin(), wanted.end(), wanted.begin(), [](unsigned char c) { return std::tolower(c); });
+  if ((wanted.find("rusticl") != std::string::npos || wanted.find("llvmpipe") != std::string::npos) &&
+      !std::getenv("RUSTICL_ENABLE"))
+    setenv("RUSTICL_ENABLE", "llvmpipe", 0);
 
   try {
     if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
