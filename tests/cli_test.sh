@@ -49,6 +49,16 @@ expect_error "bad background" "three comma-separated numbers" -- "$bin" render "
 mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights.cl"
 expect_error "kernel build failure shows the log" "cl/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
 
+# --device rusticl finds Mesa's CPU device without RUSTICL_ENABLE in the environment
+if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
+  if env -u RUSTICL_ENABLE "$bin" render "$scene" -o "$tmp/r.png" --spp 1 --width 16 --height 16 \
+      --device rusticl -q >"$tmp/out" 2>"$tmp/err" && grep -q rusticl "$tmp/out"; then
+    pass "--device rusticl enables rusticl"
+  else
+    fail "--device rusticl enables rusticl"; cat "$tmp/err"
+  fi
+fi
+
 # devices lists PoCL with a selector
 if "$bin" devices | grep -q "Portable Computing Language"; then pass "devices lists PoCL"; else fail "devices lists PoCL"; fi
 
