@@ -7,16 +7,10 @@ typedef struct {
   float3 base_color;
 } Bsdf;
 
-Bsdf bsdf_at(__global const Material* m, __global const TextureInfo* textures,
-             __global const uchar4* texels, __global const float* srgb_to_linear, float2 uv) {
+Bsdf bsdf_at(__global const Material* m, const TextureSet* textures, float2 uv) {
   Bsdf b;
   b.type = m->type;
-  b.base_color = load3(m->base_color);
-#if CD_FEATURE_TEXTURES
-  if (m->base_color_texture != NO_TEXTURE)
-    b.base_color *=
-        texture_sample(&textures[m->base_color_texture], texels, srgb_to_linear, uv).xyz;
-#endif
+  b.base_color = load3(m->base_color) * textures_lookup(textures, m->base_color_texture, uv).xyz;
   return b;
 }
 

@@ -64,7 +64,7 @@ typedef struct {
   unsigned int type;  // MATERIAL_*
   int base_color_texture;  // index into TextureInfo or NO_TEXTURE
   unsigned int double_sided;
-  unsigned int pad0;
+  int emission_texture;  // index into TextureInfo or NO_TEXTURE; scales `emission`
   float base_color[4];  // rgba factor
   float emission[4];  // rgb radiance (factor x strength), w unused
   float params[4];  // reserved: roughness, metallic, ior, anisotropy

@@ -9,9 +9,7 @@ typedef struct {
   __global const Triangle* tris;
   __global const TriangleShading* shading;
   __global const Material* materials;
-  __global const TextureInfo* textures;
-  __global const uchar4* texels;
-  __global const float* srgb_to_linear;
+  TextureSet textures;
   __global const Light* lights;
   __global const uint* light_thresholds;
   __global const RenderParams* params;
@@ -24,7 +22,7 @@ float3 path_direct_light(const SceneData* sc, const SurfaceHit* s, const Bsdf* b
   float2 u = (float2)(rng_next(rng), rng_next(rng));
   LightSample ls;
   if (!lights_sample(sc->lights, sc->light_thresholds, sc->params->num_lights, sc->tris,
-                     sc->materials, s->p, s->ns, x_select, u, &ls))
+                     sc->shading, sc->materials, &sc->textures, s->p, s->ns, x_select, u, &ls))
     return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi, s->ns, s->ng);
   float cos_i = fabs(dot(ls.wi, s->ns));
@@ -59,11 +57,11 @@ float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
     }
     SurfaceHit s = surface_at(sc->tris, sc->shading, hit, ray.dir);
     __global const Material* m = &sc->materials[s.material];
-    if (counts_emission) radiance += beta * surface_emission(m, s.front);
+    if (counts_emission) radiance += beta * surface_emission(m, s.front, &sc->textures, s.uv);
     if (depth >= params->max_depth) break;
 
     float3 wo = -ray.dir;
-    Bsdf bsdf = bsdf_at(m, sc->textures, sc->texels, sc->srgb_to_linear, s.uv);
+    Bsdf bsdf = bsdf_at(m, &sc->textures, s.uv);
     if (nee) radiance += beta * path_direct_light(sc, &s, &bsdf, wo, rng);
 
     // Continue the path by sampling the BSDF
@@ -96,8 +94,14 @@ __kernel void render_paths(__global const BvhNode* nodes, __global const Triangl
                            __global float4* film_m2) {
   uint pixel = params->pixel_begin + (uint)get_global_id(0);
   if (pixel >= params->pixel_end) return;
-  SceneData sc = {nodes,  tris,           shading, materials,        textures,
-                  texels, srgb_to_linear, lights,  light_thresholds, params};
+  SceneData sc = {nodes,
+                  tris,
+                  shading,
+                  materials,
+                  {textures, texels, srgb_to_linear},
+                  lights,
+                  light_thresholds,
+                  params};
   uint px = pixel % params->width, py = pixel / params->width;
 
   // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones

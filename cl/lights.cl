@@ -12,8 +12,9 @@ typedef struct {
 
 // Uniform point on an emissive triangle, converted to a solid-angle pdf at p
 bool lights_sample_triangle(__global const Light* light, __global const Triangle* tris,
-                            __global const Material* materials, float3 p, float2 u,
-                            LightSample* ls) {
+                            __global const TriangleShading* shading,
+                            __global const Material* materials, const TextureSet* textures,
+                            float3 p, float2 u, LightSample* ls) {
   __global const Triangle* tri = &tris[light->index];
   float3 v0 = load3(tri->v0), v1 = load3(tri->v1), v2 = load3(tri->v2);
   float2 st = sample_triangle(u.x, u.y);
@@ -26,7 +27,9 @@ bool lights_sample_triangle(__global const Light* light, __global const Triangle
   ls->wi = d / dist;
   float cos_light = dot(n, -ls->wi);
   bool front = cos_light > 0.0f;
-  ls->radiance = surface_emission(&materials[tri->material], front);
+  // y = s v0 + t v1 + (1-s-t) v2: barycentric weights of v1 and v2 are t and 1-s-t
+  float2 uv = surface_uv(&shading[tri->prim], st.y, 1.0f - st.x - st.y);
+  ls->radiance = surface_emission(&materials[tri->material], front, textures, uv);
   // Area measure to solid angle: dw/dA = cos(theta_y) / r^2
   ls->pdf = dist2 / (fabs(cos_light) * light->area);
   ls->at_infinity = false;
@@ -47,15 +50,16 @@ bool lights_sample_background(__global const Light* light, float3 ns, float2 u,
 
 bool lights_sample(__global const Light* lights, __global const uint* light_thresholds,
                    uint num_lights, __global const Triangle* tris,
-                   __global const Material* materials, float3 p, float3 ns, uint x_select,
-                   float2 u, LightSample* ls) {
+                   __global const TriangleShading* shading, __global const Material* materials,
+                   const TextureSet* textures, float3 p, float3 ns, uint x_select, float2 u,
+                   LightSample* ls) {
   if (num_lights == 0u) return false;
   __global const Light* light = &lights[sample_discrete_thresholds(light_thresholds, num_lights, x_select)];
   float p_select = light->pmf;
   bool ok;
   switch (light->type) {
     case LIGHT_TRIANGLE:
-      ok = lights_sample_triangle(light, tris, materials, p, u, ls);
+      ok = lights_sample_triangle(light, tris, shading, materials, textures, p, u, ls);
       break;
     case LIGHT_BACKGROUND:
       ok = lights_sample_background(light, ns, u, ls);

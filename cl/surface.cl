@@ -9,6 +9,12 @@ typedef struct {
   bool front;  // the ray hit the front face (counter-clockwise winding)
 } SurfaceHit;
 
+// Texture coordinates at barycentric weights (b1, b2) of v1 and v2
+float2 surface_uv(__global const TriangleShading* sh, float b1, float b2) {
+  return (1.0f - b1 - b2) * (float2)(sh->uv0_u, sh->uv0_v) + b1 * (float2)(sh->uv1_u, sh->uv1_v) +
+         b2 * (float2)(sh->uv2_u, sh->uv2_v);
+}
+
 SurfaceHit surface_at(__global const Triangle* tris, __global const TriangleShading* shading,
                       Hit hit, float3 ray_dir) {
   __global const Triangle* tri = &tris[hit.tri];
@@ -24,14 +30,14 @@ SurfaceHit surface_at(__global const Triangle* tris, __global const TriangleShad
   float len = length(n);
   s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
-  s.uv = b0 * (float2)(sh->uv0_u, sh->uv0_v) + hit.b1 * (float2)(sh->uv1_u, sh->uv1_v) +
-         hit.b2 * (float2)(sh->uv2_u, sh->uv2_v);
+  s.uv = surface_uv(sh, hit.b1, hit.b2);
   s.material = tri->material;
   return s;
 }
 
 // Radiance a surface emits toward the side the ray came from
-float3 surface_emission(__global const Material* m, bool front) {
+float3 surface_emission(__global const Material* m, bool front, const TextureSet* textures,
+                        float2 uv) {
   if (!front && !m->double_sided) return (float3)(0.0f);
-  return load3(m->emission);
+  return load3(m->emission) * textures_lookup(textures, m->emission_texture, uv).xyz;
 }

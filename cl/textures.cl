@@ -5,6 +5,13 @@
 #define CD_FEATURE_TEXTURES 1
 #endif
 
+// Every texture of the scene
+typedef struct {
+  __global const TextureInfo* info;
+  __global const uchar4* texels;
+  __global const float* srgb_to_linear;  // 256 entries
+} TextureSet;
+
 int texture_wrap(int i, int n, uint mode) {
   if (mode == WRAP_CLAMP) return clamp(i, 0, n - 1);
   if (mode == WRAP_MIRROR) {
@@ -44,4 +51,13 @@ float4 texture_sample(__global const TextureInfo* tex, __global const uchar4* te
   float4 c01 = texture_texel(tex, texels, srgb_to_linear, ix, iy + 1);
   float4 c11 = texture_texel(tex, texels, srgb_to_linear, ix + 1, iy + 1);
   return mix(mix(c00, c10, ax), mix(c01, c11, ax), ay);
+}
+
+// Texture `index` of the set at uv; white when the scene has no textures compiled in
+float4 textures_lookup(const TextureSet* set, int index, float2 uv) {
+#if CD_FEATURE_TEXTURES
+  if (index != NO_TEXTURE)
+    return texture_sample(&set->info[index], set->texels, set->srgb_to_linear, uv);
+#endif
+  return (float4)(1.0f);
 }

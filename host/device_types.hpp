@@ -27,7 +27,7 @@ static_assert(offsetof(TriangleShading, uv2_v) == 56);
 
 static_assert(sizeof(Material) == 64);
 static_assert(offsetof(Material, base_color) == 16 && offsetof(Material, emission) == 32);
-static_assert(offsetof(Material, params) == 48);
+static_assert(offsetof(Material, params) == 48 && offsetof(Material, emission_texture) == 12);
 
 static_assert(sizeof(TextureInfo) == 16);
 static_assert(sizeof(Light) == 32 && offsetof(Light, radiance) == 16);

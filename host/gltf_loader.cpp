@@ -10,6 +10,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "error.hpp"
@@ -191,6 +192,7 @@ glm::mat4 local_transform(const tinygltf::Node& node) {
 struct UvSet {
   int texcoord = 0;
   glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
+  bool operator==(const UvSet& o) const { return texcoord == o.texcoord && transform == o.transform; }
 };
 
 double number_or(const tinygltf::Value& obj, const char* key, int index, double fallback) {
@@ -213,6 +215,14 @@ void read_texture_transform(const tinygltf::Value& ext, UvSet* set) {
   set->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
                              glm::vec3(ox, oy, 1.0f));
   if (ext.Has("texCoord")) set->texcoord = int(number_or(ext, "texCoord", -1, set->texcoord));
+}
+
+UvSet uv_set_of(int texcoord, const tinygltf::ExtensionMap& extensions) {
+  UvSet set;
+  set.texcoord = texcoord;
+  auto tt = extensions.find("KHR_texture_transform");
+  if (tt != extensions.end()) read_texture_transform(tt->second, &set);
+  return set;
 }
 
 class Loader {
@@ -243,14 +253,21 @@ class Loader {
       const auto& pbr = gm.pbrMetallicRoughness;
       dev::Material m = default_material();
       for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
-      UvSet uv_set;
+      // One UV set per material: the base color texture's, else the emissive texture's
+      std::optional<UvSet> uv_set;
       if (pbr.baseColorTexture.index >= 0) {
         m.base_color_texture = texture_index(pbr.baseColorTexture.index, true);
-        uv_set.texcoord = pbr.baseColorTexture.texCoord;
-        auto tt = pbr.baseColorTexture.extensions.find("KHR_texture_transform");
-        if (tt != pbr.baseColorTexture.extensions.end()) read_texture_transform(tt->second, &uv_set);
+        uv_set = uv_set_of(pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions);
       }
-      uv_sets_.push_back(uv_set);
+      if (gm.emissiveTexture.index >= 0) {
+        m.emission_texture = texture_index(gm.emissiveTexture.index, true);
+        UvSet emissive_uv = uv_set_of(gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions);
+        if (!uv_set)
+          uv_set = emissive_uv;
+        else if (!(*uv_set == emissive_uv))
+          warn_.add("emissiveTexture with other texture coordinates than baseColorTexture is not supported yet: it uses the base color's");
+      }
+      uv_sets_.push_back(uv_set.value_or(UvSet()));
       float strength = 1.0f;
       auto ext = gm.extensions.find("KHR_materials_emissive_strength");
       if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
@@ -267,8 +284,6 @@ class Loader {
       if (pbr.metallicRoughnessTexture.index >= 0)
         warn_.add("metallicRoughnessTexture is not supported yet and is ignored");
       if (gm.normalTexture.index >= 0) warn_.add("normalTexture is not supported yet and is ignored");
-      if (gm.emissiveTexture.index >= 0)
-        warn_.add("emissiveTexture is not supported yet: emission uses emissiveFactor alone");
       if (gm.occlusionTexture.index >= 0)
         warn_.add("occlusionTexture is ignored (a path tracer computes occlusion itself)");
       if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
@@ -288,6 +303,7 @@ class Loader {
     dev::Material m{};
     m.type = MATERIAL_DIFFUSE;
     m.base_color_texture = NO_TEXTURE;
+    m.emission_texture = NO_TEXTURE;
     for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
     return m;
   }

@@ -39,6 +39,7 @@ std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
 
 LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
                              const std::vector<dev::Material>& materials,
+                             const std::vector<double>& texture_means,
                              const glm::vec3& background, const Bounds& bounds) {
   LightTable table;
   std::vector<double> power;
@@ -46,7 +47,8 @@ LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
     const dev::Triangle& t = triangles[i];
     const dev::Material& m = materials[t.material];
     double lum = luminance(m.emission);
-    if (!(lum > 0.0)) continue;
+    if (m.emission_texture != NO_TEXTURE) lum *= texture_means.at(size_t(m.emission_texture));
+    if (!(lum > 0.0)) continue;  // includes emissive textures that are black throughout
     glm::vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]),
         v2(t.v2[0], t.v2[1], t.v2[2]);
     double area = 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0));

@@ -90,7 +90,8 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   auto bvh_start = Clock::now();
   Bvh bvh = build_bvh(scene.triangles);
   std::vector<dev::Triangle> tris = bvh_ordered_triangles(scene.triangles, bvh);
-  LightTable table = build_light_table(tris, scene.materials, scene.background, scene.bounds());
+  LightTable table = build_light_table(tris, scene.materials, scene.texture_mean_luminance(),
+                                       scene.background, scene.bounds());
   bvh_build_seconds_ = seconds_since(bvh_start);
   triangles_ = tris.size();
   num_lights_ = table.lights.size();

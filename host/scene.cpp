@@ -15,9 +15,29 @@ Bounds Scene::bounds() const {
   return b;
 }
 
+std::vector<double> Scene::texture_mean_luminance() const {
+  std::vector<double> means;
+  auto decode = [](uint8_t v, bool srgb) {
+    double c = v / 255.0;
+    return srgb ? (c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4)) : c;
+  };
+  for (const auto& t : textures) {
+    bool srgb = t.flags & TEXTURE_SRGB;
+    size_t n = size_t(t.width) * t.height;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const uint8_t* c = &texels[4 * (size_t(t.offset) + i)];
+      sum += 0.2126 * decode(c[0], srgb) + 0.7152 * decode(c[1], srgb) + 0.0722 * decode(c[2], srgb);
+    }
+    means.push_back(n ? sum / n : 0.0);
+  }
+  return means;
+}
+
 SceneFeatures Scene::features() const {
   SceneFeatures f;
-  for (const auto& m : materials) f.textures |= m.base_color_texture != NO_TEXTURE;
+  for (const auto& m : materials)
+    f.textures |= m.base_color_texture != NO_TEXTURE || m.emission_texture != NO_TEXTURE;
   return f;
 }
 

@@ -56,6 +56,8 @@ struct Scene {
   std::vector<std::string> warnings;  // each unsupported feature named once
 
   Bounds bounds() const;
+  // Mean luminance of each texture's texels (sRGB decoded where flagged)
+  std::vector<double> texture_mean_luminance() const;
   SceneFeatures features() const;
   bool has_emission() const;
 };

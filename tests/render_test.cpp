@@ -2,6 +2,8 @@
 // and (when installed) on Mesa's rusticl.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <cmath>
 
 #include "error.hpp"
@@ -163,6 +165,52 @@ TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   double se = std::sqrt(ea.standard_error * ea.standard_error + eb.standard_error * eb.standard_error);
   EXPECT_GT(ea.mean, 0.01);
   EXPECT_NEAR(ea.mean, eb.mean, 4.0 * se) << "nee " << ea.mean << " bsdf " << eb.mean;
+}
+
+// An emissive texture (bright left half, black right half) on a light above a floor:
+// light sampling must look up the texture where it samples, so NEE and BSDF sampling
+// agree block by block (a mirrored lookup would light the wrong side of the floor)
+TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
+  std::string dir = ::testing::TempDir();
+  unsigned char px[6] = {255, 255, 255, 0, 0, 0};
+  auto out = OIIO::ImageOutput::create(dir + "emit.png");
+  ASSERT_TRUE(out && out->open(dir + "emit.png", OIIO::ImageSpec(2, 1, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
+  out->close();
+  const float s = 0.25f, h = 0.3f;
+  std::vector<TestQuad> quads = {
+      {{{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0},
+      {{{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1}};
+  const char* materials = R"([
+    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
+    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
+     "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0},
+     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])";
+  const char* extra = R"({"images": [{"uri": "emit.png"}],
+    "samplers": [{"magFilter": 9729, "wrapS": 33071, "wrapT": 33071}],
+    "textures": [{"source": 0, "sampler": 0}]})";
+  const float eye[3] = {0.0f, 1.2f, 0.01f}, target[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
+  write_quads_gltf(dir + "emissive-texture.gltf", quads, materials, eye, target, 1.2f, bg, extra);
+  Scene scene = load_gltf(dir + "emissive-texture.gltf");
+  ASSERT_NE(scene.materials[1].emission_texture, NO_TEXTURE);
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  settings.max_depth = 2;
+  Film nee = Renderer(pocl_device(), scene, settings).render(0, 128).film;
+  settings.strategy = Strategy::Bsdf;
+  settings.seed = 9;
+  Film bsdf = Renderer(pocl_device(), scene, settings).render(0, 1024).film;
+  double left = 0.0, right = 0.0;
+  for (int by = 0; by < 16; by += 4)
+    for (int bx = 0; bx < 16; bx += 4) {
+      Estimate a = region_mean(nee, 1, bx, bx + 4, by, by + 4);
+      Estimate b = region_mean(bsdf, 1, bx, bx + 4, by, by + 4);
+      double se = std::sqrt(a.standard_error * a.standard_error + b.standard_error * b.standard_error);
+      EXPECT_NEAR(a.mean, b.mean, 4.5 * se + 1e-6) << "block " << bx << "," << by;
+      (bx < 8 ? left : right) += a.mean;
+    }
+  // The camera looks down with +x to the right: the lit half of the floor differs from the dark
+  EXPECT_GT(std::fabs(left - right), 0.2 * (left + right)) << "left " << left << " right " << right;
 }
 
 // A scene too large for the device's biggest buffer fails with a message naming the

@@ -58,7 +58,7 @@ std::string base64(const std::string& in) {
 
 void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quads,
                       const std::string& materials_json, const float eye[3], const float target[3],
-                      float yfov, const float background[3]) {
+                      float yfov, const float background[3], const std::string& extra_json) {
   using nlohmann::json;
   std::string bin;
   json accessors = json::array(), views = json::array(), primitives = json::array();
@@ -76,7 +76,17 @@ void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quad
     bin.append(reinterpret_cast<const char*>(tri), sizeof tri);
     accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", 5126}, {"count", 6},
                          {"type", "VEC3"}, {"min", lo}, {"max", hi}});
-    primitives.push_back({{"attributes", {{"POSITION", accessors.size() - 1}}}, {"material", q.material}});
+    const float corner_uv[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    float uv[12];
+    for (int k = 0; k < 6; ++k) {
+      uv[2 * k] = corner_uv[order[k]][0];
+      uv[2 * k + 1] = corner_uv[order[k]][1];
+    }
+    views.push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", sizeof uv}});
+    bin.append(reinterpret_cast<const char*>(uv), sizeof uv);
+    accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", 5126}, {"count", 6}, {"type", "VEC2"}});
+    primitives.push_back({{"attributes", {{"POSITION", accessors.size() - 2}, {"TEXCOORD_0", accessors.size() - 1}}},
+                          {"material", q.material}});
   }
   // Camera rotation taking -z to the viewing direction, +y up
   glm::vec3 f = glm::normalize(glm::vec3(target[0], target[1], target[2]) - glm::vec3(eye[0], eye[1], eye[2]));
@@ -95,6 +105,8 @@ void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quad
                 {{"camera", 0}, {"translation", {eye[0], eye[1], eye[2]}}, {"rotation", {rot.x, rot.y, rot.z, rot.w}}}};
   j["scenes"] = {{{"nodes", {0, 1}}, {"extras", {{"candela", {{"background", {background[0], background[1], background[2]}}}}}}}};
   j["scene"] = 0;
+  json extra = json::parse(extra_json);
+  for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
   std::ofstream(path) << j.dump();
 }
 

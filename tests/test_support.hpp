@@ -44,10 +44,12 @@ struct TestQuad {
   int material;
 };
 
-// Writes a self-contained .gltf with the quads, the given materials (a JSON array text),
-// a perspective camera at `eye` looking at `target`, and a scene background
+// Writes a self-contained .gltf with the quads (TEXCOORD_0 (0,1) (1,1) (1,0) (0,0) at
+// p0..p3), the given materials (a JSON array text), a perspective camera at `eye`
+// looking at `target`, a scene background, and the top-level members of `extra_json`
+// (e.g. images, textures, samplers)
 void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quads,
                       const std::string& materials_json, const float eye[3], const float target[3],
-                      float yfov, const float background[3]);
+                      float yfov, const float background[3], const std::string& extra_json = "{}");
 
 }  // namespace candela::test
