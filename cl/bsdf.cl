@@ -7,10 +7,12 @@ typedef struct {
   float3 base_color;
 } Bsdf;
 
-Bsdf bsdf_at(__global const Material* m, const TextureSet* textures, float2 uv) {
+// glTF base color: factor x texture x COLOR_0
+Bsdf bsdf_at(__global const Material* m, const TextureSet* textures, const SurfaceHit* s) {
   Bsdf b;
   b.type = m->type;
-  b.base_color = load3(m->base_color) * textures_lookup(textures, m->base_color_texture, uv).xyz;
+  b.base_color = load3(m->base_color) *
+                 textures_lookup(textures, m->base_color_texture, s->uv).xyz * s->vertex_color;
   return b;
 }
 

@@ -59,6 +59,14 @@ typedef struct {
   float pad0;
 } TriangleShading;
 
+// Vertex colors (glTF COLOR_0, linear RGB) of one triangle, 48 bytes; uploaded only for
+// scenes that have them (CD_FEATURE_VERTEX_COLORS).
+typedef struct {
+  float c0[4];
+  float c1[4];
+  float c2[4];
+} TriangleColors;
+
 // Material, 64 bytes. Colours are linear RGB.
 typedef struct {
   unsigned int type;  // MATERIAL_*

@@ -8,6 +8,7 @@ typedef struct {
   __global const BvhNode* nodes;
   __global const Triangle* tris;
   __global const TriangleShading* shading;
+  __global const TriangleColors* colors;
   __global const Material* materials;
   TextureSet textures;
   __global const Light* lights;
@@ -55,13 +56,13 @@ float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
       if (counts_emission) radiance += beta * load3(params->background);
       break;
     }
-    SurfaceHit s = surface_at(sc->tris, sc->shading, hit, ray.dir);
+    SurfaceHit s = surface_at(sc->tris, sc->shading, sc->colors, hit, ray.dir);
     __global const Material* m = &sc->materials[s.material];
     if (counts_emission) radiance += beta * surface_emission(m, s.front, &sc->textures, s.uv);
     if (depth >= params->max_depth) break;
 
     float3 wo = -ray.dir;
-    Bsdf bsdf = bsdf_at(m, &sc->textures, s.uv);
+    Bsdf bsdf = bsdf_at(m, &sc->textures, &s);
     if (nee) radiance += beta * path_direct_light(sc, &s, &bsdf, wo, rng);
 
     // Continue the path by sampling the BSDF
@@ -85,6 +86,7 @@ float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
 
 __kernel void render_paths(__global const BvhNode* nodes, __global const Triangle* tris,
                            __global const TriangleShading* shading,
+                           __global const TriangleColors* colors,
                            __global const Material* materials,
                            __global const TextureInfo* textures, __global const uchar4* texels,
                            __global const float* srgb_to_linear,
@@ -97,6 +99,7 @@ __kernel void render_paths(__global const BvhNode* nodes, __global const Triangl
   SceneData sc = {nodes,
                   tris,
                   shading,
+                  colors,
                   materials,
                   {textures, texels, srgb_to_linear},
                   lights,

@@ -1,10 +1,15 @@
 // Surface data at a ray hit.
 
+#ifndef CD_FEATURE_VERTEX_COLORS
+#define CD_FEATURE_VERTEX_COLORS 1
+#endif
+
 typedef struct {
   float3 p;
   float3 ng;  // geometric normal, turned to the side the ray came from
   float3 ns;  // shading normal, on the same side as ng
   float2 uv;
+  float3 vertex_color;  // COLOR_0, white without CD_FEATURE_VERTEX_COLORS
   uint material;
   bool front;  // the ray hit the front face (counter-clockwise winding)
 } SurfaceHit;
@@ -16,7 +21,7 @@ float2 surface_uv(__global const TriangleShading* sh, float b1, float b2) {
 }
 
 SurfaceHit surface_at(__global const Triangle* tris, __global const TriangleShading* shading,
-                      Hit hit, float3 ray_dir) {
+                      __global const TriangleColors* colors, Hit hit, float3 ray_dir) {
   __global const Triangle* tri = &tris[hit.tri];
   __global const TriangleShading* sh = &shading[tri->prim];
   float3 v0 = load3(tri->v0), v1 = load3(tri->v1), v2 = load3(tri->v2);
@@ -31,6 +36,12 @@ SurfaceHit surface_at(__global const Triangle* tris, __global const TriangleShad
   s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
   s.uv = surface_uv(sh, hit.b1, hit.b2);
+#if CD_FEATURE_VERTEX_COLORS
+  __global const TriangleColors* c = &colors[tri->prim];
+  s.vertex_color = b0 * load3(c->c0) + hit.b1 * load3(c->c1) + hit.b2 * load3(c->c2);
+#else
+  s.vertex_color = (float3)(1.0f);
+#endif
   s.material = tri->material;
   return s;
 }

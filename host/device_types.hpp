@@ -25,6 +25,7 @@ static_assert(sizeof(TriangleShading) == 64);
 static_assert(offsetof(TriangleShading, uv0_u) == 12 && offsetof(TriangleShading, n1) == 16);
 static_assert(offsetof(TriangleShading, uv2_v) == 56);
 
+static_assert(sizeof(TriangleColors) == 48 && offsetof(TriangleColors, c2) == 32);
 static_assert(sizeof(Material) == 64);
 static_assert(offsetof(Material, base_color) == 16 && offsetof(Material, emission) == 32);
 static_assert(offsetof(Material, params) == 48 && offsetof(Material, emission_texture) == 12);

@@ -451,8 +451,6 @@ class Loader {
         warn_.add("Draco-compressed primitives (KHR_draco_mesh_compression) are not supported: they are skipped");
         continue;
       }
-      if (prim.attributes.count("COLOR_0"))
-        warn_.add("vertex colors (COLOR_0) are not supported yet and are ignored");
       auto pos_it = prim.attributes.find("POSITION");
       if (pos_it == prim.attributes.end()) {
         warn_.add("a primitive without POSITION was skipped");
@@ -470,6 +468,16 @@ class Loader {
       std::string uv_name = "TEXCOORD_" + std::to_string(uv_set.texcoord);
       if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end())
         uv = read_accessor(model_, it->second, 2);
+      // COLOR_0: RGB or RGBA (alpha unused while surfaces are opaque), linear
+      std::vector<float> col;
+      int col_comps = 0;
+      if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
+        col = read_accessor(model_, it->second, 0);
+        col_comps = tinygltf::GetNumComponentsInType(model_.accessors[it->second].type);
+        if (col_comps != 3 && col_comps != 4) throw Error("glTF COLOR_0 must be VEC3 or VEC4");
+        if (col.size() / col_comps != nverts)
+          throw Error("glTF primitive attributes have different vertex counts");
+      }
       if ((!nrm.empty() && nrm.size() != pos.size()) || (!uv.empty() && uv.size() / 2 != nverts))
         throw Error("glTF primitive attributes have different vertex counts");
 
@@ -493,6 +501,10 @@ class Loader {
                                : normal_matrix * glm::vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
           float nl = glm::length(t.n[k]);
           t.n[k] = nl > 0.0f && std::isfinite(nl) ? t.n[k] / nl : glm::vec3(0.0f);
+          if (!col.empty()) {
+            t.color[k] = glm::vec3(col[col_comps * v], col[col_comps * v + 1], col[col_comps * v + 2]);
+            if (t.color[k] != glm::vec3(1.0f)) scene_->has_vertex_colors = true;
+          }
           t.uv[k] = uv.empty() ? glm::vec2(0.0f)
                                : glm::vec2(uv_set.transform * glm::vec3(uv[2 * v], uv[2 * v + 1], 1.0f));
         }

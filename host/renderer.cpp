@@ -40,6 +40,17 @@ std::vector<dev::TriangleShading> shading_data(const std::vector<SceneTriangle>&
   return out;
 }
 
+std::vector<dev::TriangleColors> color_data(const std::vector<SceneTriangle>& tris) {
+  std::vector<dev::TriangleColors> out(tris.size());
+  for (size_t i = 0; i < tris.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      out[i].c0[a] = tris[i].color[0][a];
+      out[i].c1[a] = tris[i].color[1][a];
+      out[i].c2[a] = tris[i].color[2][a];
+    }
+  return out;
+}
+
 // sRGB 8-bit code to linear value (IEC 61966-2-1), for texture decoding in the kernel
 std::vector<float> srgb_decode_table() {
   std::vector<float> t(256);
@@ -112,6 +123,9 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   nodes_ = upload(context_, device_, bvh.nodes, "the BVH");
   tris_ = upload(context_, device_, tris, "triangles");
   shading_ = upload(context_, device_, shading_data(scene.triangles), "vertex normals and UVs");
+  colors_ = upload(context_, device_, scene.has_vertex_colors ? color_data(scene.triangles)
+                                                              : std::vector<dev::TriangleColors>(),
+                   "vertex colors");
   materials_ = upload(context_, device_, scene.materials, "materials");
   textures_ = upload(context_, device_, scene.textures, "texture descriptors");
   texels_ = upload(context_, device_, scene.texels, "textures");
@@ -138,7 +152,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
     queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
     queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
     int arg = 0;
-    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &materials_, &textures_, &texels_, &srgb_table_, &lights_,
+    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &colors_, &materials_, &textures_, &texels_, &srgb_table_, &lights_,
                           &light_thresholds_, &params_, &film_mean_, &film_m2_})
       kernel_.setArg(arg++, *b);
     queue_.finish();

@@ -71,7 +71,7 @@ class Renderer {
   cl::Context context_;
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
-  cl::Buffer nodes_, tris_, shading_, materials_, textures_, texels_, srgb_table_, lights_,
+  cl::Buffer nodes_, tris_, shading_, colors_, materials_, textures_, texels_, srgb_table_, lights_,
       light_thresholds_;
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};

@@ -5,7 +5,8 @@
 namespace candela {
 
 std::string SceneFeatures::build_options() const {
-  return std::string("-DCD_FEATURE_TEXTURES=") + (textures ? "1" : "0");
+  return std::string("-DCD_FEATURE_TEXTURES=") + (textures ? "1" : "0") +
+         " -DCD_FEATURE_VERTEX_COLORS=" + (vertex_colors ? "1" : "0");
 }
 
 Bounds Scene::bounds() const {
@@ -36,6 +37,7 @@ std::vector<double> Scene::texture_mean_luminance() const {
 
 SceneFeatures Scene::features() const {
   SceneFeatures f;
+  f.vertex_colors = has_vertex_colors;
   for (const auto& m : materials)
     f.textures |= m.base_color_texture != NO_TEXTURE || m.emission_texture != NO_TEXTURE;
   return f;

@@ -14,6 +14,7 @@ struct SceneTriangle {
   glm::vec3 p[3];
   glm::vec3 n[3];  // zero: use the flat geometric normal
   glm::vec2 uv[3];
+  glm::vec3 color[3] = {glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(1.0f)};  // COLOR_0
   uint32_t material = 0;
 };
 
@@ -43,6 +44,7 @@ struct Bounds {
 // Coarse scene features that select kernel code at build time (part of the cache key)
 struct SceneFeatures {
   bool textures = false;
+  bool vertex_colors = false;
   std::string build_options() const;
 };
 
@@ -51,6 +53,7 @@ struct Scene {
   std::vector<dev::Material> materials;
   std::vector<dev::TextureInfo> textures;
   std::vector<uint8_t> texels;  // RGBA8, 4 bytes per texel (TextureInfo::flags: encoding)
+  bool has_vertex_colors = false;  // some triangle's colors are not white
   std::optional<CameraDesc> camera;
   glm::vec3 background{0.0f};
   std::vector<std::string> warnings;  // each unsupported feature named once

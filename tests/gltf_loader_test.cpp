@@ -161,6 +161,45 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
   EXPECT_NEAR(uv.y, -2.0f, 1e-5f);
 }
 
+// COLOR_0 (normalized unsigned bytes, RGBA) multiplies the base color: a white-lit quad
+// with red corners on the left and blue on the right shows those colours, blended across
+TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
+  TempDir dir;
+  json j = quad_gltf();
+  // vertices: 0 (-1,-1) 1 (1,-1) 2 (1,1) 3 (-1,1)
+  std::string colors = {'\xff', 0, 0, '\xff', 0, 0, '\xff', '\xff', 0, 0, '\xff', '\xff', '\xff', 0, 0, '\xff'};
+  j["buffers"].push_back({{"byteLength", colors.size()}, {"uri", "data:application/octet-stream;base64," + base64(colors)}});
+  j["bufferViews"].push_back({{"buffer", 1}, {"byteLength", colors.size()}});
+  j["accessors"].push_back({{"bufferView", 3}, {"componentType", 5121}, {"normalized", true}, {"count", 4}, {"type", "VEC4"}});
+  j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 3;
+  j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 1};
+  j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.01}}}}};
+  j["nodes"].push_back({{"camera", 0}, {"translation", {0, 0, 3}}});
+  j["scenes"][0]["nodes"] = {0, 1};
+  j["scenes"][0]["extras"] = {{"candela", {{"background", {1, 1, 1}}}}};
+  Scene s = load_gltf(dir.write("colors.gltf", j.dump()));
+  ASSERT_TRUE(s.has_vertex_colors);
+  EXPECT_TRUE(s.features().vertex_colors);
+  EXPECT_FLOAT_EQ(s.triangles[0].color[0].x, 1.0f);
+  EXPECT_FLOAT_EQ(s.triangles[0].color[1].z, 1.0f);
+
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  settings.max_depth = 2;
+  Film f = Renderer(pocl_device(), s, settings).render(0, 16).film;
+  // Radiance equals the albedo (white background of 1, nothing else to see): the
+  // colour at screen x is the linear blend of red (x = -1) and blue (x = +1)
+  double half_width = 3.0 * std::tan(0.25);
+  for (int x : {1, 8, 14}) {
+    glm::vec3 c = f.pixel(size_t(8) * 16 + x);
+    double world_x = ((x + 0.5) / 16.0 * 2.0 - 1.0) * half_width;
+    double t = 0.5 * (world_x + 1.0);
+    EXPECT_NEAR(c.x, 1.0 - t, 0.05) << "pixel " << x;
+    EXPECT_NEAR(c.z, t, 0.05) << "pixel " << x;
+    EXPECT_NEAR(c.y, 0.0, 1e-6);
+  }
+}
+
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf();
