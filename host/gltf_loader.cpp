@@ -473,8 +473,13 @@ class Loader {
       int col_comps = 0;
       if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
         col = read_accessor(model_, it->second, 0);
-        col_comps = tinygltf::GetNumComponentsInType(model_.accessors[it->second].type);
-        if (col_comps != 3 && col_comps != 4) throw Error("glTF COLOR_0 must be VEC3 or VEC4");
+        int type = model_.accessors[it->second].type;
+        if (type != TINYGLTF_TYPE_VEC3 && type != TINYGLTF_TYPE_VEC4)
+          throw Error("glTF COLOR_0 must be VEC3 or VEC4");
+        col_comps = tinygltf::GetNumComponentsInType(type);
+        for (float c : col)
+          if (!(c >= 0.0f && c <= 1.0f))
+            throw Error("glTF COLOR_0 values must lie in [0, 1] (integer colors must be normalized)");
         if (col.size() / col_comps != nverts)
           throw Error("glTF primitive attributes have different vertex counts");
       }

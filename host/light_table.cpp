@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "error.hpp"
+
 namespace candela {
 namespace {
 
@@ -18,6 +20,7 @@ std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
   size_t n = weights.size();
   pmf->assign(n, 0.0);
   if (n == 0) return {};
+  if (n > (uint64_t(1) << 31)) throw Error("too many lights for the light table");
   double total = 0.0;
   for (double w : weights) total += w;
   std::vector<uint32_t> thresholds;

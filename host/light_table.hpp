@@ -20,7 +20,7 @@ std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
                                            std::vector<double>* pmf);
 
 // `triangles` in BVH order (Light::index refers to them); an emissive texture scales
-// a light's power by its mean luminance (texture_means from Scene::texture_mean_luminance)
+// a light's power by its mean luminance (texture_means from Scene::emission_texture_means)
 LightTable build_light_table(const std::vector<dev::Triangle>& triangles,
                              const std::vector<dev::Material>& materials,
                              const std::vector<double>& texture_means,

@@ -101,7 +101,7 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   auto bvh_start = Clock::now();
   Bvh bvh = build_bvh(scene.triangles);
   std::vector<dev::Triangle> tris = bvh_ordered_triangles(scene.triangles, bvh);
-  LightTable table = build_light_table(tris, scene.materials, scene.texture_mean_luminance(),
+  LightTable table = build_light_table(tris, scene.materials, scene.emission_texture_means(),
                                        scene.background, scene.bounds());
   bvh_build_seconds_ = seconds_since(bvh_start);
   triangles_ = tris.size();
@@ -194,13 +194,15 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
   // each sized to take about launch_seconds (GPU watchdogs, progress, Ctrl-C)
   uint32_t batch = 1;
   size_t chunk = std::min(pixels, std::max<size_t>(local_size_, 4096));
-  double cost = 0.0;  // seconds per pixel sample, from the last launch
+  double cost = 0.0;  // seconds per pixel sample, from the last launch (sizes chunks)
   auto out_of_time = [&] { return spp == 0 && seconds_since(start) >= time_limit; };
   while (p.spp_done < limit && !result.interrupted) {
     batch = std::min(batch, limit - p.spp_done);
+    double pass_seconds = 0.0;
     for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
       bool stopped = stop && stop();
-      if (stopped || (begin > 0 && out_of_time())) {
+      // A time limit ends a pass early only once a whole pass exists to show
+      if (stopped || (begin > 0 && p.spp_done > 0 && out_of_time())) {
         // Pixels before `begin` keep one batch more than the others (exact per-pixel
         // counts live in the film)
         result.interrupted = stopped;
@@ -210,7 +212,9 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
       end = std::min(pixels, begin + chunk);
       auto t0 = Clock::now();
       launch(sample_begin + p.spp_done, batch, begin, end);
-      cost = seconds_since(t0) / (double(end - begin) * batch);
+      double dt = seconds_since(t0);
+      pass_seconds += dt;
+      cost = dt / (double(end - begin) * batch);
       size_t want = size_t(settings_.launch_seconds / std::max(cost * batch, 1e-12));
       chunk = std::clamp((want + local_size_ - 1) / local_size_ * local_size_,
                          std::min(local_size_, pixels), pixels);
@@ -227,7 +231,7 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
     if (progress) progress(p);
     if (out_of_time()) break;
     // Next pass: whole-image launches of several samples once one sample is cheap enough
-    double pass = cost * double(pixels);
+    double pass = pass_seconds / batch;  // one sample of the whole image
     double want = settings_.launch_seconds / std::max(pass, 1e-12);
     batch = uint32_t(std::clamp(want, 1.0, std::min(2.0 * batch, 4096.0)));
     if (spp == 0) batch = uint32_t(std::clamp((time_limit - p.seconds) / std::max(pass, 1e-12), 1.0, double(batch)));

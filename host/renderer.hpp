@@ -50,7 +50,9 @@ class Renderer {
 
   // Renders sample indices [sample_begin, sample_begin + spp) of every pixel, or for
   // time_limit seconds when spp == 0. `stop` is polled between launches; a stopped
-  // render keeps the samples already done.
+  // render keeps the samples already done. After a result with partial_pass, some
+  // pixels already hold sample indices from sample_begin + result.spp on: do not
+  // resume that film from there.
   RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
                       const std::function<void(const RenderProgress&)>& progress = {},
                       const std::function<bool()>& stop = {});

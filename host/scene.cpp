@@ -16,13 +16,21 @@ Bounds Scene::bounds() const {
   return b;
 }
 
-std::vector<double> Scene::texture_mean_luminance() const {
+std::vector<double> Scene::emission_texture_means() const {
+  std::vector<bool> emissive(textures.size(), false);
+  for (const auto& m : materials)
+    if (m.emission_texture != NO_TEXTURE) emissive[size_t(m.emission_texture)] = true;
   std::vector<double> means;
   auto decode = [](uint8_t v, bool srgb) {
     double c = v / 255.0;
     return srgb ? (c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4)) : c;
   };
-  for (const auto& t : textures) {
+  for (size_t k = 0; k < textures.size(); ++k) {
+    const dev::TextureInfo& t = textures[k];
+    if (!emissive[k]) {
+      means.push_back(0.0);
+      continue;
+    }
     bool srgb = t.flags & TEXTURE_SRGB;
     size_t n = size_t(t.width) * t.height;
     double sum = 0.0;
@@ -44,8 +52,12 @@ SceneFeatures Scene::features() const {
 }
 
 bool Scene::has_emission() const {
-  for (const auto& m : materials)
-    if (m.emission[0] > 0.0f || m.emission[1] > 0.0f || m.emission[2] > 0.0f) return true;
+  std::vector<double> means = emission_texture_means();
+  for (const auto& m : materials) {
+    bool factor = m.emission[0] > 0.0f || m.emission[1] > 0.0f || m.emission[2] > 0.0f;
+    if (factor && (m.emission_texture == NO_TEXTURE || means[size_t(m.emission_texture)] > 0.0))
+      return true;
+  }
   return false;
 }
 

@@ -59,8 +59,9 @@ struct Scene {
   std::vector<std::string> warnings;  // each unsupported feature named once
 
   Bounds bounds() const;
-  // Mean luminance of each texture's texels (sRGB decoded where flagged)
-  std::vector<double> texture_mean_luminance() const;
+  // Mean luminance (sRGB decoded where flagged) of each texture used as an emissive
+  // texture; 0 for the others, which are not read
+  std::vector<double> emission_texture_means() const;
   SceneFeatures features() const;
   bool has_emission() const;
 };

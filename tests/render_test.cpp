@@ -213,6 +213,19 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   EXPECT_GT(std::fabs(left - right), 0.2 * (left + right)) << "left " << left << " right " << right;
 }
 
+// A time limit shorter than one pass still completes the first pass, so there is always
+// an image with every pixel sampled
+TEST(Render, TimeLimitShorterThanOnePassStillRendersOneSample) {
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderSettings settings;
+  settings.width = settings.height = 32;
+  settings.launch_seconds = 1e-9;  // one work-group of pixels per launch
+  RenderResult r = Renderer(pocl_device(), scene, settings).render(0, 0, 1e-9);
+  EXPECT_EQ(r.spp, 1u);
+  EXPECT_FALSE(r.partial_pass);
+  for (size_t i = 0; i < r.film.pixels(); ++i) ASSERT_EQ(r.film.samples(i), 1.0f) << "pixel " << i;
+}
+
 // A scene too large for the device's biggest buffer fails with a message naming the
 // buffer and both sizes, before anything is launched
 TEST(Render, BufferLargerThanTheDeviceAllowsIsAClearError) {
