@@ -1,6 +1,5 @@
 #include "film.hpp"
 
-#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -84,21 +83,6 @@ void write_image(const std::string& path, const Film& film,
   bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
   ok = out->close() && ok;
   if (!ok) throw Error("cannot write " + path + ": " + out->geterror());
-}
-
-std::vector<float> read_exr_rgb(const std::string& path, int* width, int* height,
-                                std::map<std::string, std::string>* metadata) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error("cannot read " + path + ": " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  *width = spec.width;
-  *height = spec.height;
-  std::vector<float> rgb(size_t(spec.width) * spec.height * 3);
-  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, rgb.data()))
-    throw Error("cannot read " + path + ": " + in->geterror());
-  if (metadata)
-    for (const auto& p : spec.extra_attribs) (*metadata)[p.name().string()] = p.get_string();
-  return rgb;
 }
 
 }  // namespace candela

@@ -36,8 +36,4 @@ void check_output_path(const std::string& path);
 void write_image(const std::string& path, const Film& film,
                  const std::map<std::string, std::string>& metadata, float exposure = 0.0f);
 
-// Linear RGB float image read back from an EXR, for tests and tools
-std::vector<float> read_exr_rgb(const std::string& path, int* width, int* height,
-                                std::map<std::string, std::string>* metadata = nullptr);
-
 }  // namespace candela

@@ -113,8 +113,8 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
-  build_options_ = "-cl-std=CL1.2 " + scene.features().build_options();
-  ProgramBuild build = build_program(context_, device_, renderer_program_source(), build_options_);
+  std::string options = "-cl-std=CL1.2 " + scene.features().build_options();
+  ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");

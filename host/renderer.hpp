@@ -63,7 +63,6 @@ class Renderer {
   size_t triangles() const { return triangles_; }
   size_t lights() const { return num_lights_; }
   const DeviceEntry& device() const { return device_; }
-  std::string build_options() const { return build_options_; }
 
  private:
   void launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end);
@@ -78,7 +77,6 @@ class Renderer {
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
-  std::string build_options_;
   double kernel_build_seconds_ = 0.0, bvh_build_seconds_ = 0.0;
   bool kernel_from_cache_ = false;
   size_t triangles_ = 0, num_lights_ = 0;
