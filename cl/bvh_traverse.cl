@@ -1,4 +1,6 @@
 // BVH traversal: a short stack, nearer child first, any-hit early exit for shadow rays.
+// The node and leaf layout (BvhNode, BvhTriangle) is private to this file and
+// host/bvh_builder.cpp; everything else sees hits by stable primitive index.
 
 #define BVH_STACK_SIZE 64
 
@@ -11,6 +13,17 @@ float max4_f(float a, float b, float c, float d) {
 float min4_f(float a, float b, float c, float d) {
   float ab = a < b ? a : b, cd = c < d ? c : d;
   return ab < cd ? ab : cd;
+}
+
+bool bvh_leaf_triangle_hit(const WatertightRay* r, __global const BvhTriangle* tri, float tmax,
+                           float* t, float* b1, float* b2) {
+  return intersect_triangle(r, load3(tri->v0), load3(tri->v1), load3(tri->v2), tmax, t, b1, b2);
+}
+
+// Leaf position of a hit to its stable primitive index
+Hit bvh_hit_to_prim(Hit hit, __global const BvhTriangle* tris) {
+  if (hit.prim >= 0) hit.prim = (int)tris[hit.prim].prim;
+  return hit;
 }
 
 // Slab test; returns the entry distance or INFINITY on a miss
@@ -35,11 +48,11 @@ float3 safe_inverse(float3 d) {
 }
 
 // Closest hit in (0, tmax), or with any_hit the first hit found.
-Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, Ray ray,
+Hit bvh_intersect(__global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
                   float tmax, bool any_hit) {
   Hit hit;
   hit.t = tmax;
-  hit.tri = -1;
+  hit.prim = -1;
   hit.b1 = hit.b2 = 0.0f;
   WatertightRay wr = watertight_ray(ray);
   float3 inv_dir = safe_inverse(ray.dir);
@@ -55,12 +68,12 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
       int end = node->left - node->right;
       for (int i = node->left; i < end; ++i) {
         float t, b1, b2;
-        if (intersect_triangle_at(&wr, &tris[i], hit.t, &t, &b1, &b2)) {
+        if (bvh_leaf_triangle_hit(&wr, &tris[i], hit.t, &t, &b1, &b2)) {
           hit.t = t;
           hit.b1 = b1;
           hit.b2 = b2;
-          hit.tri = i;
-          if (any_hit) return hit;
+          hit.prim = i;  // leaf position until the end
+          if (any_hit) return bvh_hit_to_prim(hit, tris);
         }
       }
     } else {
@@ -79,13 +92,13 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const Triangle* tris, 
     }
     // Pop, skipping nodes that start beyond the closest hit found since the push
     do {
-      if (sp == 0) return hit;
+      if (sp == 0) return bvh_hit_to_prim(hit, tris);
       index = stack[--sp];
     } while (stack_entry[sp] > hit.t);
   }
 }
 
-bool bvh_occluded(__global const BvhNode* nodes, __global const Triangle* tris, Ray ray,
+bool bvh_occluded(__global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
                   float tmax) {
-  return bvh_intersect(nodes, tris, ray, tmax, true).tri >= 0;
+  return bvh_intersect(nodes, tris, ray, tmax, true).prim >= 0;
 }

@@ -1,4 +1,4 @@
-// Pinhole camera with a box pixel filter.
+// Pinhole camera. (The box pixel filter is the integrator's uniform jitter within a pixel.)
 
 // (px, py) continuous pixel coordinates, (0, 0) at the top-left of the image
 Ray camera_ray(const __global RenderParams* params, float px, float py) {

@@ -1,6 +1,7 @@
 // Structs that cross between host and device, defined once.
 // Included by the OpenCL program (first in the source list) and by the host inside
-// namespace candela::dev (host/device_types.hpp), which static_asserts every layout.
+// namespace candela::dev (host/device_types.hpp), which static_asserts every layout from
+// CD_LAYOUT below; the device-side layout test checks the same list on each device.
 // Only 4-byte scalars and arrays of them: no float3, no vector types, explicit padding.
 
 #ifndef CANDELA_DEVICE_TYPES_H
@@ -9,93 +10,105 @@
 // Material types (switch-dispatched in bsdf.cl)
 #define MATERIAL_DIFFUSE 0u
 
-// Light types (light-selection table in lights.cl)
-#define LIGHT_TRIANGLE 0u
-#define LIGHT_BACKGROUND 1u
+// Light types (lights.cl)
+#define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
+#define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away (constant for now)
 
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
 #define STRATEGY_BSDF 1u
 
-// Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15)
-// and colour encoding
+// Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
+// colour encoding and texel storage
 #define WRAP_REPEAT 0u
 #define WRAP_CLAMP 1u
 #define WRAP_MIRROR 2u
-#define TEXTURE_SRGB 0x10000u
+#define TEXTURE_SRGB 0x10000u  // RGBA8 texels hold sRGB-encoded colour (alpha linear)
+#define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
 
 #define NO_TEXTURE (-1)
+#define NO_LIGHT (-1)
+#define NO_MEDIUM (-1)
 
-// BVH node, 32 bytes. Interior: count == 0, children at `left` and `right`.
-// Leaf: count > 0 triangles starting at `first` (left == first).
+// BVH node, 32 bytes; its encoding is private to bvh_builder.cpp and bvh_traverse.cl.
 typedef struct {
   float bmin[3];
-  int left;  // interior: left child; leaf: first triangle
+  int left;  // interior: index of the left child; leaf: first BvhTriangle
   float bmax[3];
-  int right;  // interior: right child; leaf: -(triangle count)
+  int right;  // interior: index of the right child; leaf: -(triangle count)
 } BvhNode;
 
-// Triangle positions in BVH order, 48 bytes.
+// A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
 typedef struct {
   float v0[3];
-  unsigned int material;
+  unsigned int prim;  // stable primitive index (Prim array)
   float v1[3];
-  unsigned int prim;  // index into TriangleShading (original order)
-  float v2[3];
   unsigned int pad0;
-} Triangle;
+  float v2[3];
+  unsigned int pad1;
+} BvhTriangle;
 
-// Per-vertex shading data of one triangle, 64 bytes.
+// A triangle of the scene in its stable primitive order, 16 bytes: vertex indices into
+// the per-vertex arrays (positions, normals, uv0, uv1, tangents, colors) and a material.
 typedef struct {
-  float n0[3];
-  float uv0_u;
-  float n1[3];
-  float uv0_v;
-  float n2[3];
-  float uv1_u;
-  float uv1_v;
-  float uv2_u;
-  float uv2_v;
-  float pad0;
-} TriangleShading;
+  unsigned int v[3];
+  unsigned int material;
+} Prim;
 
-// Vertex colors (glTF COLOR_0, linear RGB) of one triangle, 48 bytes; uploaded only for
-// scenes that have them (CD_FEATURE_VERTEX_COLORS).
+// One texture slot of a material, 32 bytes: which texture, which TEXCOORD_n, and the
+// KHR_texture_transform applied in the kernel: uv' = (m[0] u + m[1] v + m[2],
+// m[3] u + m[4] v + m[5]).
 typedef struct {
-  float c0[4];
-  float c1[4];
-  float c2[4];
-} TriangleColors;
+  int index;  // into TextureInfo, or NO_TEXTURE
+  unsigned int texcoord;  // 0 or 1
+  float m[6];
+} TextureRef;
 
-// Material, 64 bytes. Colours are linear RGB.
+// Material, 128 bytes. Colours are linear RGB.
 typedef struct {
   unsigned int type;  // MATERIAL_*
-  int base_color_texture;  // index into TextureInfo or NO_TEXTURE
   unsigned int double_sided;
-  int emission_texture;  // index into TextureInfo or NO_TEXTURE; scales `emission`
+  unsigned int pad0;
+  unsigned int pad1;
   float base_color[4];  // rgba factor
   float emission[4];  // rgb radiance (factor x strength), w unused
-  float params[4];  // reserved: roughness, metallic, ior, anisotropy
+  float params[4];  // reserved for the materials issue: roughness, metallic, ior, anisotropy
+  TextureRef base_color_texture;
+  TextureRef emission_texture;  // scales `emission`
 } Material;
 
-// A texture inside the shared texel array (RGBA8 texels), 16 bytes.
+// A texture inside one of the shared texel arrays, 16 bytes.
 typedef struct {
   unsigned int offset;  // first texel
   unsigned int width;
   unsigned int height;
-  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB
+  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB | TEXTURE_FLOAT
 } TextureInfo;
 
-// One entry of the light-selection table, 32 bytes. Light i is selected when a uniform
-// 32-bit integer x satisfies threshold[i-1] <= x < threshold[i] (threshold[n-1] is 2^32,
-// not stored); `pmf` is exactly that probability, so the estimator divides by what the
-// kernel realizes.
+// RGBA8 texel, 4 bytes
+typedef struct {
+  unsigned char r, g, b, a;
+} Texel8;
+
+// Float RGBA texel (HDR images, later grids), 16 bytes
+typedef struct {
+  float rgba[4];
+} TexelF;
+
+// A light, 64 bytes: a type, its selection probability, and the type's parameters.
+// Light i is selected when a uniform 32-bit integer x satisfies
+// threshold[i-1] <= x < threshold[i] (threshold[n-1] = 2^32 is not stored); `pmf` is
+// exactly that probability, so the estimator divides by what the kernel realizes.
+//   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
+//                      radiance comes from the primitive's material.
+//   LIGHT_ENVIRONMENT: radiance = constant radiance.
 typedef struct {
   unsigned int type;  // LIGHT_*
-  unsigned int index;  // LIGHT_TRIANGLE: index into Triangle array
-  float area;  // LIGHT_TRIANGLE: triangle area (world units)
-  float pmf;  // selection probability
-  float radiance[4];  // emitted radiance, rgb
+  float pmf;
+  unsigned int index;
+  unsigned int pad0;
+  float radiance[4];  // rgb
+  float params[8];  // per-type parameters, see above
 } Light;
 
 // Pinhole camera, 64 bytes: ray direction = forward + (2x-1) right + (1-2y) up.
@@ -110,22 +123,67 @@ typedef struct {
   float pad3;
 } Camera;
 
-// Everything one launch needs besides buffers, 128 bytes.
+// Everything one launch needs besides buffers, 112 bytes.
 typedef struct {
   Camera camera;
-  float background[4];  // constant radiance of escaping rays, rgb
   unsigned int width;
   unsigned int height;
   unsigned int seed;
   unsigned int max_depth;  // scattering events; 0 = emission seen directly only
   unsigned int strategy;  // STRATEGY_*
   unsigned int num_lights;
+  int environment_light;  // index of the LIGHT_ENVIRONMENT light, or NO_LIGHT
+  unsigned int rr_depth;  // Russian roulette starts after this many bounces
   unsigned int sample_begin;  // first sample index of this launch
   unsigned int sample_count;  // samples per pixel in this launch
-  unsigned int rr_depth;  // Russian roulette starts after this many bounces
   unsigned int pixel_begin;  // first pixel of this launch (row-major)
   unsigned int pixel_end;  // one past the last pixel of this launch
-  unsigned int pad0;
 } RenderParams;
+
+// Every scene buffer, in kernel-argument order: X(element type, name). This one list
+// generates the kernel's parameters and SceneData (cl/scene_data.cl) and the host's
+// SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
+// Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
+// vertex; an array the scene does not need holds one dummy element.
+#define CD_SCENE_BUFFERS(X)  \
+  X(BvhNode, bvh_nodes)      \
+  X(BvhTriangle, bvh_tris)   \
+  X(Prim, prims)             \
+  X(float, positions)        \
+  X(float, normals)          \
+  X(float, uv0)              \
+  X(float, uv1)              \
+  X(float, tangents)         \
+  X(float, colors)           \
+  X(Material, materials)     \
+  X(TextureInfo, textures)   \
+  X(Texel8, texels8)         \
+  X(TexelF, texelsf)         \
+  X(float, srgb_to_linear)   \
+  X(Light, lights)           \
+  X(unsigned int, light_thresholds)
+
+// Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
+// FIELD(type, field, offset). The host static_asserts these; tests/cl checks them on
+// each device.
+#define CD_LAYOUT(SIZE, FIELD)                                                              \
+  SIZE(BvhNode, 32) FIELD(BvhNode, left, 12) FIELD(BvhNode, bmax, 16)                       \
+  FIELD(BvhNode, right, 28)                                                                 \
+  SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16)             \
+  FIELD(BvhTriangle, v2, 32)                                                                \
+  SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
+  SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
+  SIZE(Material, 128) FIELD(Material, base_color, 16) FIELD(Material, emission, 32)         \
+  FIELD(Material, params, 48) FIELD(Material, base_color_texture, 64)                       \
+  FIELD(Material, emission_texture, 96)                                                     \
+  SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
+  SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
+  SIZE(TexelF, 16)                                                                          \
+  SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
+  FIELD(Light, params, 32)                                                                  \
+  SIZE(Camera, 64) FIELD(Camera, forward, 16) FIELD(Camera, right, 32) FIELD(Camera, up, 48) \
+  SIZE(RenderParams, 112) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
+  FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \
+  FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)
 
 #endif  // CANDELA_DEVICE_TYPES_H

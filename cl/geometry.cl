@@ -1,4 +1,4 @@
-// Rays, frames and robust ray offsets.
+// Rays, shading frames, triangle helpers and robust ray offsets.
 
 typedef struct {
   float3 org;
@@ -9,27 +9,57 @@ float3 load3(__global const float* p) { return vload3(0, p); }
 
 float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 
-float luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(float3 c) { return luminance_rgb(c.x, c.y, c.z); }
 
 bool all_finite(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
-// Orthonormal basis around unit n (Duff et al. 2017, Building an Orthonormal Basis, Revisited)
-void frame_from_normal(float3 n, float3* t, float3* b) {
+// Orthonormal frame (t, b, n); local coordinates have z along n
+typedef struct {
+  float3 t, b, n;
+} Frame;
+
+float3 frame_to_local(const Frame* f, float3 v) {
+  return (float3)(dot(v, f->t), dot(v, f->b), dot(v, f->n));
+}
+
+float3 frame_from_local(const Frame* f, float3 v) { return v.x * f->t + v.y * f->b + v.z * f->n; }
+
+// Any frame around unit n (Duff et al. 2017, Building an Orthonormal Basis, Revisited)
+Frame frame_from_z(float3 n) {
   float sign = n.z >= 0.0f ? 1.0f : -1.0f;
   float a = -1.0f / (sign + n.z);
   float c = n.x * n.y * a;
-  *t = (float3)(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  *b = (float3)(c, sign + n.y * n.y * a, -n.y);
+  Frame f;
+  f.t = (float3)(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  f.b = (float3)(c, sign + n.y * n.y * a, -n.y);
+  f.n = n;
+  return f;
 }
 
-float3 frame_to_world(float3 v, float3 n) {
-  float3 t, b;
-  frame_from_normal(n, &t, &b);
-  return v.x * t + v.y * b + v.z * n;
+// Frame around unit n with t along the part of `tangent` orthogonal to n (Gram-Schmidt);
+// any frame when that part vanishes
+Frame frame_from_z_x(float3 n, float3 tangent) {
+  float3 t = tangent - dot(tangent, n) * n;
+  float len = length(t);
+  if (!(len > 1e-6f * length(tangent)) || !isfinite(len)) return frame_from_z(n);
+  Frame f;
+  f.t = t / len;
+  f.b = cross(n, f.t);
+  f.n = n;
+  return f;
+}
+
+// Unit normal of triangle (v0, v1, v2) by its counter-clockwise winding; *area gets its area
+float3 triangle_normal_area(float3 v0, float3 v1, float3 v2, float* area) {
+  float3 c = cross(v1 - v0, v2 - v0);
+  float len = length(c);
+  *area = 0.5f * len;
+  return c / len;
 }
 
 // Move p off its surface along the geometric normal n by a few ulps, on the side of n
 // (Waechter and Binder 2019, A Fast and Robust Method for Avoiding Self-Intersection).
+// n = 0 (a point in a medium) leaves p where it is.
 float3 offset_ray_origin(float3 p, float3 n) {
   const float origin = 1.0f / 32.0f;
   const float float_scale = 1.0f / 65536.0f;

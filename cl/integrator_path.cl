@@ -1,36 +1,48 @@
-// Megakernel path tracer: one work-item per pixel traces `sample_count` whole paths and
-// folds them into the film with Welford's running mean and squared deviations.
+// Megakernel path tracer: one work-item per pixel traces `sample_count` whole paths, each
+// from a box-filtered (uniformly jittered) point of its pixel, and folds them into the
+// film with Welford's running mean and squared deviations.
 // Strategies (no MIS, each light path counted exactly once):
-//   STRATEGY_NEE:  emission seen by camera rays, all other light through shadow rays
-//   STRATEGY_BSDF: no shadow rays; emission added whenever a sampled ray finds it
+//   STRATEGY_NEE:  emission counted on camera rays and after delta lobes; all other light
+//                  arrives through shadow rays to sampled lights (skipped at delta lobes)
+//   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it
 
+// Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
-  __global const BvhNode* nodes;
-  __global const Triangle* tris;
-  __global const TriangleShading* shading;
-  __global const TriangleColors* colors;
-  __global const Material* materials;
-  TextureSet textures;
-  __global const Light* lights;
-  __global const uint* light_thresholds;
-  __global const RenderParams* params;
-} SceneData;
+  Ray ray;
+  float3 beta;  // throughput
+  float3 radiance;  // light gathered so far
+  uint depth;  // scattering events so far
+  bool specular_bounce;  // the last scattering was a delta lobe: count emission next
+  float eta_scale;  // product of eta^2 over transmissions, so roulette sees radiance scale
+  int medium;  // medium the ray travels in, NO_MEDIUM = vacuum (for the volumes issue)
+} PathState;
 
-// Next-event estimate of light arriving at s and scattered toward wo
-float3 path_direct_light(const SceneData* sc, const SurfaceHit* s, const Bsdf* bsdf, float3 wo,
-                         Rng* rng) {
+PathState path_start(Ray ray) {
+  PathState ps;
+  ps.ray = ray;
+  ps.beta = (float3)(1.0f);
+  ps.radiance = (float3)(0.0f);
+  ps.depth = 0u;
+  ps.specular_bounce = false;
+  ps.eta_scale = 1.0f;
+  ps.medium = NO_MEDIUM;
+  return ps;
+}
+
+// Next-event estimate of light arriving at ctx and scattered by bsdf toward wo
+float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
+                         float3 wo, Rng* rng) {
   uint x_select = rng_next_uint(rng);
   float2 u = (float2)(rng_next(rng), rng_next(rng));
   LightSample ls;
-  if (!lights_sample(sc->lights, sc->light_thresholds, sc->params->num_lights, sc->tris,
-                     sc->shading, sc->materials, &sc->textures, s->p, s->ns, x_select, u, &ls))
-    return (float3)(0.0f);
-  float3 f = bsdf_eval(bsdf, wo, ls.wi, s->ns, s->ng);
-  float cos_i = fabs(dot(ls.wi, s->ns));
+  if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
+  float3 f = bsdf_eval(bsdf, wo, ls.wi);
+  float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
   if (max_component(contrib) <= 0.0f) return (float3)(0.0f);
+  // Shadow ray from the side of the surface that wi leaves from
   Ray shadow;
-  shadow.org = offset_ray_origin(s->p, s->ng);
+  shadow.org = offset_ray_origin(ctx->p, dot(ls.wi, ctx->n) >= 0.0f ? ctx->n : -ctx->n);
   float tmax = INFINITY;
   shadow.dir = ls.wi;
   if (!ls.at_infinity) {
@@ -39,72 +51,65 @@ float3 path_direct_light(const SceneData* sc, const SurfaceHit* s, const Bsdf* b
     if (!(tmax > 0.0f)) return (float3)(0.0f);
     shadow.dir = d / tmax;
   }
-  if (bvh_occluded(sc->nodes, sc->tris, shadow, tmax)) return (float3)(0.0f);
+  if (scene_occluded(sc, shadow, tmax)) return (float3)(0.0f);
   return contrib;
 }
 
-// Radiance along one camera ray
-float3 path_trace(const SceneData* sc, Ray ray, Rng* rng) {
-  __global const RenderParams* params = sc->params;
-  const bool nee = params->strategy == STRATEGY_NEE;
-  float3 radiance = (float3)(0.0f);
-  float3 beta = (float3)(1.0f);
-  for (uint depth = 0u;; ++depth) {
-    Hit hit = bvh_intersect(sc->nodes, sc->tris, ray, INFINITY, false);
-    bool counts_emission = depth == 0u || !nee;
-    if (hit.tri < 0) {
-      if (counts_emission) radiance += beta * load3(params->background);
-      break;
-    }
-    SurfaceHit s = surface_at(sc->tris, sc->shading, sc->colors, hit, ray.dir);
-    __global const Material* m = &sc->materials[s.material];
-    if (counts_emission) radiance += beta * surface_emission(m, s.front, &sc->textures, s.uv);
-    if (depth >= params->max_depth) break;
-
-    float3 wo = -ray.dir;
-    Bsdf bsdf = bsdf_at(m, &sc->textures, &s);
-    if (nee) radiance += beta * path_direct_light(sc, &s, &bsdf, wo, rng);
-
-    // Continue the path by sampling the BSDF
-    float2 u = (float2)(rng_next(rng), rng_next(rng));
-    float3 wi, f;
-    float pdf;
-    if (!bsdf_sample(&bsdf, wo, s.ns, s.ng, u, &wi, &f, &pdf)) break;
-    beta *= f * (fabs(dot(wi, s.ns)) / pdf);
-
-    // Russian roulette on the throughput
-    if (depth + 1u >= params->rr_depth) {
-      float q = fmin(max_component(beta), 0.95f);
-      if (rng_next(rng) >= q) break;
-      beta /= q;
-    }
-    ray.org = offset_ray_origin(s.p, dot(wi, s.ng) > 0.0f ? s.ng : -s.ng);
-    ray.dir = wi;
-  }
-  return radiance;
+// Russian roulette on throughput x eta_scale; false when the path ends
+bool path_survives_roulette(PathState* ps, uint rr_depth, Rng* rng) {
+  if (ps->depth + 1u < rr_depth) return true;
+  float q = fmin(max_component(ps->beta) * ps->eta_scale, 0.95f);
+  if (rng_next(rng) >= q) return false;
+  ps->beta /= q;
+  return true;
 }
 
-__kernel void render_paths(__global const BvhNode* nodes, __global const Triangle* tris,
-                           __global const TriangleShading* shading,
-                           __global const TriangleColors* colors,
-                           __global const Material* materials,
-                           __global const TextureInfo* textures, __global const uchar4* texels,
-                           __global const float* srgb_to_linear,
-                           __global const Light* lights,
-                           __global const uint* light_thresholds,
-                           __global const RenderParams* params, __global float4* film_mean,
-                           __global float4* film_m2) {
+// Radiance along one camera ray
+float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
+  __global const RenderParams* params = sc->params;
+  const bool nee = params->strategy == STRATEGY_NEE;
+  PathState ps = path_start(camera_ray);
+  for (;; ++ps.depth) {
+    Hit hit = scene_intersect(sc, ps.ray, INFINITY);
+    bool counts_emission = ps.depth == 0u || ps.specular_bounce || !nee;
+    if (hit.prim < 0) {
+      if (counts_emission) ps.radiance += ps.beta * lights_environment_radiance(sc, ps.ray.dir);
+      break;
+    }
+    SurfaceHit s = surface_at(sc, (uint)hit.prim, hit.b1, hit.b2, ps.ray.dir);
+    if (counts_emission)
+      ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
+    if (ps.depth >= params->max_depth) break;
+
+    float3 wo = -ps.ray.dir;
+    Bsdf bsdf = bsdf_at(sc, &s);
+    uint flags = bsdf_flags(&bsdf);
+    // Light sampling, except at lobes that are all delta (no light sample can find them)
+    if (nee && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u) {
+      LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, rng);
+    }
+
+    // Continue the path by sampling the BSDF
+    float uc = rng_next(rng);
+    float2 u = (float2)(rng_next(rng), rng_next(rng));
+    BsdfSample bs;
+    if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
+    ps.beta *= bs.f * (fabs(dot(bs.wi, s.ns)) / bs.pdf);
+    ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u;
+    if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
+    if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
+    ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);
+    ps.ray.dir = bs.wi;
+  }
+  return ps.radiance;
+}
+
+__kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
+                           __global float4* film_mean, __global float4* film_m2) {
   uint pixel = params->pixel_begin + (uint)get_global_id(0);
   if (pixel >= params->pixel_end) return;
-  SceneData sc = {nodes,
-                  tris,
-                  shading,
-                  colors,
-                  materials,
-                  {textures, texels, srgb_to_linear},
-                  lights,
-                  light_thresholds,
-                  params};
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   uint px = pixel % params->width, py = pixel / params->width;
 
   // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones

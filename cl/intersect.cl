@@ -8,10 +8,12 @@ typedef struct {
   float3 shear;  // (Sx, Sy, Sz)
 } WatertightRay;
 
+// A ray hit: distance, barycentric weights of the triangle's second and third vertices
+// (the point is (1 - b1 - b2) v0 + b1 v1 + b2 v2), and the stable primitive index
 typedef struct {
   float t;
-  float b1, b2;  // barycentric weights of v1 and v2
-  int tri;  // -1: no hit
+  float b1, b2;
+  int prim;  // -1: no hit
 } Hit;
 
 float3 permute3(float3 v, uint4 perm) { return shuffle((float4)(v, 0.0f), perm).xyz; }
@@ -72,9 +74,4 @@ bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2,
   *b1 = v * inv_det;
   *b2 = w * inv_det;
   return true;
-}
-
-bool intersect_triangle_at(const WatertightRay* r, __global const Triangle* tri, float tmax,
-                           float* t, float* b1, float* b2) {
-  return intersect_triangle(r, load3(tri->v0), load3(tri->v1), load3(tri->v2), tmax, t, b1, b2);
 }

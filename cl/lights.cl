@@ -1,72 +1,143 @@
-// Light sampling through one light-selection table (probability proportional to power).
-// Directions and pdfs are measured from the shading point p; the shadow ray runs from
-// p's offset origin to `target`, which sits off the light's surface on p's side.
+// Light sampling from a context (a surface point, or a point in a medium), through one
+// light-selection table with probabilities proportional to power. Directions and pdfs
+// are measured from ctx.p; a finite light's shadow ray ends at `target`, just off the
+// light's surface on ctx.p's side.
 
 typedef struct {
-  float3 wi;  // unit direction from the shading point toward the light
-  float3 radiance;  // emitted radiance arriving along -wi
-  float pdf;  // solid-angle pdf of wi, including the selection probability
-  bool at_infinity;  // shadow ray along wi without end (the background)
-  float3 target;  // finite lights: the sampled point, moved off the light toward p
+  float3 p;
+  float3 n;  // geometric normal on the side light is gathered from; 0 at a point in a medium
+  float3 ns;  // shading normal on the same side; 0 in a medium
+  bool transmits;  // the BSDF (or phase function) also scatters light arriving from behind n
+} LightSampleContext;
+
+typedef struct {
+  float3 wi;  // unit direction from ctx.p toward the light
+  float3 radiance;  // emitted radiance arriving along -wi (intensity for delta lights)
+  float pdf;  // solid-angle pdf of wi including the selection probability (delta: pmf)
+  bool is_delta;  // a punctual or directional light: no BSDF-sampled ray can hit it
+  bool at_infinity;  // shadow ray along wi without end
+  float3 target;  // finite lights: the sampled point, moved off the light toward ctx.p
 } LightSample;
 
-// Uniform point on an emissive triangle, converted to a solid-angle pdf at p
-bool lights_sample_triangle(__global const Light* light, __global const Triangle* tris,
-                            __global const TriangleShading* shading,
-                            __global const Material* materials, const TextureSet* textures,
-                            float3 p, float2 u, LightSample* ls) {
-  __global const Triangle* tri = &tris[light->index];
-  float3 v0 = load3(tri->v0), v1 = load3(tri->v1), v2 = load3(tri->v2);
-  float2 st = sample_triangle(u.x, u.y);
-  float3 y = st.x * v0 + st.y * v1 + (1.0f - st.x - st.y) * v2;
-  float3 n = normalize(cross(v1 - v0, v2 - v0));
-  float3 d = y - p;
-  float dist2 = dot(d, d);
-  if (!(dist2 > 0.0f)) return false;
-  float dist = sqrt(dist2);
-  ls->wi = d / dist;
-  float cos_light = dot(n, -ls->wi);
-  bool front = cos_light > 0.0f;
-  // y = s v0 + t v1 + (1-s-t) v2: barycentric weights of v1 and v2 are t and 1-s-t
-  float2 uv = surface_uv(&shading[tri->prim], st.y, 1.0f - st.x - st.y);
-  ls->radiance = surface_emission(&materials[tri->material], front, textures, uv);
-  // Area measure to solid angle: dw/dA = cos(theta_y) / r^2
-  ls->pdf = dist2 / (fabs(cos_light) * light->area);
-  ls->at_infinity = false;
-  ls->target = offset_ray_origin(y, front ? n : -n);
-  return fabs(cos_light) > 0.0f && isfinite(ls->pdf);
+LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) {
+  LightSampleContext ctx;
+  ctx.p = s->p;
+  ctx.n = s->ng;
+  ctx.ns = s->ns;
+  ctx.transmits = (bsdf_flags(b) & BSDF_TRANSMISSION) != 0u;
+  return ctx;
 }
 
-// Cosine-weighted direction around the shading normal toward the constant background
-bool lights_sample_background(__global const Light* light, float3 ns, float2 u,
-                              LightSample* ls) {
-  float3 dir_local = sample_cosine_hemisphere(u.x, u.y);
-  ls->wi = frame_to_world(dir_local, ns);
-  ls->pdf = sample_cosine_hemisphere_pdf(dir_local.z);
+// Environment light: radiance arriving along -dir from infinitely far away
+float3 lights_environment_radiance(const SceneData* sc, float3 dir) {
+  int i = sc->params->environment_light;
+  if (i == NO_LIGHT) return (float3)(0.0f);
+  return load3(sc->lights[i].radiance);
+}
+
+// Reflection-only surfaces see the environment over the hemisphere of n (sampled by the
+// cosine to n); points in media and transmissive surfaces over the whole sphere
+bool lights_environment_hemisphere(const LightSampleContext* ctx) {
+  return !ctx->transmits && dot(ctx->n, ctx->n) > 0.0f;
+}
+
+float lights_pdf_environment(const LightSampleContext* ctx, float3 wi) {
+  if (lights_environment_hemisphere(ctx)) return sample_cosine_hemisphere_pdf(dot(wi, ctx->n));
+  return sample_uniform_sphere_pdf();
+}
+
+bool lights_sample_environment(const SceneData* sc, const LightSampleContext* ctx, float2 u,
+                               LightSample* ls) {
+  if (lights_environment_hemisphere(ctx)) {
+    Frame f = frame_from_z(ctx->n);
+    ls->wi = frame_from_local(&f, sample_cosine_hemisphere(u.x, u.y));
+  } else {
+    ls->wi = sample_uniform_sphere(u.x, u.y);
+  }
+  ls->pdf = lights_pdf_environment(ctx, ls->wi);
+  ls->radiance = lights_environment_radiance(sc, ls->wi);
   ls->at_infinity = true;
-  ls->radiance = load3(light->radiance);
   return ls->pdf > 0.0f;
 }
 
-bool lights_sample(__global const Light* lights, __global const uint* light_thresholds,
-                   uint num_lights, __global const Triangle* tris,
-                   __global const TriangleShading* shading, __global const Material* materials,
-                   const TextureSet* textures, float3 p, float3 ns, uint x_select, float2 u,
+// Area measure to solid angle at ctx.p for a point y on a triangle of normal n and area A
+float lights_triangle_solid_angle_pdf(float3 p, float3 y, float3 n, float area) {
+  float3 d = y - p;
+  float dist2 = dot(d, d);
+  float cos_light = fabs(dot(n, d)) / sqrt(dist2);
+  return dist2 / (cos_light * area);  // dw/dA = cos(theta_y) / r^2
+}
+
+// Uniform point on the light's triangle, converted to a solid-angle pdf at ctx.p
+bool lights_sample_triangle(const SceneData* sc, __global const Light* light,
+                            const LightSampleContext* ctx, float2 u, LightSample* ls) {
+  float3 v0, v1, v2;
+  scene_prim_positions(sc, light->index, &v0, &v1, &v2);
+  float area;
+  float3 n = triangle_normal_area(v0, v1, v2, &area);
+  // sample_triangle gives y = s v0 + t v1 + (1-s-t) v2: weights b1 = t of v1, b2 = 1-s-t of v2
+  float2 st = sample_triangle(u.x, u.y);
+  float b1 = st.y, b2 = 1.0f - st.x - st.y;
+  float3 y = (1.0f - b1 - b2) * v0 + b1 * v1 + b2 * v2;
+  float3 d = y - ctx->p;
+  float dist2 = dot(d, d);
+  if (!(dist2 > 0.0f)) return false;
+  ls->wi = d / sqrt(dist2);
+  bool front = dot(n, ls->wi) < 0.0f;
+  __global const Prim* pr = &sc->prims[light->index];
+  ls->radiance = surface_emission(sc, &sc->materials[pr->material], front, surface_uvs(sc, pr, b1, b2));
+  ls->pdf = lights_triangle_solid_angle_pdf(ctx->p, y, n, light->params[0]);
+  ls->at_infinity = false;
+  ls->target = offset_ray_origin(y, front ? n : -n);
+  return ls->pdf > 0.0f && isfinite(ls->pdf);
+}
+
+// The pdf lights_sample_triangle would give for wi: where the ray from ctx.p along wi
+// meets the light's triangle (0 if it misses)
+float lights_pdf_triangle(const SceneData* sc, __global const Light* light,
+                          const LightSampleContext* ctx, float3 wi) {
+  float3 v0, v1, v2;
+  scene_prim_positions(sc, light->index, &v0, &v1, &v2);
+  Ray r = {ctx->p, wi};
+  WatertightRay wr = watertight_ray(r);
+  float t, b1, b2;
+  if (!intersect_triangle(&wr, v0, v1, v2, INFINITY, &t, &b1, &b2)) return 0.0f;
+  float area;
+  float3 n = triangle_normal_area(v0, v1, v2, &area);
+  return lights_triangle_solid_angle_pdf(ctx->p, ctx->p + t * wi, n, light->params[0]);
+}
+
+// Picks a light by x_select (power-proportional table) and samples a direction toward it
+bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u,
                    LightSample* ls) {
-  if (num_lights == 0u) return false;
-  __global const Light* light = &lights[sample_discrete_thresholds(light_thresholds, num_lights, x_select)];
-  float p_select = light->pmf;
+  uint n = sc->params->num_lights;
+  if (n == 0u) return false;
+  __global const Light* light = &sc->lights[sample_discrete_thresholds(sc->light_thresholds, n, x_select)];
   bool ok;
+  ls->is_delta = false;
   switch (light->type) {
     case LIGHT_TRIANGLE:
-      ok = lights_sample_triangle(light, tris, shading, materials, textures, p, u, ls);
+      ok = lights_sample_triangle(sc, light, ctx, u, ls);
       break;
-    case LIGHT_BACKGROUND:
-      ok = lights_sample_background(light, ns, u, ls);
+    case LIGHT_ENVIRONMENT:
+      ok = lights_sample_environment(sc, ctx, u, ls);
       break;
     default:
       ok = false;
   }
-  ls->pdf *= p_select;
-  return ok && p_select > 0.0f;
+  ls->pdf *= light->pmf;
+  return ok && light->pmf > 0.0f;
+}
+
+// The pdf with which lights_sample picks light `index` and direction wi from ctx
+float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index, float3 wi) {
+  __global const Light* light = &sc->lights[index];
+  switch (light->type) {
+    case LIGHT_TRIANGLE:
+      return light->pmf * lights_pdf_triangle(sc, light, ctx, wi);
+    case LIGHT_ENVIRONMENT:
+      return light->pmf * lights_pdf_environment(ctx, wi);
+    default:
+      return 0.0f;
+  }
 }

@@ -1,16 +1,10 @@
-// Bilinear lookup of RGBA8 textures in one shared texel array. sRGB texels are decoded
-// through a 256-entry table before filtering, so filtering happens in linear space.
+// Bilinear lookup of textures in two shared texel arrays (RGBA8 and float RGBA). sRGB
+// texels are decoded through a 256-entry table before filtering, so filtering happens in
+// linear space. Each material slot is a TextureRef: texture, UV set and transform.
 
 #ifndef CD_FEATURE_TEXTURES
 #define CD_FEATURE_TEXTURES 1
 #endif
-
-// Every texture of the scene
-typedef struct {
-  __global const TextureInfo* info;
-  __global const uchar4* texels;
-  __global const float* srgb_to_linear;  // 256 entries
-} TextureSet;
 
 int texture_wrap(int i, int n, uint mode) {
   if (mode == WRAP_CLAMP) return clamp(i, 0, n - 1);
@@ -24,20 +18,21 @@ int texture_wrap(int i, int n, uint mode) {
   return m < 0 ? m + n : m;
 }
 
-float4 texture_texel(__global const TextureInfo* tex, __global const uchar4* texels,
-                     __global const float* srgb_to_linear, int x, int y) {
+float4 texture_texel(const SceneData* sc, __global const TextureInfo* tex, int x, int y) {
   int w = (int)tex->width, h = (int)tex->height;
   x = texture_wrap(x, w, tex->flags & 0xffu);
   y = texture_wrap(y, h, (tex->flags >> 8) & 0xffu);
-  uchar4 c = texels[tex->offset + (uint)y * (uint)w + (uint)x];
+  uint i = tex->offset + (uint)y * (uint)w + (uint)x;
+  if (tex->flags & TEXTURE_FLOAT) return vload4(0, sc->texelsf[i].rgba);
+  Texel8 c = sc->texels8[i];
   if (tex->flags & TEXTURE_SRGB)
-    return (float4)(srgb_to_linear[c.x], srgb_to_linear[c.y], srgb_to_linear[c.z], c.w / 255.0f);
-  return convert_float4(c) / 255.0f;
+    return (float4)(sc->srgb_to_linear[c.r], sc->srgb_to_linear[c.g], sc->srgb_to_linear[c.b],
+                    c.a / 255.0f);
+  return (float4)(c.r, c.g, c.b, c.a) / 255.0f;
 }
 
 // uv in glTF convention: (0, 0) is the top-left corner of the image
-float4 texture_sample(__global const TextureInfo* tex, __global const uchar4* texels,
-                      __global const float* srgb_to_linear, float2 uv) {
+float4 texture_sample(const SceneData* sc, __global const TextureInfo* tex, float2 uv) {
   float x = uv.x * (float)tex->width - 0.5f;
   float y = uv.y * (float)tex->height - 0.5f;
   // Keep huge coordinates in range before converting to int
@@ -46,18 +41,24 @@ float4 texture_sample(__global const TextureInfo* tex, __global const uchar4* te
   float fx = floor(x), fy = floor(y);
   float ax = x - fx, ay = y - fy;
   int ix = (int)fx, iy = (int)fy;
-  float4 c00 = texture_texel(tex, texels, srgb_to_linear, ix, iy);
-  float4 c10 = texture_texel(tex, texels, srgb_to_linear, ix + 1, iy);
-  float4 c01 = texture_texel(tex, texels, srgb_to_linear, ix, iy + 1);
-  float4 c11 = texture_texel(tex, texels, srgb_to_linear, ix + 1, iy + 1);
+  float4 c00 = texture_texel(sc, tex, ix, iy);
+  float4 c10 = texture_texel(sc, tex, ix + 1, iy);
+  float4 c01 = texture_texel(sc, tex, ix, iy + 1);
+  float4 c11 = texture_texel(sc, tex, ix + 1, iy + 1);
   return mix(mix(c00, c10, ax), mix(c01, c11, ax), ay);
 }
 
-// Texture `index` of the set at uv; white when the scene has no textures compiled in
-float4 textures_lookup(const TextureSet* set, int index, float2 uv) {
+// The slot's texture at the surface's texture coordinates (uvs.xy = TEXCOORD_0,
+// uvs.zw = TEXCOORD_1), after its KHR_texture_transform; white for an empty slot or when
+// the scene has no textures compiled in
+float4 textures_lookup(const SceneData* sc, __global const TextureRef* ref, float4 uvs) {
 #if CD_FEATURE_TEXTURES
-  if (index != NO_TEXTURE)
-    return texture_sample(&set->info[index], set->texels, set->srgb_to_linear, uv);
+  if (ref->index != NO_TEXTURE) {
+    float2 uv = ref->texcoord == 1u ? uvs.zw : uvs.xy;
+    float2 st = (float2)(ref->m[0] * uv.x + ref->m[1] * uv.y + ref->m[2],
+                         ref->m[3] * uv.x + ref->m[4] * uv.y + ref->m[5]);
+    return texture_sample(sc, &sc->textures[ref->index], st);
+  }
 #endif
   return (float4)(1.0f);
 }

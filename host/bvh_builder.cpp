@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include "scene.hpp"
+
 namespace candela {
 namespace {
 
@@ -18,22 +20,24 @@ float surface_area(const Bounds& b) {
 
 class Builder {
  public:
-  explicit Builder(const std::vector<SceneTriangle>& tris) {
-    size_t n = tris.size();
+  Builder(const std::vector<float>& positions, const std::vector<dev::Prim>& prims)
+      : positions_(positions), prims_(prims) {
+    size_t n = prims.size();
     boxes_.resize(n);
     centroids_.resize(n);
     for (size_t i = 0; i < n; ++i) {
-      for (const auto& p : tris[i].p) boxes_[i].grow(p);
+      for (uint32_t v : prims[i].v) boxes_[i].grow(vertex(v));
       centroids_[i] = boxes_[i].center();
     }
-    bvh_.order.resize(n);
-    for (size_t i = 0; i < n; ++i) bvh_.order[i] = uint32_t(i);
+    order_.resize(n);
+    for (size_t i = 0; i < n; ++i) order_[i] = uint32_t(i);
   }
 
   Bvh build() {
-    bvh_.nodes.reserve(2 * bvh_.order.size());
+    bvh_.nodes.reserve(2 * order_.size());
     bvh_.nodes.emplace_back();
-    build_node(0, 0, uint32_t(bvh_.order.size()), 1);
+    build_node(0, 0, uint32_t(order_.size()), 1);
+    leaf_triangles();
     return std::move(bvh_);
   }
 
@@ -44,10 +48,31 @@ class Builder {
     float cost = 1e30f;
   };
 
+  glm::vec3 vertex(uint32_t v) const {
+    return glm::vec3(positions_[3 * size_t(v)], positions_[3 * size_t(v) + 1], positions_[3 * size_t(v) + 2]);
+  }
+
+  // Leaf triangles in BVH order, each with its primitive index
+  void leaf_triangles() {
+    bvh_.tris.resize(order_.size());
+    for (size_t i = 0; i < order_.size(); ++i) {
+      const dev::Prim& p = prims_[order_[i]];
+      dev::BvhTriangle& d = bvh_.tris[i];
+      d = dev::BvhTriangle{};
+      glm::vec3 v0 = vertex(p.v[0]), v1 = vertex(p.v[1]), v2 = vertex(p.v[2]);
+      for (int a = 0; a < 3; ++a) {
+        d.v0[a] = v0[a];
+        d.v1[a] = v1[a];
+        d.v2[a] = v2[a];
+      }
+      d.prim = order_[i];
+    }
+  }
+
   Bounds range_bounds(uint32_t begin, uint32_t end, bool centroids) const {
     Bounds b;
     for (uint32_t i = begin; i < end; ++i) {
-      uint32_t t = bvh_.order[i];
+      uint32_t t = order_[i];
       if (centroids)
         b.grow(centroids_[t]);
       else
@@ -66,7 +91,7 @@ class Builder {
       std::array<Bounds, kBins> bins;
       std::array<uint32_t, kBins> counts{};
       for (uint32_t i = begin; i < end; ++i) {
-        uint32_t t = bvh_.order[i];
+        uint32_t t = order_[i];
         int b = std::min(kBins - 1, int((centroids_[t][axis] - lo) * scale));
         bins[b].grow(boxes_[t]);
         counts[b]++;
@@ -124,9 +149,9 @@ class Builder {
     float split_cost = kTraversalCost + split.cost / std::max(surface_area(box), 1e-30f);
     uint32_t mid;
     if (split.axis >= 0 && (split_cost < leaf_cost || count > kMaxLeafSize)) {
-      auto it = std::partition(bvh_.order.begin() + begin, bvh_.order.begin() + end,
+      auto it = std::partition(order_.begin() + begin, order_.begin() + end,
                                [&](uint32_t t) { return centroids_[t][split.axis] < split.position; });
-      mid = uint32_t(it - bvh_.order.begin());
+      mid = uint32_t(it - order_.begin());
     } else if (count > kMaxLeafSize) {
       // All centroids coincide (or no useful plane): split the range in half
       mid = begin + count / 2;
@@ -144,6 +169,9 @@ class Builder {
     build_node(left + 1, mid, end, depth + 1);
   }
 
+  const std::vector<float>& positions_;
+  const std::vector<dev::Prim>& prims_;
+  std::vector<uint32_t> order_;  // order_[i]: primitive stored at leaf position i
   std::vector<Bounds> boxes_;
   std::vector<glm::vec3> centroids_;
   Bvh bvh_;
@@ -151,24 +179,8 @@ class Builder {
 
 }  // namespace
 
-Bvh build_bvh(const std::vector<SceneTriangle>& triangles) { return Builder(triangles).build(); }
-
-std::vector<dev::Triangle> bvh_ordered_triangles(const std::vector<SceneTriangle>& triangles,
-                                                 const Bvh& bvh) {
-  std::vector<dev::Triangle> out(bvh.order.size());
-  for (size_t i = 0; i < bvh.order.size(); ++i) {
-    const SceneTriangle& t = triangles[bvh.order[i]];
-    dev::Triangle& d = out[i];
-    for (int a = 0; a < 3; ++a) {
-      d.v0[a] = t.p[0][a];
-      d.v1[a] = t.p[1][a];
-      d.v2[a] = t.p[2][a];
-    }
-    d.material = t.material;
-    d.prim = bvh.order[i];
-    d.pad0 = 0;
-  }
-  return out;
+Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims) {
+  return Builder(positions, prims).build();
 }
 
 }  // namespace candela

@@ -1,15 +1,18 @@
-// Binned-SAH BVH over triangles, flattened for bvh_traverse.cl.
+// Binned-SAH BVH over the scene's primitives, flattened for bvh_traverse.cl. The node
+// and leaf layout (BvhNode, BvhTriangle) is private to this file and bvh_traverse.cl:
+// the rest of candela refers to triangles by their stable primitive index.
 #pragma once
 
+#include <glm/glm.hpp>
 #include <vector>
 
-#include "scene.hpp"
+#include "device_types.hpp"
 
 namespace candela {
 
 struct Bvh {
   std::vector<dev::BvhNode> nodes;  // root at 0
-  std::vector<uint32_t> order;  // order[i]: scene triangle stored at position i
+  std::vector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
   int depth = 0;
 };
 
@@ -17,10 +20,7 @@ struct Bvh {
 // the tree shallower than that.
 constexpr int kMaxBvhDepth = 60;
 
-Bvh build_bvh(const std::vector<SceneTriangle>& triangles);
-
-// Device triangles in BVH order
-std::vector<dev::Triangle> bvh_ordered_triangles(const std::vector<SceneTriangle>& triangles,
-                                                 const Bvh& bvh);
+// `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order)
+Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims);
 
 }  // namespace candela

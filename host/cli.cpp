@@ -146,8 +146,7 @@ int run_render(const RenderArgs& a) {
   }
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  float bg_max = std::max(scene.background.x, std::max(scene.background.y, scene.background.z));
-  if (!scene.has_emission() && !(bg_max > 0))
+  if (!scene.has_emission())
     std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
   if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
 

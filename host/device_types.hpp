@@ -1,44 +1,40 @@
 // Host view of cl/device_types.h, the one definition of every struct that crosses to
-// the device, with its layout pinned down. tests/layout_test.cpp checks the same
-// numbers on the device itself.
+// the device, with its layout pinned down by static_asserts generated from CD_LAYOUT;
+// tests/layout_test.cpp checks the same list on each device. cl/color.h brings the
+// colour helpers both sides share.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <vector>
 
 namespace candela::dev {
+#include "cl/color.h"
 #include "cl/device_types.h"
 }  // namespace candela::dev
 
 namespace candela::dev {
 static_assert(sizeof(float) == 4 && sizeof(int) == 4 && sizeof(unsigned int) == 4);
 
-static_assert(sizeof(BvhNode) == 32);
-static_assert(offsetof(BvhNode, left) == 12 && offsetof(BvhNode, bmax) == 16);
-static_assert(offsetof(BvhNode, right) == 28);
+#define CD_ASSERT_SIZE(type, bytes) static_assert(sizeof(type) == (bytes), #type " size");
+#define CD_ASSERT_FIELD(type, field, offset) \
+  static_assert(offsetof(type, field) == (offset), #type "::" #field " offset");
+CD_LAYOUT(CD_ASSERT_SIZE, CD_ASSERT_FIELD)
+#undef CD_ASSERT_SIZE
+#undef CD_ASSERT_FIELD
 
-static_assert(sizeof(Triangle) == 48);
-static_assert(offsetof(Triangle, material) == 12 && offsetof(Triangle, v1) == 16);
-static_assert(offsetof(Triangle, prim) == 28 && offsetof(Triangle, v2) == 32);
-static_assert(offsetof(Triangle, pad0) == 44);
+// Host copies of every scene buffer, one vector per entry of CD_SCENE_BUFFERS
+#define CD_HOST_BUFFER(type, name) std::vector<type> name;
+#define CD_BUFFER_BYTES(type, name) +name.size() * sizeof(type)
+struct SceneBuffers {
+  CD_SCENE_BUFFERS(CD_HOST_BUFFER)
+  size_t bytes() const { return 0 CD_SCENE_BUFFERS(CD_BUFFER_BYTES); }
+};
+#undef CD_HOST_BUFFER
+#undef CD_BUFFER_BYTES
 
-static_assert(sizeof(TriangleShading) == 64);
-static_assert(offsetof(TriangleShading, uv0_u) == 12 && offsetof(TriangleShading, n1) == 16);
-static_assert(offsetof(TriangleShading, uv2_v) == 56);
-
-static_assert(sizeof(TriangleColors) == 48 && offsetof(TriangleColors, c2) == 32);
-static_assert(sizeof(Material) == 64);
-static_assert(offsetof(Material, base_color) == 16 && offsetof(Material, emission) == 32);
-static_assert(offsetof(Material, params) == 48 && offsetof(Material, emission_texture) == 12);
-
-static_assert(sizeof(TextureInfo) == 16);
-static_assert(sizeof(Light) == 32 && offsetof(Light, radiance) == 16);
-
-static_assert(sizeof(Camera) == 64);
-static_assert(offsetof(Camera, forward) == 16 && offsetof(Camera, right) == 32);
-static_assert(offsetof(Camera, up) == 48);
-
-static_assert(sizeof(RenderParams) == 128);
-static_assert(offsetof(RenderParams, background) == 64 && offsetof(RenderParams, width) == 80);
-static_assert(offsetof(RenderParams, strategy) == 96 && offsetof(RenderParams, rr_depth) == 112);
-static_assert(offsetof(RenderParams, pixel_begin) == 116 && offsetof(RenderParams, pixel_end) == 120);
+// Number of entries in CD_SCENE_BUFFERS (the kernel has these plus params and the film)
+#define CD_COUNT_BUFFER(type, name) +1
+constexpr unsigned kSceneBufferCount = 0 CD_SCENE_BUFFERS(CD_COUNT_BUFFER);
+#undef CD_COUNT_BUFFER
 }  // namespace candela::dev

@@ -188,13 +188,6 @@ glm::mat4 local_transform(const tinygltf::Node& node) {
   return m;
 }
 
-// Which TEXCOORD_n a material's texture reads, and its KHR_texture_transform
-struct UvSet {
-  int texcoord = 0;
-  glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
-  bool operator==(const UvSet& o) const { return texcoord == o.texcoord && transform == o.transform; }
-};
-
 double number_or(const tinygltf::Value& obj, const char* key, int index, double fallback) {
   if (!obj.Has(key)) return fallback;
   const tinygltf::Value& v = obj.Get(key);
@@ -205,168 +198,305 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
   return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
-// KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv
-void read_texture_transform(const tinygltf::Value& ext, UvSet* set) {
+// KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv, and its texCoord
+void read_texture_transform(const tinygltf::Value& ext, TextureRef* ref) {
   float ox = float(number_or(ext, "offset", 0, 0.0)), oy = float(number_or(ext, "offset", 1, 0.0));
   float r = float(number_or(ext, "rotation", -1, 0.0));
   float sx = float(number_or(ext, "scale", 0, 1.0)), sy = float(number_or(ext, "scale", 1, 1.0));
   float c = std::cos(r), s = std::sin(r);
   // Column-major: columns are the images of (1,0,0), (0,1,0), (0,0,1)
-  set->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
+  ref->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
                              glm::vec3(ox, oy, 1.0f));
-  if (ext.Has("texCoord")) set->texcoord = int(number_or(ext, "texCoord", -1, set->texcoord));
+  if (ext.Has("texCoord")) ref->texcoord = int(number_or(ext, "texCoord", -1, ref->texcoord));
 }
 
-UvSet uv_set_of(int texcoord, const tinygltf::ExtensionMap& extensions) {
-  UvSet set;
-  set.texcoord = texcoord;
-  auto tt = extensions.find("KHR_texture_transform");
-  if (tt != extensions.end()) read_texture_transform(tt->second, &set);
-  return set;
-}
-
-class Loader {
+// Materials and the textures they use
+class MaterialReader {
  public:
-  Loader(const tinygltf::Model& model, Scene* scene)
-      : model_(model), scene_(scene), warn_(&scene->warnings) {}
+  MaterialReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
+      : model_(model), scene_(scene), warn_(*warn) {}
 
-  void load() {
-    for (const auto& ext : model_.extensionsUsed)
-      if (!kSupportedExtensions.count(ext)) warn_.add("glTF extension " + ext + " is not supported yet and is ignored");
-    for (const auto& ext : model_.extensionsRequired)
-      if (!kSupportedExtensions.count(ext))
-        warn_.add("the scene requires glTF extension " + ext + ", which candela does not support: the image may be wrong");
-    if (!model_.animations.empty()) warn_.add("animations are ignored (the first frame is rendered)");
-    if (!model_.skins.empty()) warn_.add("skins are ignored (meshes render in their bind pose)");
-    load_materials();
-    load_scene_roots();
-    if (degenerate_ > 0)
-      warn_.add(std::to_string(degenerate_) + " zero-area triangles were skipped");
-    if (scene_->triangles.empty()) throw Error("the scene has no triangles to render");
+  // Reads every material, then the default one (index = model's material count)
+  void read_all() {
+    for (size_t i = 0; i < model_.materials.size(); ++i) scene_->materials.push_back(read(int(i)));
+    scene_->materials.push_back(MaterialDesc());  // glTF default: white, for primitives without one
   }
 
  private:
-  void load_materials() {
-    for (size_t i = 0; i < model_.materials.size(); ++i) {
-      const tinygltf::Material& gm = model_.materials[i];
-      std::string name = "material '" + (gm.name.empty() ? std::to_string(i) : gm.name) + "'";
-      const auto& pbr = gm.pbrMetallicRoughness;
-      dev::Material m = default_material();
-      for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
-      // One UV set per material: the base color texture's, else the emissive texture's
-      std::optional<UvSet> uv_set;
-      if (pbr.baseColorTexture.index >= 0) {
-        m.base_color_texture = texture_index(pbr.baseColorTexture.index, true);
-        uv_set = uv_set_of(pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions);
-      }
-      if (gm.emissiveTexture.index >= 0) {
-        m.emission_texture = texture_index(gm.emissiveTexture.index, true);
-        UvSet emissive_uv = uv_set_of(gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions);
-        if (!uv_set)
-          uv_set = emissive_uv;
-        else if (!(*uv_set == emissive_uv))
-          warn_.add("emissiveTexture with other texture coordinates than baseColorTexture is not supported yet: it uses the base color's");
-      }
-      uv_sets_.push_back(uv_set.value_or(UvSet()));
-      float strength = 1.0f;
-      auto ext = gm.extensions.find("KHR_materials_emissive_strength");
-      if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
-        strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
-      for (int c = 0; c < 3; ++c) {
-        m.emission[c] = float(gm.emissiveFactor[c]) * strength;
-        if (!(m.emission[c] >= 0.0f) || !std::isfinite(m.emission[c]))
-          throw Error(name + " has a negative or non-finite emission (emissiveFactor x emissiveStrength)");
-      }
-      m.double_sided = gm.doubleSided ? 1u : 0u;
-
-      if (pbr.metallicFactor > 0.0)
-        warn_.add("metallic materials are not supported yet: rendered as diffuse with their base color (" + name + ", metallicFactor " + std::to_string(pbr.metallicFactor) + ")");
-      if (pbr.metallicRoughnessTexture.index >= 0)
-        warn_.add("metallicRoughnessTexture is not supported yet and is ignored");
-      if (gm.normalTexture.index >= 0) warn_.add("normalTexture is not supported yet and is ignored");
-      if (gm.occlusionTexture.index >= 0)
-        warn_.add("occlusionTexture is ignored (a path tracer computes occlusion itself)");
-      if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
-        warn_.add("alphaMode " + gm.alphaMode + " is not supported yet: surfaces are opaque");
-      for (const auto& e : gm.extensions)
-        if (!kSupportedExtensions.count(e.first))
-          warn_.add("glTF extension " + e.first + " is not supported yet and is ignored");
-      scene_->materials.push_back(m);
+  MaterialDesc read(int index) {
+    const tinygltf::Material& gm = model_.materials[size_t(index)];
+    std::string name = "material '" + (gm.name.empty() ? std::to_string(index) : gm.name) + "'";
+    const auto& pbr = gm.pbrMetallicRoughness;
+    MaterialDesc m;
+    for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
+    if (pbr.baseColorTexture.index >= 0)
+      m.base_color_texture = texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                         pbr.baseColorTexture.extensions, true);
+    if (gm.emissiveTexture.index >= 0)
+      m.emission_texture = texture_ref(gm.emissiveTexture.index, gm.emissiveTexture.texCoord,
+                                       gm.emissiveTexture.extensions, true);
+    float strength = 1.0f;
+    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+    if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
+      strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    for (int c = 0; c < 3; ++c) {
+      m.emission[c] = float(gm.emissiveFactor[c]) * strength;
+      if (!(m.emission[c] >= 0.0f) || !std::isfinite(m.emission[c]))
+        throw Error(name + " has a negative or non-finite emission (emissiveFactor x emissiveStrength)");
     }
-    // Default material (glTF: white, metallic 1, roughness 1) for primitives without one
-    default_material_index_ = uint32_t(scene_->materials.size());
-    scene_->materials.push_back(default_material());
-    uv_sets_.push_back(UvSet());
-  }
-
-  static dev::Material default_material() {
-    dev::Material m{};
-    m.type = MATERIAL_DIFFUSE;
-    m.base_color_texture = NO_TEXTURE;
-    m.emission_texture = NO_TEXTURE;
-    for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
+    m.double_sided = gm.doubleSided;
+    warn_unsupported(gm, name);
     return m;
   }
 
-  // Adds the glTF texture's image once, returning its TextureInfo index (or NO_TEXTURE)
+  void warn_unsupported(const tinygltf::Material& gm, const std::string& name) {
+    const auto& pbr = gm.pbrMetallicRoughness;
+    if (pbr.metallicFactor > 0.0)
+      warn_.add("metallic materials are not supported yet: rendered as diffuse with their base color (" + name + ", metallicFactor " + std::to_string(pbr.metallicFactor) + ")");
+    if (pbr.metallicRoughnessTexture.index >= 0)
+      warn_.add("metallicRoughnessTexture is not supported yet and is ignored");
+    if (gm.normalTexture.index >= 0) warn_.add("normalTexture is not supported yet and is ignored");
+    if (gm.occlusionTexture.index >= 0)
+      warn_.add("occlusionTexture is ignored (a path tracer computes occlusion itself)");
+    if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+      warn_.add("alphaMode " + gm.alphaMode + " is not supported yet: surfaces are opaque");
+    for (const auto& e : gm.extensions)
+      if (!kSupportedExtensions.count(e.first))
+        warn_.add("glTF extension " + e.first + " is not supported yet and is ignored");
+  }
+
+  TextureRef texture_ref(int gltf_texture, int texcoord, const tinygltf::ExtensionMap& extensions,
+                         bool srgb) {
+    TextureRef ref;
+    ref.index = texture_index(gltf_texture, srgb);
+    ref.texcoord = texcoord;
+    auto tt = extensions.find("KHR_texture_transform");
+    if (tt != extensions.end()) read_texture_transform(tt->second, &ref);
+    if (ref.texcoord < 0 || ref.texcoord > 1) {
+      warn_.add("textures on TEXCOORD_" + std::to_string(ref.texcoord) + " are not supported (only TEXCOORD_0 and TEXCOORD_1): the texture is ignored");
+      ref.index = NO_TEXTURE;
+    }
+    return ref;
+  }
+
+  // Adds the glTF texture's image once, returning its index in Scene::textures (or NO_TEXTURE)
   int texture_index(int gltf_texture, bool srgb) {
     auto key = std::make_pair(gltf_texture, srgb);
     if (auto it = texture_cache_.find(key); it != texture_cache_.end()) return it->second;
     if (gltf_texture < 0 || gltf_texture >= (int)model_.textures.size())
       throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
-    const tinygltf::Texture& tex = model_.textures[gltf_texture];
+    const tinygltf::Texture& tex = model_.textures[size_t(gltf_texture)];
     if (tex.source < 0 || tex.source >= (int)model_.images.size()) {
       warn_.add("glTF texture " + std::to_string(gltf_texture) +
                 " has no PNG or JPEG source (e.g. only KHR_texture_basisu): it is ignored");
       return NO_TEXTURE;
     }
-    const tinygltf::Image& img = model_.images[tex.source];
-    if (img.width <= 0 || img.height <= 0 || img.image.empty())
-      throw Error("glTF image " + std::to_string(tex.source) + " ('" + img.uri + "') could not be decoded");
-
-    size_t n = size_t(img.width) * img.height;
-    if (scene_->texels.size() / 4 + n > size_t(UINT32_MAX))
-      throw Error("the scene's textures hold more than 2^32 texels");
-    dev::TextureInfo info{};
-    info.offset = uint32_t(scene_->texels.size() / 4);
-    info.width = uint32_t(img.width);
-    info.height = uint32_t(img.height);
-    uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
-    if (tex.sampler >= 0 && tex.sampler < (int)model_.samplers.size()) {
-      const tinygltf::Sampler& sampler = model_.samplers[tex.sampler];
-      auto mode = [](int w) {
-        return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ? WRAP_CLAMP
-               : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
-                                                            : WRAP_REPEAT;
-      };
-      wrap_s = mode(sampler.wrapS);
-      wrap_t = mode(sampler.wrapT);
-      if (sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
-        warn_.add("texture filter NEAREST is not supported yet: textures are filtered bilinearly");
-    }
-    info.flags = wrap_s | (wrap_t << 8) | (srgb ? TEXTURE_SRGB : 0u);
-
-    // tinygltf decodes every image to 4 channels of 8 or 16 bits; keep 8 bits
-    if (img.component != 4 || (img.bits != 8 && img.bits != 16) ||
-        img.image.size() < n * 4 * size_t(img.bits / 8))
-      throw Error("glTF image " + std::to_string(tex.source) + " has an unexpected pixel layout");
-    size_t first = scene_->texels.size();
-    scene_->texels.resize(first + 4 * n);
-    for (size_t i = 0; i < 4 * n; ++i)
-      scene_->texels[first + i] = img.bits == 8 ? img.image[i] : img.image[2 * i + 1];  // high byte (little-endian)
+    TextureDesc t = decode_image(tex.source, srgb);
+    read_sampler(tex.sampler, &t);
     int index = int(scene_->textures.size());
-    scene_->textures.push_back(info);
+    scene_->textures.push_back(std::move(t));
     texture_cache_[key] = index;
     return index;
   }
 
-  void load_scene_roots() {
+  // tinygltf decodes every image to 4 channels of 8 or 16 bits: 8-bit images stay RGBA8
+  // (sRGB decoded in the kernel), 16-bit ones become float texels, decoded here
+  TextureDesc decode_image(int source, bool srgb) {
+    const tinygltf::Image& img = model_.images[size_t(source)];
+    if (img.width <= 0 || img.height <= 0 || img.image.empty())
+      throw Error("glTF image " + std::to_string(source) + " ('" + img.uri + "') could not be decoded");
+    TextureDesc t;
+    t.width = img.width;
+    t.height = img.height;
+    size_t n = t.texels();
+    if (img.component != 4 || (img.bits != 8 && img.bits != 16) ||
+        img.image.size() < n * 4 * size_t(img.bits / 8))
+      throw Error("glTF image " + std::to_string(source) + " has an unexpected pixel layout");
+    if (img.bits == 8) {
+      t.srgb = srgb;
+      t.rgba8.assign(img.image.begin(), img.image.begin() + ptrdiff_t(4 * n));
+      return t;
+    }
+    t.rgbaf.resize(4 * n);
+    for (size_t i = 0; i < 4 * n; ++i) {
+      uint16_t v;
+      std::memcpy(&v, &img.image[2 * i], 2);
+      float c = v / 65535.0f;
+      t.rgbaf[i] = srgb && i % 4 != 3 ? dev::srgb_to_linear(c) : c;
+    }
+    return t;
+  }
+
+  void read_sampler(int sampler_index, TextureDesc* t) {
+    if (sampler_index < 0 || sampler_index >= (int)model_.samplers.size()) return;
+    const tinygltf::Sampler& sampler = model_.samplers[size_t(sampler_index)];
+    auto mode = [](int w) {
+      return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE      ? WRAP_CLAMP
+             : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
+                                                           : WRAP_REPEAT;
+    };
+    t->wrap_s = mode(sampler.wrapS);
+    t->wrap_t = mode(sampler.wrapT);
+    if (sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+      warn_.add("texture filter NEAREST is not supported yet: textures are filtered bilinearly");
+  }
+
+  const tinygltf::Model& model_;
+  Scene* scene_;
+  Warnings& warn_;
+  std::map<std::pair<int, bool>, int> texture_cache_;
+};
+
+// One primitive's vertex attributes and triangles, placed in the world
+class MeshReader {
+ public:
+  MeshReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
+      : model_(model), scene_(scene), warn_(*warn) {}
+
+  void read(const tinygltf::Mesh& mesh, const glm::mat4& world) {
+    for (const auto& prim : mesh.primitives) {
+      if (!renderable(prim)) continue;
+      MeshDesc m;
+      m.material = prim.material >= 0 && prim.material < (int)model_.materials.size()
+                       ? uint32_t(prim.material)
+                       : uint32_t(model_.materials.size());  // the default material
+      read_attributes(prim, world, &m);
+      read_triangles(prim, world, &m);
+      if (m.triangles() > 0) scene_->meshes.push_back(std::move(m));
+    }
+  }
+
+  size_t degenerate() const { return degenerate_; }
+
+ private:
+  bool renderable(const tinygltf::Primitive& prim) {
+    if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        prim.mode != TINYGLTF_MODE_TRIANGLE_FAN && prim.mode != -1) {
+      warn_.add("point and line primitives are not rendered");
+      return false;
+    }
+    if (!prim.targets.empty()) warn_.add("morph targets are not supported yet: base geometry is rendered");
+    if (prim.extensions.count("KHR_draco_mesh_compression")) {
+      warn_.add("Draco-compressed primitives (KHR_draco_mesh_compression) are not supported: they are skipped");
+      return false;
+    }
+    if (!prim.attributes.count("POSITION")) {
+      warn_.add("a primitive without POSITION was skipped");
+      return false;
+    }
+    return true;
+  }
+
+  // Attribute `name` with `comps` components per vertex (0: VEC3 or VEC4), or empty
+  std::vector<float> attribute(const tinygltf::Primitive& prim, const std::string& name, int comps,
+                               size_t nverts, int* got_comps = nullptr) {
+    auto it = prim.attributes.find(name);
+    if (it == prim.attributes.end()) return {};
+    std::vector<float> v = read_accessor(model_, it->second, comps);
+    int c = tinygltf::GetNumComponentsInType(model_.accessors[size_t(it->second)].type);
+    if (got_comps) *got_comps = c;
+    if (v.size() != nverts * size_t(c)) throw Error("glTF primitive attributes have different vertex counts");
+    return v;
+  }
+
+  void read_attributes(const tinygltf::Primitive& prim, const glm::mat4& world, MeshDesc* m) {
+    std::vector<float> pos = read_accessor(model_, prim.attributes.at("POSITION"), 3);
+    size_t n = pos.size() / 3;
+    glm::mat3 linear(world), normal_matrix = glm::transpose(glm::inverse(linear));
+    for (size_t v = 0; v < n; ++v) {
+      glm::vec3 p = glm::vec3(world * glm::vec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0f));
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw Error("glTF mesh has non-finite vertex positions");
+      m->positions.push_back(p);
+    }
+    auto unit_or_zero = [](glm::vec3 v) {
+      float len = glm::length(v);
+      return len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0.0f);
+    };
+    std::vector<float> nrm = attribute(prim, "NORMAL", 3, n);
+    for (size_t v = 0; v < nrm.size() / 3; ++v)
+      m->normals.push_back(unit_or_zero(normal_matrix * glm::vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2])));
+    std::vector<float> tan = attribute(prim, "TANGENT", 4, n);
+    for (size_t v = 0; v < tan.size() / 4; ++v)
+      m->tangents.push_back(glm::vec4(unit_or_zero(linear * glm::vec3(tan[4 * v], tan[4 * v + 1], tan[4 * v + 2])),
+                                      tan[4 * v + 3] < 0.0f ? -1.0f : 1.0f));
+    for (int set = 0; set < 2; ++set) {
+      std::vector<float> uv = attribute(prim, "TEXCOORD_" + std::to_string(set), 2, n);
+      auto& out = set == 0 ? m->uv0 : m->uv1;
+      for (size_t v = 0; v < uv.size() / 2; ++v) out.push_back(glm::vec2(uv[2 * v], uv[2 * v + 1]));
+    }
+    read_colors(prim, n, m);
+  }
+
+  // COLOR_0: RGB or RGBA (alpha unused while surfaces are opaque), linear, in [0, 1]
+  void read_colors(const tinygltf::Primitive& prim, size_t n, MeshDesc* m) {
+    int comps = 0;
+    std::vector<float> col = attribute(prim, "COLOR_0", 0, n, &comps);
+    if (col.empty()) return;
+    if (comps != 3 && comps != 4) throw Error("glTF COLOR_0 must be VEC3 or VEC4");
+    for (float c : col)
+      if (!(c >= 0.0f && c <= 1.0f))
+        throw Error("glTF COLOR_0 values must lie in [0, 1] (integer colors must be normalized)");
+    for (size_t v = 0; v < n; ++v)
+      m->colors.push_back(glm::vec3(col[comps * v], col[comps * v + 1], col[comps * v + 2]));
+  }
+
+  // Triangles from TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN, zero-area ones skipped
+  void read_triangles(const tinygltf::Primitive& prim, const glm::mat4& world, MeshDesc* m) {
+    size_t nverts = m->positions.size();
+    std::vector<uint32_t> indices;
+    if (prim.indices >= 0) {
+      indices = read_indices(model_, prim.indices);
+    } else {
+      for (uint32_t i = 0; i < nverts; ++i) indices.push_back(i);
+    }
+    for (uint32_t i : indices)
+      if (i >= nverts) throw Error("glTF primitive index out of range");
+    bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
+    auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+      if (mirrored) std::swap(b, c);  // a mirroring transform flips the winding
+      double area;
+      triangle_normal_area(m->positions[a], m->positions[b], m->positions[c], &area);
+      if (!(area > 0.0)) {
+        ++degenerate_;  // zero area: invisible, and it has no normal
+        return;
+      }
+      m->indices.insert(m->indices.end(), {a, b, c});
+    };
+    int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      for (size_t i = 0; i + 2 < indices.size(); i += 3) emit(indices[i], indices[i + 1], indices[i + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (size_t i = 0; i + 2 < indices.size(); ++i) {
+        if (i % 2 == 0)
+          emit(indices[i], indices[i + 1], indices[i + 2]);
+        else
+          emit(indices[i + 1], indices[i], indices[i + 2]);
+      }
+    } else {
+      for (size_t i = 1; i + 1 < indices.size(); ++i) emit(indices[i], indices[i + 1], indices[0]);
+    }
+  }
+
+  const tinygltf::Model& model_;
+  Scene* scene_;
+  Warnings& warn_;
+  size_t degenerate_ = 0;
+};
+
+// The default scene's node trees: transforms, meshes, the first camera, scene extras
+class NodeReader {
+ public:
+  NodeReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
+      : model_(model), scene_(scene), warn_(*warn), meshes_(model, scene, warn) {}
+
+  void read_scene() {
     std::vector<int> roots;
     int scene_index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
     if (model_.defaultScene >= (int)model_.scenes.size())
       throw Error("glTF 'scene' " + std::to_string(model_.defaultScene) + " does not exist");
     if (scene_index < (int)model_.scenes.size()) {
-      const tinygltf::Scene& s = model_.scenes[scene_index];
+      const tinygltf::Scene& s = model_.scenes[size_t(scene_index)];
       roots = s.nodes;
       read_scene_extras(s.extras);
     } else {
@@ -374,55 +504,57 @@ class Loader {
       std::vector<bool> is_child(model_.nodes.size(), false);
       for (const auto& n : model_.nodes)
         for (int c : n.children)
-          if (c >= 0 && c < (int)is_child.size()) is_child[c] = true;
+          if (c >= 0 && c < (int)is_child.size()) is_child[size_t(c)] = true;
       for (size_t i = 0; i < model_.nodes.size(); ++i)
         if (!is_child[i]) roots.push_back(int(i));
     }
     visited_.assign(model_.nodes.size(), false);
-    for (int r : roots) visit_node(r, glm::mat4(1.0f));
+    for (int r : roots) visit(r, glm::mat4(1.0f));
+    if (meshes_.degenerate() > 0)
+      warn_.add(std::to_string(meshes_.degenerate()) + " zero-area triangles were skipped");
   }
 
+ private:
   void read_scene_extras(const tinygltf::Value& extras) {
     if (!extras.Has("candela")) return;
     const tinygltf::Value& c = extras.Get("candela");
-    if (c.Has("background")) {
-      const tinygltf::Value& bg = c.Get("background");
-      if (!bg.IsArray() || bg.ArrayLen() != 3)
-        throw Error("scene extras candela.background must be an array of 3 numbers");
-      for (int i = 0; i < 3; ++i) {
-        if (!bg.Get(i).IsNumber()) throw Error("scene extras candela.background must hold numbers");
-        scene_->background[i] = float(bg.Get(i).GetNumberAsDouble());
-        if (!(scene_->background[i] >= 0.0f) || !std::isfinite(scene_->background[i]))
-          throw Error("scene extras candela.background must be finite and non-negative");
-      }
+    if (!c.Has("background")) return;
+    const tinygltf::Value& bg = c.Get("background");
+    if (!bg.IsArray() || bg.ArrayLen() != 3)
+      throw Error("scene extras candela.background must be an array of 3 numbers");
+    for (int i = 0; i < 3; ++i) {
+      if (!bg.Get(i).IsNumber()) throw Error("scene extras candela.background must hold numbers");
+      scene_->background[i] = float(bg.Get(i).GetNumberAsDouble());
+      if (!(scene_->background[i] >= 0.0f) || !std::isfinite(scene_->background[i]))
+        throw Error("scene extras candela.background must be finite and non-negative");
     }
   }
 
-  void visit_node(int index, const glm::mat4& parent) {
+  void visit(int index, const glm::mat4& parent) {
     if (index < 0 || index >= (int)model_.nodes.size())
       throw Error("glTF node " + std::to_string(index) + " does not exist");
     // glTF 3.5.2: nodes form disjoint strict trees (no node has two parents, no cycles)
-    if (visited_[index])
+    if (visited_[size_t(index)])
       throw Error("glTF node " + std::to_string(index) + " has two parents or is part of a cycle");
-    visited_[index] = true;
-    const tinygltf::Node& node = model_.nodes[index];
+    visited_[size_t(index)] = true;
+    const tinygltf::Node& node = model_.nodes[size_t(index)];
     glm::mat4 world = parent * local_transform(node);
     if (node.mesh >= 0) {
       if (node.mesh >= (int)model_.meshes.size())
         throw Error("glTF node " + std::to_string(index) + " refers to a missing mesh");
-      load_mesh(model_.meshes[node.mesh], world);
-      if (!node.weights.empty() || !model_.meshes[node.mesh].weights.empty())
+      meshes_.read(model_.meshes[size_t(node.mesh)], world);
+      if (!node.weights.empty() || !model_.meshes[size_t(node.mesh)].weights.empty())
         warn_.add("morph targets are not supported yet: base geometry is rendered");
     }
-    if (node.camera >= 0 && !scene_->camera) load_camera(node.camera, world);
+    if (node.camera >= 0 && !scene_->camera) read_camera(node.camera, world);
     if (node.extensions.count("KHR_lights_punctual"))
       warn_.add("KHR_lights_punctual lights are not supported yet and are ignored");
-    for (int child : node.children) visit_node(child, world);
+    for (int child : node.children) visit(child, world);
   }
 
-  void load_camera(int index, const glm::mat4& world) {
+  void read_camera(int index, const glm::mat4& world) {
     if (index >= (int)model_.cameras.size()) throw Error("glTF camera " + std::to_string(index) + " does not exist");
-    const tinygltf::Camera& c = model_.cameras[index];
+    const tinygltf::Camera& c = model_.cameras[size_t(index)];
     if (c.type != "perspective") {
       warn_.add("camera type '" + c.type + "' is not supported yet; it is skipped");
       return;
@@ -437,117 +569,22 @@ class Loader {
     scene_->camera = cam;
   }
 
-  void load_mesh(const tinygltf::Mesh& mesh, const glm::mat4& world) {
-    glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(world)));
-    bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
-    for (const auto& prim : mesh.primitives) {
-      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-          prim.mode != TINYGLTF_MODE_TRIANGLE_FAN && prim.mode != -1) {
-        warn_.add("point and line primitives are not rendered");
-        continue;
-      }
-      if (!prim.targets.empty()) warn_.add("morph targets are not supported yet: base geometry is rendered");
-      if (prim.extensions.count("KHR_draco_mesh_compression")) {
-        warn_.add("Draco-compressed primitives (KHR_draco_mesh_compression) are not supported: they are skipped");
-        continue;
-      }
-      auto pos_it = prim.attributes.find("POSITION");
-      if (pos_it == prim.attributes.end()) {
-        warn_.add("a primitive without POSITION was skipped");
-        continue;
-      }
-      uint32_t material = prim.material >= 0 && prim.material < (int)model_.materials.size()
-                              ? uint32_t(prim.material)
-                              : default_material_index_;
-      std::vector<float> pos = read_accessor(model_, pos_it->second, 3);
-      size_t nverts = pos.size() / 3;
-      std::vector<float> nrm, uv;
-      if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end())
-        nrm = read_accessor(model_, it->second, 3);
-      const UvSet& uv_set = uv_sets_[material];
-      std::string uv_name = "TEXCOORD_" + std::to_string(uv_set.texcoord);
-      if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end())
-        uv = read_accessor(model_, it->second, 2);
-      // COLOR_0: RGB or RGBA (alpha unused while surfaces are opaque), linear
-      std::vector<float> col;
-      int col_comps = 0;
-      if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
-        col = read_accessor(model_, it->second, 0);
-        int type = model_.accessors[it->second].type;
-        if (type != TINYGLTF_TYPE_VEC3 && type != TINYGLTF_TYPE_VEC4)
-          throw Error("glTF COLOR_0 must be VEC3 or VEC4");
-        col_comps = tinygltf::GetNumComponentsInType(type);
-        for (float c : col)
-          if (!(c >= 0.0f && c <= 1.0f))
-            throw Error("glTF COLOR_0 values must lie in [0, 1] (integer colors must be normalized)");
-        if (col.size() / col_comps != nverts)
-          throw Error("glTF primitive attributes have different vertex counts");
-      }
-      if ((!nrm.empty() && nrm.size() != pos.size()) || (!uv.empty() && uv.size() / 2 != nverts))
-        throw Error("glTF primitive attributes have different vertex counts");
-
-      std::vector<uint32_t> indices;
-      if (prim.indices >= 0) {
-        indices = read_indices(model_, prim.indices);
-      } else {
-        for (uint32_t i = 0; i < nverts; ++i) indices.push_back(i);
-      }
-      for (uint32_t i : indices)
-        if (i >= nverts) throw Error("glTF primitive index out of range");
-
-      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
-        if (mirrored) std::swap(b, c);  // a mirroring transform flips the winding
-        SceneTriangle t;
-        uint32_t idx[3] = {a, b, c};
-        for (int k = 0; k < 3; ++k) {
-          uint32_t v = idx[k];
-          t.p[k] = glm::vec3(world * glm::vec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0f));
-          t.n[k] = nrm.empty() ? glm::vec3(0.0f)
-                               : normal_matrix * glm::vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
-          float nl = glm::length(t.n[k]);
-          t.n[k] = nl > 0.0f && std::isfinite(nl) ? t.n[k] / nl : glm::vec3(0.0f);
-          if (!col.empty()) {
-            t.color[k] = glm::vec3(col[col_comps * v], col[col_comps * v + 1], col[col_comps * v + 2]);
-            if (t.color[k] != glm::vec3(1.0f)) scene_->has_vertex_colors = true;
-          }
-          t.uv[k] = uv.empty() ? glm::vec2(0.0f)
-                               : glm::vec2(uv_set.transform * glm::vec3(uv[2 * v], uv[2 * v + 1], 1.0f));
-        }
-        t.material = material;
-        for (const auto& p : t.p)
-          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            throw Error("glTF mesh has non-finite vertex positions");
-        if (!(glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) > 0.0f)) {
-          ++degenerate_;  // zero area: invisible, and it has no normal
-          return;
-        }
-        scene_->triangles.push_back(t);
-      };
-      int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-      if (mode == TINYGLTF_MODE_TRIANGLES) {
-        for (size_t i = 0; i + 2 < indices.size(); i += 3) emit(indices[i], indices[i + 1], indices[i + 2]);
-      } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-        for (size_t i = 0; i + 2 < indices.size(); ++i) {
-          if (i % 2 == 0)
-            emit(indices[i], indices[i + 1], indices[i + 2]);
-          else
-            emit(indices[i + 1], indices[i], indices[i + 2]);
-        }
-      } else {
-        for (size_t i = 1; i + 1 < indices.size(); ++i) emit(indices[i], indices[i + 1], indices[0]);
-      }
-    }
-  }
-
   const tinygltf::Model& model_;
   Scene* scene_;
-  Warnings warn_;
-  std::map<std::pair<int, bool>, int> texture_cache_;
-  std::vector<UvSet> uv_sets_;  // per material: the UVs of its base color texture
-  uint32_t default_material_index_ = 0;
-  size_t degenerate_ = 0;
+  Warnings& warn_;
+  MeshReader meshes_;
   std::vector<bool> visited_;  // nodes reached so far
 };
+
+void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
+  for (const auto& ext : model.extensionsUsed)
+    if (!kSupportedExtensions.count(ext)) warn->add("glTF extension " + ext + " is not supported yet and is ignored");
+  for (const auto& ext : model.extensionsRequired)
+    if (!kSupportedExtensions.count(ext))
+      warn->add("the scene requires glTF extension " + ext + ", which candela does not support: the image may be wrong");
+  if (!model.animations.empty()) warn->add("animations are ignored (the first frame is rendered)");
+  if (!model.skins.empty()) warn->add("skins are ignored (meshes render in their bind pose)");
+}
 
 }  // namespace
 
@@ -575,7 +612,11 @@ Scene load_gltf(const std::string& path) {
     while (!warn.empty() && warn.back() == '\n') warn.pop_back();
     scene.warnings.push_back("glTF loader: " + warn);
   }
-  Loader(model, &scene).load();
+  Warnings warnings(&scene.warnings);
+  warn_model_wide(model, &warnings);
+  MaterialReader(model, &scene, &warnings).read_all();
+  NodeReader(model, &scene, &warnings).read_scene();
+  if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
   return scene;
 }
 

@@ -1,5 +1,6 @@
 #include "program_cache.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -7,6 +8,7 @@
 #include <fstream>
 #include <unistd.h>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "error.hpp"
@@ -60,7 +62,11 @@ std::vector<unsigned char> read_entry(const std::string& path) {
 void write_entry(const std::string& path, const std::vector<unsigned char>& binary) {
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
-  std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  // Unique per process, thread and call: workers of several devices may write at once
+  static std::atomic<uint64_t> counter{0};
+  std::string tmp = path + ".tmp" + std::to_string(::getpid()) + "-" +
+                    std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id())) + "-" +
+                    std::to_string(counter++);
   {
     std::ofstream out(tmp, std::ios::binary);
     if (!out) return;  // an unwritable cache is not an error

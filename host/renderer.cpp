@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <thread>
 
-#include "bvh_builder.hpp"
 #include "error.hpp"
 #include "kernel_sources.hpp"
-#include "light_table.hpp"
 #include "program_cache.hpp"
 
 namespace candela {
@@ -17,48 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-std::vector<dev::TriangleShading> shading_data(const std::vector<SceneTriangle>& tris) {
-  std::vector<dev::TriangleShading> out(tris.size());
-  for (size_t i = 0; i < tris.size(); ++i) {
-    const SceneTriangle& t = tris[i];
-    dev::TriangleShading& s = out[i];
-    s = dev::TriangleShading{};
-    for (int a = 0; a < 3; ++a) {
-      s.n0[a] = t.n[0][a];
-      s.n1[a] = t.n[1][a];
-      s.n2[a] = t.n[2][a];
-    }
-    s.uv0_u = t.uv[0].x;
-    s.uv0_v = t.uv[0].y;
-    s.uv1_u = t.uv[1].x;
-    s.uv1_v = t.uv[1].y;
-    s.uv2_u = t.uv[2].x;
-    s.uv2_v = t.uv[2].y;
-  }
-  return out;
-}
-
-std::vector<dev::TriangleColors> color_data(const std::vector<SceneTriangle>& tris) {
-  std::vector<dev::TriangleColors> out(tris.size());
-  for (size_t i = 0; i < tris.size(); ++i)
-    for (int a = 0; a < 3; ++a) {
-      out[i].c0[a] = tris[i].color[0][a];
-      out[i].c1[a] = tris[i].color[1][a];
-      out[i].c2[a] = tris[i].color[2][a];
-    }
-  return out;
-}
-
-// sRGB 8-bit code to linear value (IEC 61966-2-1), for texture decoding in the kernel
-std::vector<float> srgb_decode_table() {
-  std::vector<float> t(256);
-  for (int i = 0; i < 256; ++i) {
-    double c = i / 255.0;
-    t[i] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-  }
-  return t;
 }
 
 std::string format_mib(uint64_t bytes) {
@@ -79,17 +38,13 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
                 " in one buffer, more than " + device.description() + " allows (" +
                 format_mib(device.max_alloc) + ")");
   try {
-    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T),
-                      const_cast<T*>(src.data()));
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(src.data()));
   } catch (const cl::Error& e) {
     throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
   }
 }
 
-}  // namespace
-
-Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
-    : device_(device), settings_(settings) {
+void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 ||
       settings.height > 65536 || uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
     throw Error("image size must be between 1x1 and 65536x65536 with at most 2^28 pixels");
@@ -97,71 +52,65 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
       device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
     throw Error(device.description() + " supports only " + device.opencl_c_version +
                 "; candela needs OpenCL C 1.2");
+}
 
-  auto bvh_start = Clock::now();
-  Bvh bvh = build_bvh(scene.triangles);
-  std::vector<dev::Triangle> tris = bvh_ordered_triangles(scene.triangles, bvh);
-  LightTable table = build_light_table(tris, scene.materials, scene.emission_texture_means(),
-                                       scene.background, scene.bounds());
-  bvh_build_seconds_ = seconds_since(bvh_start);
-  triangles_ = tris.size();
-  num_lights_ = table.lights.size();
+}  // namespace
 
+DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene,
+                               const RenderSettings& settings)
+    : device_(device), settings_(settings) {
+  check_settings(device, settings);
   try {
     context_ = cl::Context(device_.device);
     queue_ = cl::CommandQueue(context_, device_.device);
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
-  std::string options = "-cl-std=CL1.2 " + scene.features().build_options();
+  std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
   ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
+  const unsigned want_args = dev::kSceneBufferCount + 3;  // + params and the film's two buffers
+  if (kernel_.getInfo<CL_KERNEL_NUM_ARGS>() != want_args)
+    throw Error("render_paths takes " + std::to_string(kernel_.getInfo<CL_KERNEL_NUM_ARGS>()) +
+                " arguments, but the host binds " + std::to_string(want_args) +
+                " (CD_SCENE_BUFFERS out of step with the kernel)");
   local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
 
-  nodes_ = upload(context_, device_, bvh.nodes, "the BVH");
-  tris_ = upload(context_, device_, tris, "triangles");
-  shading_ = upload(context_, device_, shading_data(scene.triangles), "vertex normals and UVs");
-  colors_ = upload(context_, device_, scene.has_vertex_colors ? color_data(scene.triangles)
-                                                              : std::vector<dev::TriangleColors>(),
-                   "vertex colors");
-  materials_ = upload(context_, device_, scene.materials, "materials");
-  textures_ = upload(context_, device_, scene.textures, "texture descriptors");
-  texels_ = upload(context_, device_, scene.texels, "textures");
-  srgb_table_ = upload(context_, device_, srgb_decode_table(), "sRGB table");
-  lights_ = upload(context_, device_, table.lights, "lights");
-  light_thresholds_ = upload(context_, device_, table.thresholds, "the light table");
+#define CD_UPLOAD(type, name) scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));
+  CD_SCENE_BUFFERS(CD_UPLOAD)
+#undef CD_UPLOAD
 
-  CameraDesc cam = resolve_camera(scene);
-  params_host_.camera = make_device_camera(cam, settings.width, settings.height);
-  for (int c = 0; c < 3; ++c) params_host_.background[c] = scene.background[c];
+  params_host_.camera = make_device_camera(scene.camera, settings.width, settings.height);
   params_host_.width = uint32_t(settings.width);
   params_host_.height = uint32_t(settings.height);
   params_host_.seed = settings.seed;
   params_host_.max_depth = settings.max_depth;
   params_host_.rr_depth = settings.rr_depth;
   params_host_.strategy = uint32_t(settings.strategy);
-  params_host_.num_lights = uint32_t(table.lights.size());
+  params_host_.num_lights = uint32_t(scene.buffers.lights.size());
+  params_host_.environment_light = scene.environment_light;
 
-  size_t film_bytes = size_t(settings.width) * settings.height * 4 * sizeof(float);
+  size_t pixels = size_t(settings.width) * settings.height;
+  chunk_ = std::min(pixels, std::max<size_t>(local_size_, 4096));
+  size_t film_bytes = pixels * 4 * sizeof(float);
   try {
     params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
     film_mean_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
     film_m2_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
     queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
     queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
-    int arg = 0;
-    for (cl::Buffer* b : {&nodes_, &tris_, &shading_, &colors_, &materials_, &textures_, &texels_, &srgb_table_, &lights_,
-                          &light_thresholds_, &params_, &film_mean_, &film_m2_})
-      kernel_.setArg(arg++, *b);
+    cl_uint arg = 0;
+    for (const cl::Buffer& b : scene_buffers_) kernel_.setArg(arg++, b);
+    for (const cl::Buffer* b : {&params_, &film_mean_, &film_m2_}) kernel_.setArg(arg++, *b);
     queue_.finish();
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("allocating the film", e.err()));
   }
 }
 
-void Renderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end) {
+void DeviceRenderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end) {
   params_host_.sample_begin = sample_begin;
   params_host_.sample_count = count;
   params_host_.pixel_begin = uint32_t(pixel_begin);
@@ -170,76 +119,44 @@ void Renderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin,
     queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
     // Work-groups of local_size_ work-items; the kernel skips the padding at the end
     size_t global = (pixel_end - pixel_begin + local_size_ - 1) / local_size_ * local_size_;
-    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global),
-                                cl::NDRange(local_size_));
+    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(local_size_));
     queue_.finish();
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("running the path tracing kernel", e.err()));
   }
 }
 
-RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_limit,
-                              const std::function<void(const RenderProgress&)>& progress,
-                              const std::function<bool()>& stop) {
-  if (spp == 0 && !(time_limit > 0.0)) throw Error("render needs a sample count or a time limit");
-  auto start = Clock::now();
-  RenderProgress p;
-  p.spp_target = spp;
-  p.time_limit = time_limit;
-  RenderResult result;
+bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
+                                  const std::function<void(double)>& progress) {
   const size_t pixels = size_t(settings_.width) * settings_.height;
-  // The film counts samples in floats: a time-limited render stops at 2^24 per pixel
-  const uint32_t limit = spp > 0 ? spp : kMaxSamplesPerPixel;
-  // A pass adds `batch` samples to every pixel, in launches of at most `chunk` pixels,
-  // each sized to take about launch_seconds (GPU watchdogs, progress, Ctrl-C)
-  uint32_t batch = 1;
-  size_t chunk = std::min(pixels, std::max<size_t>(local_size_, 4096));
-  double cost = 0.0;  // seconds per pixel sample, from the last launch (sizes chunks)
-  auto out_of_time = [&] { return spp == 0 && seconds_since(start) >= time_limit; };
-  while (p.spp_done < limit && !result.interrupted) {
-    batch = std::min(batch, limit - p.spp_done);
-    double pass_seconds = 0.0;
-    for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
-      bool stopped = stop && stop();
-      // A time limit ends a pass early only once a whole pass exists to show
-      if (stopped || (begin > 0 && p.spp_done > 0 && out_of_time())) {
-        // Pixels before `begin` keep one batch more than the others (exact per-pixel
-        // counts live in the film)
-        result.interrupted = stopped;
-        result.partial_pass = begin > 0;
-        break;
-      }
-      end = std::min(pixels, begin + chunk);
-      auto t0 = Clock::now();
-      launch(sample_begin + p.spp_done, batch, begin, end);
-      double dt = seconds_since(t0);
-      pass_seconds += dt;
-      cost = dt / (double(end - begin) * batch);
-      size_t want = size_t(settings_.launch_seconds / std::max(cost * batch, 1e-12));
-      chunk = std::clamp((want + local_size_ - 1) / local_size_ * local_size_,
-                         std::min(local_size_, pixels), pixels);
-      if (end < pixels && progress) {
-        p.spp_partial = batch * double(end) / double(pixels);
-        p.seconds = seconds_since(start);
-        progress(p);
-      }
-    }
-    p.spp_partial = 0.0;
-    if (result.interrupted || result.partial_pass) break;
-    p.spp_done += batch;
-    p.seconds = seconds_since(start);
-    if (progress) progress(p);
-    if (out_of_time()) break;
-    // Next pass: whole-image launches of several samples once one sample is cheap enough
-    double pass = pass_seconds / batch;  // one sample of the whole image
-    double want = settings_.launch_seconds / std::max(pass, 1e-12);
-    batch = uint32_t(std::clamp(want, 1.0, std::min(2.0 * batch, 4096.0)));
-    if (spp == 0) batch = uint32_t(std::clamp((time_limit - p.seconds) / std::max(pass, 1e-12), 1.0, double(batch)));
-    if (want >= 1.0) chunk = pixels;
+  double seconds = 0.0;
+  for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
+    if (begin > 0 && stop && stop()) return false;
+    end = std::min(pixels, begin + chunk_);
+    auto t0 = Clock::now();
+    launch(sample_begin, count, begin, end);
+    double dt = seconds_since(t0);
+    seconds += dt;
+    // Next launch: about launch_seconds of pixels at the measured cost
+    double cost = dt / (double(end - begin) * count);
+    size_t want = size_t(settings_.launch_seconds / std::max(cost * count, 1e-12));
+    chunk_ = std::clamp((want + local_size_ - 1) / local_size_ * local_size_, std::min(local_size_, pixels), pixels);
+    if (end < pixels && progress) progress(double(end) / double(pixels));
   }
-  result.spp = p.spp_done;
-  result.seconds = seconds_since(start);
+  // Next range: whole-image launches of several samples once one sample is cheap enough
+  pass_seconds_ = seconds / count;
+  double want = settings_.launch_seconds / std::max(pass_seconds_, 1e-12);
+  batch_ = uint32_t(std::clamp(want, 1.0, std::min(2.0 * count, 4096.0)));
+  if (want >= 1.0) chunk_ = pixels;
+  return true;
+}
 
+uint32_t DeviceRenderer::suggested_batch(double seconds_left) const {
+  if (pass_seconds_ <= 0.0) return batch_;
+  return uint32_t(std::clamp(seconds_left / pass_seconds_, 1.0, double(batch_)));
+}
+
+Film DeviceRenderer::film() {
   Film film(settings_.width, settings_.height);
   try {
     queue_.enqueueReadBuffer(film_mean_, CL_TRUE, 0, film.mean.size() * sizeof(float), film.mean.data());
@@ -247,8 +164,132 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("reading back the film", e.err()));
   }
-  result.film = std::move(film);
+  return film;
+}
+
+namespace {
+
+// Hands out disjoint ranges of sample indices to the workers and keeps the count of
+// samples that every pixel has received
+class SampleScheduler {
+ public:
+  SampleScheduler(uint32_t spp, double time_limit, size_t workers)
+      : limit_(spp > 0 ? spp : kMaxSamplesPerPixel), time_limit_(spp > 0 ? 0.0 : time_limit),
+        partial_(workers, 0.0), start_(Clock::now()) {}
+
+  // The next range (offsets from the render's first sample) for a worker that wants
+  // `want` samples per pixel; false when the render is over
+  bool take(DeviceRenderer* w, uint32_t* begin, uint32_t* count) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (ended_ || next_ >= limit_ || out_of_time()) return false;
+    *begin = next_;
+    *count = std::min(w->suggested_batch(time_limit_ > 0 ? time_limit_ - seconds() : 1e30), limit_ - next_);
+    next_ += *count;
+    return true;
+  }
+
+  // A time limit ends the render only once every pixel has a sample
+  bool out_of_time() const { return time_limit_ > 0.0 && done_ > 0 && seconds() >= time_limit_; }
+  bool out_of_time_locked() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return out_of_time();
+  }
+
+  void finish(size_t worker, uint32_t count, bool whole, bool interrupted) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    partial_[worker] = 0.0;
+    if (whole) done_ += count;
+    if (!whole) partial_pass_ = ended_ = true;
+    if (interrupted) interrupted_ = ended_ = true;
+  }
+
+  void report(size_t worker, double spp_partial, const std::function<void(const RenderProgress&)>& progress,
+              uint32_t spp) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    partial_[worker] = spp_partial;
+    if (!progress) return;
+    RenderProgress p;
+    p.spp_done = done_;
+    for (double v : partial_) p.spp_partial += v;
+    p.spp_target = spp;
+    p.time_limit = time_limit_;
+    p.seconds = seconds();
+    progress(p);
+  }
+
+  double seconds() const { return seconds_since(start_); }
+  uint32_t done() const { return done_; }
+  bool interrupted() const { return interrupted_; }
+  bool partial_pass() const { return partial_pass_; }
+
+ private:
+  std::mutex mutex_;
+  const uint32_t limit_;
+  const double time_limit_;
+  std::vector<double> partial_;
+  Clock::time_point start_;
+  uint32_t next_ = 0, done_ = 0;
+  bool ended_ = false, interrupted_ = false, partial_pass_ = false;
+};
+
+}  // namespace
+
+RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin, uint32_t spp,
+                            double time_limit, const std::function<void(const RenderProgress&)>& progress,
+                            const std::function<bool()>& stop) {
+  if (workers.empty()) throw Error("render_samples needs a device");
+  if (spp == 0 && !(time_limit > 0.0)) throw Error("render needs a sample count or a time limit");
+  SampleScheduler sched(spp, time_limit, workers.size());
+  std::vector<std::exception_ptr> errors(workers.size());
+  auto work = [&](size_t i) {
+    try {
+      DeviceRenderer* w = workers[i];
+      uint32_t begin, count;
+      while (sched.take(w, &begin, &count)) {
+        bool stopped = false;
+        auto should_stop = [&] { return (stopped = stop && stop()) || sched.out_of_time_locked(); };
+        bool whole = w->render_range(sample_begin + begin, count, should_stop,
+                                     [&](double f) { sched.report(i, f * count, progress, spp); });
+        sched.finish(i, count, whole, stopped);
+        sched.report(i, 0.0, progress, spp);
+        if (stop && stop()) sched.finish(i, 0, true, true);
+      }
+    } catch (...) {
+      errors[i] = std::current_exception();
+      sched.finish(i, 0, true, true);
+    }
+  };
+  if (workers.size() == 1) {
+    work(0);
+  } else {
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < workers.size(); ++i) threads.emplace_back(work, i);
+    for (auto& t : threads) t.join();
+  }
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+
+  RenderResult result;
+  result.spp = sched.done();
+  result.seconds = sched.seconds();
+  result.interrupted = sched.interrupted();
+  result.partial_pass = sched.partial_pass();
+  result.film = workers[0]->film();
+  for (size_t i = 1; i < workers.size(); ++i) result.film = merge_films(result.film, workers[i]->film());
   return result;
+}
+
+Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
+    : Renderer(device, std::make_shared<const CompiledScene>(compile_scene(scene)), settings) {}
+
+Renderer::Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+                   const RenderSettings& settings)
+    : scene_(std::move(scene)), worker_(device, *scene_, settings) {}
+
+RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_limit,
+                              const std::function<void(const RenderProgress&)>& progress,
+                              const std::function<bool()>& stop) {
+  return render_samples({&worker_}, sample_begin, spp, time_limit, progress, stop);
 }
 
 }  // namespace candela

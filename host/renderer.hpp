@@ -1,15 +1,20 @@
-// Runs the megakernel on one device: uploads the scene, launches sample batches sized to
-// a target duration, and reads back the film.
+// Rendering a compiled scene: a DeviceRenderer per device (context, queue, program,
+// buffers, film) renders given ranges of sample indices; render_samples hands ranges out
+// to one or more of them and merges their films. Renderer bundles the common case: one
+// scene, compiled once, on one device.
 #pragma once
 
 #include <CL/opencl.hpp>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "device.hpp"
 #include "film.hpp"
 #include "scene.hpp"
+#include "scene_compiler.hpp"
 
 namespace candela {
 
@@ -29,7 +34,7 @@ struct RenderSettings {
 
 struct RenderProgress {
   uint32_t spp_done = 0;
-  double spp_partial = 0.0;  // fraction of the pass under way, in samples per pixel
+  double spp_partial = 0.0;  // samples per pixel of the ranges under way
   uint32_t spp_target = 0;  // 0 when rendering for a time budget
   double seconds = 0.0;
   double time_limit = 0.0;
@@ -40,28 +45,29 @@ struct RenderResult {
   uint32_t spp = 0;  // samples every pixel received
   double seconds = 0.0;
   bool interrupted = false;  // stopped by the caller
-  bool partial_pass = false;  // stopped inside a pass: some pixels hold one batch more
+  bool partial_pass = false;  // stopped inside a range: some pixels hold more samples
 };
 
-class Renderer {
+// One device's worker: renders ranges of sample indices of a compiled scene into its film
+class DeviceRenderer {
  public:
-  // Builds the BVH, light table and kernel program and uploads the scene.
-  Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
+  // Builds the kernel program for the scene's features and uploads the scene buffers
+  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings);
 
-  // Renders sample indices [sample_begin, sample_begin + spp) of every pixel, or for
-  // time_limit seconds when spp == 0. `stop` is polled between launches; a stopped
-  // render keeps the samples already done. After a result with partial_pass, some
-  // pixels already hold sample indices from sample_begin + result.spp on: do not
-  // resume that film from there.
-  RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
-                      const std::function<void(const RenderProgress&)>& progress = {},
-                      const std::function<bool()>& stop = {});
+  // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
+  // of about settings.launch_seconds over ranges of pixels. `stop` is polled between
+  // launches; returns false when it stopped the range part way (some pixels then hold
+  // the range's samples, the others not). `progress` gets the fraction of the range done.
+  bool render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
+                    const std::function<void(double)>& progress);
 
+  // Samples per pixel for the next range: about launch_seconds of work once measured,
+  // and no more than fit in `seconds_left`
+  uint32_t suggested_batch(double seconds_left) const;
+
+  Film film();  // reads the film back from the device
   double kernel_build_seconds() const { return kernel_build_seconds_; }
   bool kernel_from_cache() const { return kernel_from_cache_; }
-  double bvh_build_seconds() const { return bvh_build_seconds_; }
-  size_t triangles() const { return triangles_; }
-  size_t lights() const { return num_lights_; }
   const DeviceEntry& device() const { return device_; }
 
  private:
@@ -72,14 +78,50 @@ class Renderer {
   cl::Context context_;
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
-  cl::Buffer nodes_, tris_, shading_, colors_, materials_, textures_, texels_, srgb_table_, lights_,
-      light_thresholds_;
+  std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
-  double kernel_build_seconds_ = 0.0, bvh_build_seconds_ = 0.0;
+  size_t chunk_ = 1;  // pixels per launch
+  uint32_t batch_ = 1;  // samples per pixel for the next range
+  double pass_seconds_ = 0.0;  // one sample of every pixel, measured; 0 = not yet
+  double kernel_build_seconds_ = 0.0;
   bool kernel_from_cache_ = false;
-  size_t triangles_ = 0, num_lights_ = 0;
+};
+
+// Renders sample indices [sample_begin, sample_begin + spp) of every pixel, or for
+// time_limit seconds when spp == 0, handing ranges out to the workers (one thread each)
+// and merging their films by sample count. A time limit never ends the first range.
+// `stop` is polled between launches; a stopped render keeps the samples already done.
+// After a result with partial_pass, some pixels already hold sample indices from
+// sample_begin + result.spp on: do not resume that film from there.
+RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin,
+                            uint32_t spp, double time_limit = 0.0,
+                            const std::function<void(const RenderProgress&)>& progress = {},
+                            const std::function<bool()>& stop = {});
+
+// A scene compiled once and rendered on one device
+class Renderer {
+ public:
+  Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
+  Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+           const RenderSettings& settings);
+
+  RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
+                      const std::function<void(const RenderProgress&)>& progress = {},
+                      const std::function<bool()>& stop = {});
+
+  const CompiledScene& scene() const { return *scene_; }
+  DeviceRenderer& worker() { return worker_; }
+  double kernel_build_seconds() const { return worker_.kernel_build_seconds(); }
+  bool kernel_from_cache() const { return worker_.kernel_from_cache(); }
+  double bvh_build_seconds() const { return scene_->bvh_build_seconds; }
+  size_t triangles() const { return scene_->triangles; }
+  size_t lights() const { return scene_->buffers.lights.size(); }
+
+ private:
+  std::shared_ptr<const CompiledScene> scene_;
+  DeviceRenderer worker_;
 };
 
 }  // namespace candela

@@ -5,60 +5,72 @@
 namespace candela {
 
 std::string SceneFeatures::build_options() const {
-  return std::string("-DCD_FEATURE_TEXTURES=") + (textures ? "1" : "0") +
-         " -DCD_FEATURE_VERTEX_COLORS=" + (vertex_colors ? "1" : "0");
+  auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
+  return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
+         flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors);
+}
+
+double TextureDesc::mean_luminance() const {
+  size_t n = texels();
+  if (n == 0) return 0.0;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    float c[3];
+    for (int k = 0; k < 3; ++k) {
+      if (!rgbaf.empty()) {
+        c[k] = rgbaf[4 * i + k];
+      } else {
+        float v = rgba8[4 * i + k] / 255.0f;
+        c[k] = srgb ? dev::srgb_to_linear(v) : v;
+      }
+    }
+    sum += dev::luminance_rgb(c[0], c[1], c[2]);
+  }
+  return sum / double(n);
+}
+
+size_t Scene::triangles() const {
+  size_t n = 0;
+  for (const auto& m : meshes) n += m.triangles();
+  return n;
 }
 
 Bounds Scene::bounds() const {
   Bounds b;
-  for (const auto& t : triangles)
-    for (const auto& p : t.p) b.grow(p);
+  for (const auto& m : meshes)
+    for (const auto& p : m.positions) b.grow(p);
   return b;
-}
-
-std::vector<double> Scene::emission_texture_means() const {
-  std::vector<bool> emissive(textures.size(), false);
-  for (const auto& m : materials)
-    if (m.emission_texture != NO_TEXTURE) emissive[size_t(m.emission_texture)] = true;
-  std::vector<double> means;
-  auto decode = [](uint8_t v, bool srgb) {
-    double c = v / 255.0;
-    return srgb ? (c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4)) : c;
-  };
-  for (size_t k = 0; k < textures.size(); ++k) {
-    const dev::TextureInfo& t = textures[k];
-    if (!emissive[k]) {
-      means.push_back(0.0);
-      continue;
-    }
-    bool srgb = t.flags & TEXTURE_SRGB;
-    size_t n = size_t(t.width) * t.height;
-    double sum = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      const uint8_t* c = &texels[4 * (size_t(t.offset) + i)];
-      sum += 0.2126 * decode(c[0], srgb) + 0.7152 * decode(c[1], srgb) + 0.0722 * decode(c[2], srgb);
-    }
-    means.push_back(n ? sum / n : 0.0);
-  }
-  return means;
 }
 
 SceneFeatures Scene::features() const {
   SceneFeatures f;
-  f.vertex_colors = has_vertex_colors;
   for (const auto& m : materials)
-    f.textures |= m.base_color_texture != NO_TEXTURE || m.emission_texture != NO_TEXTURE;
+    f.textures |= m.base_color_texture.index != NO_TEXTURE || m.emission_texture.index != NO_TEXTURE;
+  for (const auto& m : meshes) {
+    f.uvs |= !m.uv0.empty() || !m.uv1.empty();
+    f.tangents |= !m.tangents.empty();
+    for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
+  }
   return f;
 }
 
 bool Scene::has_emission() const {
-  std::vector<double> means = emission_texture_means();
-  for (const auto& m : materials) {
-    bool factor = m.emission[0] > 0.0f || m.emission[1] > 0.0f || m.emission[2] > 0.0f;
-    if (factor && (m.emission_texture == NO_TEXTURE || means[size_t(m.emission_texture)] > 0.0))
-      return true;
+  if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) return true;
+  for (const auto& mesh : meshes) {
+    const MaterialDesc& m = materials.at(mesh.material);
+    bool factor = m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;
+    int tex = m.emission_texture.index;
+    if (factor && (tex == NO_TEXTURE || textures.at(size_t(tex)).mean_luminance() > 0.0)) return true;
   }
   return false;
+}
+
+glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                               double* area) {
+  glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+  double len = glm::length(n);
+  *area = 0.5 * len;
+  return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
 }
 
 CameraDesc resolve_camera(const Scene& scene) {

@@ -1,4 +1,5 @@
-// Host-side scene: what the glTF loader produces and the renderer uploads.
+// Host-side scene description: what the glTF loader produces and the scene compiler
+// (scene_compiler.hpp) turns into device records.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -10,12 +11,46 @@
 
 namespace candela {
 
-struct SceneTriangle {
-  glm::vec3 p[3];
-  glm::vec3 n[3];  // zero: use the flat geometric normal
-  glm::vec2 uv[3];
-  glm::vec3 color[3] = {glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(1.0f)};  // COLOR_0
+// One texture slot of a material: texture, TEXCOORD_n, KHR_texture_transform
+struct TextureRef {
+  int index = NO_TEXTURE;  // into Scene::textures
+  int texcoord = 0;  // 0 or 1
+  glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
+  bool operator==(const TextureRef& o) const {
+    return index == o.index && texcoord == o.texcoord && transform == o.transform;
+  }
+};
+
+struct MaterialDesc {
+  uint32_t type = MATERIAL_DIFFUSE;
+  glm::vec4 base_color{1.0f};  // linear rgba factor
+  TextureRef base_color_texture;
+  glm::vec3 emission{0.0f};  // radiance: emissiveFactor x emissive strength
+  TextureRef emission_texture;
+  bool double_sided = false;
+};
+
+struct TextureDesc {
+  int width = 0, height = 0;
+  uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
+  bool srgb = false;  // rgba8 holds sRGB-encoded colour (alpha linear)
+  std::vector<uint8_t> rgba8;  // 4 per texel, or
+  std::vector<float> rgbaf;  // 4 per texel (float images)
+  size_t texels() const { return size_t(width) * height; }
+  // Mean luminance of the decoded texels
+  double mean_luminance() const;
+};
+
+// One glTF primitive placed in the world: vertex arrays (world space) and triangles
+struct MeshDesc {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;  // per vertex, unit or zero (flat); empty: all flat
+  std::vector<glm::vec2> uv0, uv1;  // TEXCOORD_0/1 as stored; empty when absent
+  std::vector<glm::vec4> tangents;  // xyz world-space tangent, w handedness; empty when absent
+  std::vector<glm::vec3> colors;  // COLOR_0 rgb, linear; empty when absent
+  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise = front
   uint32_t material = 0;
+  size_t triangles() const { return indices.size() / 3; }
 };
 
 struct CameraDesc {
@@ -43,28 +78,31 @@ struct Bounds {
 
 // Coarse scene features that select kernel code at build time (part of the cache key)
 struct SceneFeatures {
-  bool textures = false;
-  bool vertex_colors = false;
+  bool textures = false;  // some material slot has a texture
+  bool uvs = false;  // some mesh has TEXCOORD_0 or TEXCOORD_1
+  bool tangents = false;  // some mesh has TANGENT
+  bool vertex_colors = false;  // some COLOR_0 is not white
   std::string build_options() const;
 };
 
 struct Scene {
-  std::vector<SceneTriangle> triangles;
-  std::vector<dev::Material> materials;
-  std::vector<dev::TextureInfo> textures;
-  std::vector<uint8_t> texels;  // RGBA8, 4 bytes per texel (TextureInfo::flags: encoding)
-  bool has_vertex_colors = false;  // some triangle's colors are not white
+  std::vector<MeshDesc> meshes;
+  std::vector<MaterialDesc> materials;
+  std::vector<TextureDesc> textures;
   std::optional<CameraDesc> camera;
-  glm::vec3 background{0.0f};
+  glm::vec3 background{0.0f};  // constant environment radiance
   std::vector<std::string> warnings;  // each unsupported feature named once
 
+  size_t triangles() const;
   Bounds bounds() const;
-  // Mean luminance (sRGB decoded where flagged) of each texture used as an emissive
-  // texture; 0 for the others, which are not read
-  std::vector<double> emission_texture_means() const;
   SceneFeatures features() const;
-  bool has_emission() const;
+  bool has_emission() const;  // some triangle or the background emits
 };
+
+// Unit normal of triangle (a, b, c) by its counter-clockwise winding; *area gets its area
+// (the host twin of triangle_normal_area in cl/geometry.cl)
+glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                               double* area);
 
 // Camera for an image of width x height: the scene's, else one framing the bounds
 CameraDesc resolve_camera(const Scene& scene);

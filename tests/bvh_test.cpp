@@ -13,6 +13,28 @@
 namespace candela::test {
 namespace {
 
+struct Tri {
+  glm::vec3 p[3];
+};
+
+// Triangle soup as vertex positions and primitives (prim i = tris[i]), and its BVH
+struct Soup {
+  std::vector<float> positions;
+  std::vector<dev::Prim> prims;
+  Bvh bvh;
+  explicit Soup(const std::vector<Tri>& tris) {
+    for (const Tri& t : tris) {
+      dev::Prim p{};
+      for (int k = 0; k < 3; ++k) {
+        p.v[k] = uint32_t(positions.size() / 3);
+        for (int a = 0; a < 3; ++a) positions.push_back(t.p[k][a]);
+      }
+      prims.push_back(p);
+    }
+    bvh = build_bvh(positions, prims);
+  }
+};
+
 struct HostHit {
   double t = INFINITY;
   int tri = -1;
@@ -20,7 +42,7 @@ struct HostHit {
 };
 
 // Moller-Trumbore in double precision over every triangle
-HostHit host_closest_hit(const std::vector<SceneTriangle>& tris, glm::dvec3 o, glm::dvec3 d, double tmax) {
+HostHit host_closest_hit(const std::vector<Tri>& tris, glm::dvec3 o, glm::dvec3 d, double tmax) {
   HostHit best;
   best.t = tmax;
   for (size_t i = 0; i < tris.size(); ++i) {
@@ -41,8 +63,8 @@ HostHit host_closest_hit(const std::vector<SceneTriangle>& tris, glm::dvec3 o, g
   return best;
 }
 
-SceneTriangle make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
-  SceneTriangle t{};
+Tri make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  Tri t;
   t.p[0] = a;
   t.p[1] = b;
   t.p[2] = c;
@@ -50,7 +72,7 @@ SceneTriangle make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
 }
 
 // Closed icosphere with shared vertices: every edge belongs to two triangles
-std::vector<SceneTriangle> icosphere(int subdivisions, glm::vec3 center, float radius) {
+std::vector<Tri> icosphere(int subdivisions, glm::vec3 center, float radius) {
   const float p = 1.6180339887f;
   std::vector<glm::vec3> v = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
                               {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
@@ -74,7 +96,7 @@ std::vector<SceneTriangle> icosphere(int subdivisions, glm::vec3 center, float r
     }
     f = nf;
   }
-  std::vector<SceneTriangle> out;
+  std::vector<Tri> out;
   for (auto t : f) out.push_back(make_tri(center + radius * v[t.x], center + radius * v[t.y], center + radius * v[t.z]));
   return out;
 }
@@ -85,13 +107,13 @@ struct GpuTrace {
 };
 
 // rays: pairs (org + tmax, dir)
-GpuTrace trace(KernelRig& rig, const std::vector<SceneTriangle>& scene, const Bvh& bvh,
-               const std::vector<cl_float4>& rays) {
-  auto tris = bvh_ordered_triangles(scene, bvh);
+GpuTrace trace(KernelRig& rig, const Bvh& bvh, const std::vector<cl_float4>& rays) {
+  const auto& tris = bvh.tris;
   size_t n = rays.size() / 2;
   cl::Buffer nodes(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bvh.nodes.size() * sizeof(dev::BvhNode),
                    const_cast<dev::BvhNode*>(bvh.nodes.data()));
-  cl::Buffer tri_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, tris.size() * sizeof(dev::Triangle), tris.data());
+  cl::Buffer tri_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, tris.size() * sizeof(dev::BvhTriangle),
+                     const_cast<dev::BvhTriangle*>(tris.data()));
   cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4),
                      const_cast<cl_float4*>(rays.data()));
   cl::Buffer out_bvh(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
@@ -129,17 +151,18 @@ class BvhTest : public ::testing::TestWithParam<std::string> {};
 TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<SceneTriangle> tris;
+  std::vector<Tri> tris;
   for (int i = 0; i < 5000; ++i) {
     glm::vec3 c(u(rng), u(rng), u(rng));
     tris.push_back(make_tri(c, c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.05f * glm::vec3(u(rng), u(rng), u(rng))));
   }
   // Many copies of one triangle: no spatial split exists
   for (int i = 0; i < 100; ++i) tris.push_back(tris[0]);
-  Bvh bvh = build_bvh(tris);
+  Bvh bvh = Soup(tris).bvh;
   EXPECT_LE(bvh.depth, kMaxBvhDepth);
+  ASSERT_EQ(bvh.tris.size(), tris.size());
   std::vector<int> seen(tris.size(), 0);
-  for (uint32_t o : bvh.order) seen[o]++;
+  for (const auto& t : bvh.tris) seen[t.prim]++;
   for (int s : seen) ASSERT_EQ(s, 1);
   std::vector<int> covered(tris.size(), 0);
   for (size_t n = 0; n < bvh.nodes.size(); ++n) {
@@ -152,7 +175,7 @@ TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
     if (node.right < 0) {
       for (int i = node.left; i < node.left - node.right; ++i) {
         covered[i]++;
-        for (const auto& p : tris[bvh.order[i]].p) ASSERT_TRUE(inside(p));
+        for (const auto& p : tris[bvh.tris[i].prim].p) ASSERT_TRUE(inside(p));
       }
     } else {
       for (int c : {node.left, node.right})
@@ -171,13 +194,13 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
   KernelRig rig(device);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<SceneTriangle> scene = icosphere(2, glm::vec3(0.3f, -0.2f, 0.1f), 0.6f);
+  std::vector<Tri> scene = icosphere(2, glm::vec3(0.3f, -0.2f, 0.1f), 0.6f);
   for (int i = 0; i < 2000; ++i) {
     glm::vec3 c(u(rng), u(rng), u(rng));
     float s = 0.02f + 0.15f * std::fabs(u(rng));
     scene.push_back(make_tri(c, c + s * glm::vec3(u(rng), u(rng), u(rng)), c + s * glm::vec3(u(rng), u(rng), u(rng))));
   }
-  Bvh bvh = build_bvh(scene);
+  Bvh bvh = Soup(scene).bvh;
   std::vector<cl_float4> rays;
   for (int i = 0; i < 20000; ++i) {
     glm::vec3 o = 1.5f * glm::vec3(u(rng), u(rng), u(rng));
@@ -187,7 +210,7 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
     rays.push_back(f4(o, tmax));
     rays.push_back(f4(d, 0));
   }
-  GpuTrace gpu = trace(rig, scene, bvh, rays);
+  GpuTrace gpu = trace(rig, bvh, rays);
   int hits = 0, checked = 0;
   for (size_t i = 0; i < rays.size() / 2; ++i) {
     glm::dvec3 o(rays[2 * i].s[0], rays[2 * i].s[1], rays[2 * i].s[2]);
@@ -204,7 +227,7 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
     if (ref.tri < 0) continue;
     ++hits;
     EXPECT_NEAR(h.s[0], ref.t, 1e-5 * (1.0 + ref.t)) << "ray " << i;
-    int kernel_tri = int(bvh.order[int(h.s[3])]);
+    int kernel_tri = int(h.s[3]);  // stable primitive index
     if (kernel_tri != ref.tri) {
       // Another triangle at the same distance (overlapping soup): accept only a tie
       HostHit alt = host_closest_hit({scene[kernel_tri]}, o, d, INFINITY);
@@ -220,8 +243,8 @@ TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
   CANDELA_DEVICE_OR_SKIP(GetParam(), device);
   KernelRig rig(device);
   glm::vec3 center(0.1f, 0.2f, -0.3f);
-  std::vector<SceneTriangle> sphere = icosphere(3, center, 2.0f);
-  Bvh bvh = build_bvh(sphere);
+  std::vector<Tri> sphere = icosphere(3, center, 2.0f);
+  Bvh bvh = Soup(sphere).bvh;
   // From points inside, aim exactly at every vertex and every edge midpoint
   std::vector<glm::vec3> origins = {center, center + glm::vec3(0.3f, -0.5f, 0.2f), center + glm::vec3(-1.1f, 0.4f, 0.6f)};
   std::vector<cl_float4> rays;
@@ -233,7 +256,7 @@ TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
           rays.push_back(f4(glm::normalize(target - o), 0));
         }
       }
-  GpuTrace gpu = trace(rig, sphere, bvh, rays);
+  GpuTrace gpu = trace(rig, bvh, rays);
   int leaks = 0;
   for (size_t i = 0; i < rays.size() / 2; ++i) {
     const cl_float4& h = gpu.bvh_hits[i];

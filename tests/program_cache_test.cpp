@@ -43,7 +43,7 @@ class ScopedCacheDir {
 
 bool kernel_runs(const cl::Context& ctx, const DeviceEntry& d, cl::Program& program) {
   cl::CommandQueue q(ctx, d.device);
-  cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, 16 * sizeof(cl_uint));
+  cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, 256 * sizeof(cl_uint));  // room for all of CD_LAYOUT
   cl::Kernel k(program, "test_struct_layout");
   k.setArg(0, out);
   q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));

@@ -194,7 +194,7 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   const float eye[3] = {0.0f, 1.2f, 0.01f}, target[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
   write_quads_gltf(dir + "emissive-texture.gltf", quads, materials, eye, target, 1.2f, bg, extra);
   Scene scene = load_gltf(dir + "emissive-texture.gltf");
-  ASSERT_NE(scene.materials[1].emission_texture, NO_TEXTURE);
+  ASSERT_NE(scene.materials[1].emission_texture.index, NO_TEXTURE);
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 2;

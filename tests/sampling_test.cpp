@@ -6,7 +6,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 
-#include "light_table.hpp"
+#include "scene_compiler.hpp"
 #include "stats.hpp"
 #include "test_support.hpp"
 

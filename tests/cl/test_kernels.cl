@@ -1,31 +1,17 @@
 // Test kernels: thin wrappers that run the real cl/ routines on inputs from the host.
 
-// Sizes and offsets of the shared structs as the device compiler lays them out
-#define OFFSET_OF(object, field) ((uint)((char*)&(object).field - (char*)&(object)))
+// Sizes and offsets of the shared structs as the device compiler lays them out, in the
+// order of CD_LAYOUT (device_types.h), the list the host's static_asserts come from
+#define TEST_LAYOUT_SIZE(type, bytes) out[n++] = (uint)sizeof(type);
+#define TEST_LAYOUT_FIELD(type, field, offset) \
+  {                                            \
+    type object;                               \
+    out[n++] = (uint)((char*)&object.field - (char*)&object); \
+  }
 __kernel void test_struct_layout(__global uint* out) {
   if (get_global_id(0) != 0) return;
-  BvhNode node;
-  Triangle tri;
-  TriangleShading shading;
-  Material material;
-  Light light;
-  RenderParams params;
-  out[0] = sizeof(BvhNode);
-  out[1] = sizeof(Triangle);
-  out[2] = sizeof(TriangleShading);
-  out[3] = sizeof(Material);
-  out[4] = sizeof(TextureInfo);
-  out[5] = sizeof(Light);
-  out[6] = sizeof(Camera);
-  out[7] = sizeof(RenderParams);
-  out[8] = OFFSET_OF(node, right);
-  out[9] = OFFSET_OF(tri, v2);
-  out[10] = OFFSET_OF(shading, uv2_v);
-  out[11] = OFFSET_OF(material, emission);
-  out[12] = OFFSET_OF(light, radiance);
-  out[13] = OFFSET_OF(params, background);
-  out[14] = OFFSET_OF(params, strategy);
-  out[15] = OFFSET_OF(params, rr_depth);
+  uint n = 0u;
+  CD_LAYOUT(TEST_LAYOUT_SIZE, TEST_LAYOUT_FIELD)
 }
 
 __kernel void test_rng_uniform(uint seed, __global float* out) {
@@ -55,7 +41,7 @@ __kernel void test_sample_triangle(uint seed, float4 v1, float4 v2, float4 v3,
 }
 
 // rays: (org, tmax) then (dir, 0); out: (t, b1, b2, tri) closest hit, occluded flag
-__kernel void test_trace_bvh(__global const BvhNode* nodes, __global const Triangle* tris,
+__kernel void test_trace_bvh(__global const BvhNode* nodes, __global const BvhTriangle* tris,
                              __global const float4* rays, __global float4* out,
                              __global int* occluded) {
   uint i = get_global_id(0);
@@ -64,12 +50,12 @@ __kernel void test_trace_bvh(__global const BvhNode* nodes, __global const Trian
   r.dir = rays[2 * i + 1].xyz;
   float tmax = rays[2 * i].w;
   Hit h = bvh_intersect(nodes, tris, r, tmax, false);
-  out[i] = (float4)(h.t, h.b1, h.b2, (float)h.tri);
+  out[i] = (float4)(h.t, h.b1, h.b2, (float)h.prim);
   occluded[i] = bvh_occluded(nodes, tris, r, tmax) ? 1 : 0;
 }
 
 // The same rays against every triangle, without the BVH
-__kernel void test_trace_brute(__global const Triangle* tris, uint num_tris,
+__kernel void test_trace_brute(__global const BvhTriangle* tris, uint num_tris,
                                __global const float4* rays, __global float4* out) {
   uint i = get_global_id(0);
   Ray r;
@@ -80,9 +66,9 @@ __kernel void test_trace_brute(__global const Triangle* tris, uint num_tris,
   float4 result = (float4)(best, 0.0f, 0.0f, -1.0f);
   for (uint k = 0; k < num_tris; ++k) {
     float t, b1, b2;
-    if (intersect_triangle_at(&wr, &tris[k], best, &t, &b1, &b2)) {
+    if (bvh_leaf_triangle_hit(&wr, &tris[k], best, &t, &b1, &b2)) {
       best = t;
-      result = (float4)(t, b1, b2, (float)k);
+      result = (float4)(t, b1, b2, (float)tris[k].prim);
     }
   }
   out[i] = result;

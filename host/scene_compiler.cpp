@@ -1,0 +1,212 @@
+#include "scene_compiler.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "bvh_builder.hpp"
+#include "error.hpp"
+
+namespace candela {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+template <int N, typename V>
+void append(std::vector<float>* out, const V& v) {
+  for (int i = 0; i < N; ++i) out->push_back(v[i]);
+}
+
+// Appends `values` (N floats each) for a mesh of n vertices, or `fallback` for each
+// vertex when the mesh lacks the attribute
+template <int N, typename V>
+void append_attribute(std::vector<float>* out, const std::vector<V>& values, size_t n, const V& fallback) {
+  for (size_t i = 0; i < n; ++i) append<N>(out, values.empty() ? fallback : values[i]);
+}
+
+// Vertices and primitives of every mesh, in mesh order: stable primitive indices.
+// Optional arrays are filled only when the scene's features read them.
+void compile_geometry(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b) {
+  for (const MeshDesc& m : scene.meshes) {
+    size_t n = m.positions.size(), base = b->positions.size() / 3;
+    if (base + n > size_t(UINT32_MAX)) throw Error("the scene has more than 2^32 vertices");
+    append_attribute<3>(&b->positions, m.positions, n, glm::vec3(0.0f));
+    append_attribute<3>(&b->normals, m.normals, n, glm::vec3(0.0f));
+    if (f.uvs) {
+      append_attribute<2>(&b->uv0, m.uv0, n, glm::vec2(0.0f));
+      append_attribute<2>(&b->uv1, m.uv1, n, glm::vec2(0.0f));
+    }
+    if (f.tangents) append_attribute<4>(&b->tangents, m.tangents, n, glm::vec4(0.0f));
+    if (f.vertex_colors) append_attribute<3>(&b->colors, m.colors, n, glm::vec3(1.0f));
+    for (size_t t = 0; t < m.triangles(); ++t) {
+      dev::Prim p{};
+      for (int k = 0; k < 3; ++k) p.v[k] = uint32_t(base + m.indices[3 * t + k]);
+      p.material = m.material;
+      b->prims.push_back(p);
+    }
+  }
+}
+
+dev::TextureRef compile_texture_ref(const TextureRef& r) {
+  dev::TextureRef d{};
+  d.index = r.index;
+  d.texcoord = uint32_t(r.texcoord);
+  // Rows of the affine 2D part of the column-major 3x3 transform
+  const glm::mat3& m = r.transform;
+  float rows[6] = {m[0][0], m[1][0], m[2][0], m[0][1], m[1][1], m[2][1]};
+  std::copy(rows, rows + 6, d.m);
+  return d;
+}
+
+void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
+  for (const MaterialDesc& m : scene.materials) {
+    dev::Material d{};
+    d.type = m.type;
+    d.double_sided = m.double_sided ? 1u : 0u;
+    for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
+    for (int c = 0; c < 3; ++c) d.emission[c] = m.emission[c];
+    d.base_color_texture = compile_texture_ref(m.base_color_texture);
+    d.emission_texture = compile_texture_ref(m.emission_texture);
+    b->materials.push_back(d);
+  }
+}
+
+void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
+  for (const TextureDesc& t : scene.textures) {
+    dev::TextureInfo info{};
+    bool is_float = !t.rgbaf.empty();
+    size_t offset = is_float ? b->texelsf.size() : b->texels8.size();
+    if (offset + t.texels() > size_t(UINT32_MAX)) throw Error("the scene's textures hold more than 2^32 texels");
+    info.offset = uint32_t(offset);
+    info.width = uint32_t(t.width);
+    info.height = uint32_t(t.height);
+    info.flags = t.wrap_s | (t.wrap_t << 8) | (t.srgb ? TEXTURE_SRGB : 0u) | (is_float ? TEXTURE_FLOAT : 0u);
+    for (size_t i = 0; i < t.texels(); ++i) {
+      if (is_float)
+        b->texelsf.push_back({{t.rgbaf[4 * i], t.rgbaf[4 * i + 1], t.rgbaf[4 * i + 2], t.rgbaf[4 * i + 3]}});
+      else
+        b->texels8.push_back({t.rgba8[4 * i], t.rgba8[4 * i + 1], t.rgba8[4 * i + 2], t.rgba8[4 * i + 3]});
+    }
+    b->textures.push_back(info);
+  }
+  for (int i = 0; i < 256; ++i) b->srgb_to_linear.push_back(dev::srgb_to_linear(i / 255.0f));
+}
+
+glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {
+  return glm::vec3(b.positions[3 * size_t(v)], b.positions[3 * size_t(v) + 1], b.positions[3 * size_t(v) + 2]);
+}
+
+// Every emissive triangle and the environment, with the selection table
+int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
+  std::vector<double> texture_mean(scene.textures.size(), -1.0);  // computed on first use
+  std::vector<double> power;
+  double radius = std::max(double(scene.bounds().radius()), 1e-6);
+  for (size_t i = 0; i < b->prims.size(); ++i) {
+    const dev::Prim& p = b->prims[i];
+    const MaterialDesc& m = scene.materials[p.material];
+    if (!(dev::luminance_rgb(m.emission.x, m.emission.y, m.emission.z) > 0.0f)) continue;
+    double scale = 1.0;
+    if (int tex = m.emission_texture.index; tex != NO_TEXTURE) {
+      if (texture_mean[size_t(tex)] < 0.0) texture_mean[size_t(tex)] = scene.textures[size_t(tex)].mean_luminance();
+      scale = texture_mean[size_t(tex)];
+    }
+    double area;
+    triangle_normal_area(vertex(*b, p.v[0]), vertex(*b, p.v[1]), vertex(*b, p.v[2]), &area);
+    dev::Light l{};
+    l.type = LIGHT_TRIANGLE;
+    l.index = uint32_t(i);
+    l.params[0] = float(area);
+    double w = light_power(l, *b, scale, radius);
+    if (!(w > 0.0)) continue;  // includes emissive textures that are black throughout
+    b->lights.push_back(l);
+    power.push_back(w);
+  }
+  int environment = NO_LIGHT;
+  if (dev::luminance_rgb(scene.background.x, scene.background.y, scene.background.z) > 0.0f) {
+    dev::Light l{};
+    l.type = LIGHT_ENVIRONMENT;
+    for (int c = 0; c < 3; ++c) l.radiance[c] = scene.background[c];
+    environment = int(b->lights.size());
+    b->lights.push_back(l);
+    power.push_back(light_power(l, *b, 1.0, radius));
+  }
+  std::vector<double> pmf;
+  b->light_thresholds = selection_thresholds(power, &pmf);
+  for (size_t i = 0; i < b->lights.size(); ++i) b->lights[i].pmf = float(pmf[i]);
+  return environment;
+}
+
+}  // namespace
+
+double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
+                   double scene_radius) {
+  switch (light.type) {
+    case LIGHT_TRIANGLE: {
+      // Diffuse emitter: power = pi * L * A per emitting side
+      const dev::Material& m = buffers.materials[buffers.prims[light.index].material];
+      double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
+      return kPi * lum * light.params[0] * (m.double_sided ? 2.0 : 1.0);
+    }
+    case LIGHT_ENVIRONMENT:
+      // A constant environment's power through the scene's bounding sphere
+      return 4.0 * kPi * kPi * scene_radius * scene_radius *
+             dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+    default:
+      throw Error("light_power: unknown light type " + std::to_string(light.type));
+  }
+}
+
+std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
+                                           std::vector<double>* pmf) {
+  const uint64_t range = uint64_t(1) << 32;
+  size_t n = weights.size();
+  pmf->assign(n, 0.0);
+  if (n == 0) return {};
+  if (n > (uint64_t(1) << 31)) throw Error("too many lights for the light table");
+  double total = 0.0;
+  for (double w : weights) total += w;
+  std::vector<uint32_t> thresholds;
+  uint64_t prev = 0;
+  double cum = 0.0;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    cum += weights[i];
+    uint64_t t = uint64_t(std::llround(cum / total * double(range)));
+    // At least one integer per light, and room for every light after this one
+    t = std::max(t, prev + 1);
+    t = std::min(t, range - (n - 1 - i));
+    thresholds.push_back(uint32_t(t));
+    (*pmf)[i] = double(t - prev) / double(range);
+    prev = t;
+  }
+  (*pmf)[n - 1] = double(range - prev) / double(range);
+  return thresholds;
+}
+
+CompiledScene compile_scene(const Scene& scene) {
+  auto start = Clock::now();
+  CompiledScene c;
+  c.features = scene.features();
+  c.camera = resolve_camera(scene);
+  compile_geometry(scene, c.features, &c.buffers);
+  compile_materials(scene, &c.buffers);
+  compile_textures(scene, &c.buffers);
+  c.environment_light = compile_lights(scene, &c.buffers);
+  auto bvh_start = Clock::now();
+  Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims);
+  c.bvh_build_seconds = seconds_since(bvh_start);
+  c.bvh_depth = bvh.depth;
+  c.buffers.bvh_nodes = std::move(bvh.nodes);
+  c.buffers.bvh_tris = std::move(bvh.tris);
+  c.triangles = c.buffers.prims.size();
+  c.vertices = c.buffers.positions.size() / 3;
+  c.compile_seconds = seconds_since(start);
+  return c;
+}
+
+}  // namespace candela

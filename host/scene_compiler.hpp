@@ -1,0 +1,37 @@
+// The compile step: turns the host scene description (scene.hpp) into the device
+// records of every scene buffer (CD_SCENE_BUFFERS), built once and shared by every
+// device that renders the scene.
+#pragma once
+
+#include <vector>
+
+#include "scene.hpp"
+
+namespace candela {
+
+struct CompiledScene {
+  dev::SceneBuffers buffers;
+  SceneFeatures features;
+  CameraDesc camera;  // resolved: the scene's, or one framing it
+  int environment_light = NO_LIGHT;  // index into buffers.lights
+  size_t triangles = 0, vertices = 0;
+  int bvh_depth = 0;
+  double bvh_build_seconds = 0.0;
+  double compile_seconds = 0.0;  // everything, the BVH included
+};
+
+CompiledScene compile_scene(const Scene& scene);
+
+// Thresholds for selecting index i with probability ~ weights[i] (all > 0) from a
+// uniform 32-bit integer (lights.cl); the exact probabilities realized go to *pmf.
+// Each index gets at least one of the 2^32 integers.
+std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
+                                           std::vector<double>* pmf);
+
+// Emitted power of a light (luminance-weighted, for light selection). `emission_scale`
+// is the mean luminance of a triangle light's emissive texture (1 without one);
+// `scene_radius` bounds the scene for environment lights.
+double light_power(const dev::Light& light, const dev::SceneBuffers& buffers,
+                   double emission_scale, double scene_radius);
+
+}  // namespace candela
