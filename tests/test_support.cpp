@@ -32,6 +32,32 @@ KernelRig::KernelRig(const DeviceEntry& d) : device(d) {
   program = build_program(context, device, test_program_source(), "-cl-std=CL1.2").program;
 }
 
+namespace {
+template <typename T>
+cl::Buffer upload_or_dummy(const cl::Context& ctx, const std::vector<T>& data) {
+  std::vector<T> one(1);
+  const std::vector<T>& src = data.empty() ? one : data;
+  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T), const_cast<T*>(src.data()));
+}
+}  // namespace
+
+SceneOnDevice::SceneOnDevice(KernelRig& rig, const CompiledScene& scene) {
+#define CD_TEST_UPLOAD(type, name) buffers.push_back(upload_or_dummy(rig.context, scene.buffers.name));
+  CD_SCENE_BUFFERS(CD_TEST_UPLOAD)
+#undef CD_TEST_UPLOAD
+  params_host.num_lights = cl_uint(scene.buffers.lights.size());
+  params_host.environment_light = scene.environment_light;
+  params_host.width = params_host.height = 1;
+  params = cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof params_host, &params_host);
+}
+
+cl_uint SceneOnDevice::bind(cl::Kernel& kernel, cl_uint first_arg) const {
+  cl_uint arg = first_arg;
+  for (const cl::Buffer& b : buffers) kernel.setArg(arg++, b);
+  kernel.setArg(arg++, params);
+  return arg;
+}
+
 std::string scene_path(const std::string& relative) {
   return std::string(CANDELA_SOURCE_DIR) + "/scenes/" + relative;
 }

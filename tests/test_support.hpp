@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "device.hpp"
+#include "device_types.hpp"
+#include "scene_compiler.hpp"
 
 namespace candela::test {
 
@@ -32,6 +34,17 @@ struct KernelRig {
   cl::CommandQueue queue;
   cl::Program program;
   explicit KernelRig(const DeviceEntry& d);
+};
+
+// A compiled scene uploaded for test kernels that take CD_SCENE_BUFFERS(CD_SCENE_PARAM)
+// followed by a `__global const RenderParams*` (as render_paths does): bind() sets those
+// arguments from `first_arg` on and returns the index of the next argument.
+struct SceneOnDevice {
+  std::vector<cl::Buffer> buffers;  // CD_SCENE_BUFFERS order
+  cl::Buffer params;
+  dev::RenderParams params_host{};
+  SceneOnDevice(KernelRig& rig, const CompiledScene& scene);
+  cl_uint bind(cl::Kernel& kernel, cl_uint first_arg) const;
 };
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
