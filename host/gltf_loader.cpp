@@ -199,7 +199,7 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
 }
 
 // KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv, and its texCoord
-void read_texture_transform(const tinygltf::Value& ext, TextureRef* ref) {
+void read_texture_transform(const tinygltf::Value& ext, TextureSlot* ref) {
   float ox = float(number_or(ext, "offset", 0, 0.0)), oy = float(number_or(ext, "offset", 1, 0.0));
   float r = float(number_or(ext, "rotation", -1, 0.0));
   float sx = float(number_or(ext, "scale", 0, 1.0)), sy = float(number_or(ext, "scale", 1, 1.0));
@@ -265,9 +265,9 @@ class MaterialReader {
         warn_.add("glTF extension " + e.first + " is not supported yet and is ignored");
   }
 
-  TextureRef texture_ref(int gltf_texture, int texcoord, const tinygltf::ExtensionMap& extensions,
+  TextureSlot texture_ref(int gltf_texture, int texcoord, const tinygltf::ExtensionMap& extensions,
                          bool srgb) {
-    TextureRef ref;
+    TextureSlot ref;
     ref.index = texture_index(gltf_texture, srgb);
     ref.texcoord = texcoord;
     auto tt = extensions.find("KHR_texture_transform");

@@ -12,11 +12,11 @@
 namespace candela {
 
 // One texture slot of a material: texture, TEXCOORD_n, KHR_texture_transform
-struct TextureRef {
+struct TextureSlot {
   int index = NO_TEXTURE;  // into Scene::textures
   int texcoord = 0;  // 0 or 1
   glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
-  bool operator==(const TextureRef& o) const {
+  bool operator==(const TextureSlot& o) const {
     return index == o.index && texcoord == o.texcoord && transform == o.transform;
   }
 };
@@ -24,9 +24,9 @@ struct TextureRef {
 struct MaterialDesc {
   uint32_t type = MATERIAL_DIFFUSE;
   glm::vec4 base_color{1.0f};  // linear rgba factor
-  TextureRef base_color_texture;
+  TextureSlot base_color_texture;
   glm::vec3 emission{0.0f};  // radiance: emissiveFactor x emissive strength
-  TextureRef emission_texture;
+  TextureSlot emission_texture;
   bool double_sided = false;
 };
 

@@ -53,7 +53,7 @@ void compile_geometry(const Scene& scene, const SceneFeatures& f, dev::SceneBuff
   }
 }
 
-dev::TextureRef compile_texture_ref(const TextureRef& r) {
+dev::TextureRef compile_texture_ref(const TextureSlot& r) {
   dev::TextureRef d{};
   d.index = r.index;
   d.texcoord = uint32_t(r.texcoord);

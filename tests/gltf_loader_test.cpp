@@ -177,7 +177,7 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
   Scene s = load_gltf(dir.write("tt.gltf", j.dump()));
   // Raw UVs reach the device; the slot's transform maps uv (1, 1): scaled (2, 2), rotated
   // by pi/2 (u' = u cos + v sin, v' = -u sin + v cos) to (2, -2), offset to (2.5, -2)
-  const TextureRef& ref = s.materials[0].base_color_texture;
+  const TextureSlot& ref = s.materials[0].base_color_texture;
   EXPECT_EQ(ref.texcoord, 0);
   glm::vec2 uv = glm::vec2(ref.transform * glm::vec3(1.0f, 1.0f, 1.0f));
   EXPECT_NEAR(uv.x, 2.5f, 1e-5f);
