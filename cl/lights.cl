@@ -75,9 +75,8 @@ bool lights_sample_triangle(const SceneData* sc, __global const Light* light,
   scene_prim_positions(sc, light->index, &v0, &v1, &v2);
   float area;
   float3 n = triangle_normal_area(v0, v1, v2, &area);
-  // sample_triangle gives y = s v0 + t v1 + (1-s-t) v2: weights b1 = t of v1, b2 = 1-s-t of v2
-  float2 st = sample_triangle(u.x, u.y);
-  float b1 = st.y, b2 = 1.0f - st.x - st.y;
+  float2 b = sample_triangle(u.x, u.y);
+  float b1 = b.x, b2 = b.y;
   float3 y = (1.0f - b1 - b2) * v0 + b1 * v1 + b2 * v2;
   float3 d = y - ctx->p;
   float dist2 = dot(d, d);

@@ -23,11 +23,13 @@ float3 sample_uniform_sphere(float u, float v) {
 
 float sample_uniform_sphere_pdf(void) { return 0.25f * INV_PI_F; }
 
-// Uniform point on a triangle: s = 1 - sqrt(u), t = v sqrt(u), x = s v1 + t v2 + (1-s-t) v3.
-// Returns (s, t); the pdf is 1 / area.
+// Uniform point on a triangle (v0, v1, v2): the lecture's s = 1 - sqrt(u), t = v sqrt(u),
+// x = s v0 + t v1 + (1-s-t) v2, returned as Hit's barycentric weights (b1, b2) = (t, 1-s-t)
+// of v1 and v2, so that x = (1 - b1 - b2) v0 + b1 v1 + b2 v2. The pdf is 1 / area.
 float2 sample_triangle(float u, float v) {
   float su = sqrt(u);
-  return (float2)(1.0f - su, v * su);
+  float s = 1.0f - su, t = v * su;
+  return (float2)(t, 1.0f - s - t);
 }
 
 // Index i with threshold[i-1] <= x < threshold[i] for a uniform 32-bit x; the last

@@ -36,8 +36,8 @@ __kernel void test_sample_triangle(uint seed, float4 v1, float4 v2, float4 v3,
   uint i = get_global_id(0);
   Rng rng = rng_init(i, 0u, seed);
   float u = rng_next(&rng), v = rng_next(&rng);
-  float2 st = sample_triangle(u, v);
-  out[i] = st.x * v1 + st.y * v2 + (1.0f - st.x - st.y) * v3;
+  float2 b = sample_triangle(u, v);
+  out[i] = (1.0f - b.x - b.y) * v1 + b.x * v2 + b.y * v3;
 }
 
 // rays: (org, tmax) then (dir, 0); out: (t, b1, b2, tri) closest hit, occluded flag
