@@ -127,17 +127,14 @@ void apply_camera_options(const RenderArgs& a, Scene* scene) {
   scene->camera = cam;
 }
 
-int run_render(const RenderArgs& a) {
-  Strategy strategy;
-  if (a.strategy == "nee")
-    strategy = Strategy::Nee;
-  else if (a.strategy == "bsdf")
-    strategy = Strategy::Bsdf;
-  else
-    throw Error("--strategy must be nee or bsdf, not '" + a.strategy + "'");
-  if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
-  for (const auto& out : a.outputs) check_output_path(out);
+Strategy parse_strategy(const std::string& name) {
+  if (name == "nee") return Strategy::Nee;
+  if (name == "bsdf") return Strategy::Bsdf;
+  throw Error("--strategy must be nee or bsdf, not '" + name + "'");
+}
 
+// The scene with the command line's overrides, its warnings printed
+Scene load_scene(const RenderArgs& a) {
   Scene scene = load_gltf(a.scene);
   if (!a.background.empty()) {
     scene.background = parse_vec3(a.background, "--background");
@@ -149,12 +146,42 @@ int run_render(const RenderArgs& a) {
   if (!scene.has_emission())
     std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
   if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
+  return scene;
+}
 
+void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
+                 const RenderResult& r, double samples_per_second) {
+  nlohmann::json j = {{"spp", r.spp},
+                      {"seconds", r.seconds},
+                      {"samples_per_second", samples_per_second},
+                      {"kernel_build_seconds", renderer.kernel_build_seconds()},
+                      {"kernel_from_cache", renderer.kernel_from_cache()},
+                      {"bvh_build_seconds", renderer.bvh_build_seconds()},
+                      {"scene_compile_seconds", renderer.scene().compile_seconds},
+                      {"scene_device_bytes", renderer.scene().buffers.bytes()},
+                      {"triangles", renderer.triangles()},
+                      {"lights", renderer.lights()},
+                      {"device", renderer.worker().device().description()},
+                      {"width", settings.width},
+                      {"height", settings.height},
+                      {"strategy", a.strategy},
+                      {"max_depth", a.max_depth},
+                      {"seed", a.seed},
+                      {"interrupted", r.interrupted},
+                      {"dropped_samples", r.film.dropped_samples()}};
+  std::ofstream f(a.stats);
+  if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + a.stats);
+}
+
+int run_render(const RenderArgs& a) {
   RenderSettings settings;
+  settings.strategy = parse_strategy(a.strategy);
+  if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
+  for (const auto& out : a.outputs) check_output_path(out);
+  Scene scene = load_scene(a);
   resolve_size(a, scene, &settings.width, &settings.height);
   settings.seed = a.seed;
   settings.max_depth = a.max_depth;
-  settings.strategy = strategy;
 
   DeviceEntry device = select_device(a.device);
   if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
@@ -178,14 +205,10 @@ int run_render(const RenderArgs& a) {
   double samples_per_second = r.spp * pixels / std::max(r.seconds, 1e-9);
   uint64_t dropped = r.film.dropped_samples();
   std::map<std::string, std::string> meta = {
-      {"spp", std::to_string(r.spp)},
-      {"seconds", std::to_string(r.seconds)},
-      {"device", device.description()},
-      {"seed", std::to_string(a.seed)},
-      {"strategy", a.strategy},
-      {"max_depth", std::to_string(a.max_depth)},
-      {"dropped_samples", std::to_string(dropped)},
-      {"scene", a.scene}};
+      {"spp", std::to_string(r.spp)},          {"seconds", std::to_string(r.seconds)},
+      {"device", device.description()},        {"seed", std::to_string(a.seed)},
+      {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
+      {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
@@ -195,45 +218,13 @@ int run_render(const RenderArgs& a) {
   if (r.partial_pass)
     std::fprintf(stderr, "note: stopped inside a pass; some pixels hold more than %u samples\n", r.spp);
   if (dropped) std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)dropped);
-
-  if (!a.stats.empty()) {
-    nlohmann::json j = {{"spp", r.spp},
-                        {"seconds", r.seconds},
-                        {"samples_per_second", samples_per_second},
-                        {"kernel_build_seconds", renderer.kernel_build_seconds()},
-                        {"kernel_from_cache", renderer.kernel_from_cache()},
-                        {"bvh_build_seconds", renderer.bvh_build_seconds()},
-                        {"triangles", renderer.triangles()},
-                        {"lights", renderer.lights()},
-                        {"device", device.description()},
-                        {"width", settings.width},
-                        {"height", settings.height},
-                        {"strategy", a.strategy},
-                        {"max_depth", a.max_depth},
-                        {"seed", a.seed},
-                        {"interrupted", r.interrupted},
-                        {"dropped_samples", dropped}};
-    std::ofstream f(a.stats);
-    if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + a.stats);
-  }
+  if (!a.stats.empty()) write_stats(a, settings, renderer, r, samples_per_second);
   return r.interrupted ? 130 : 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"candela: a physically based path tracer running on OpenCL devices"};
-  app.set_version_flag("--version", "candela " CANDELA_VERSION);
-  app.require_subcommand(1);
-  std::string kernel_dir;
-  app.add_option("--kernel-dir", kernel_dir,
-                 "Load kernel sources from this cl/ directory instead of the embedded copy "
-                 "(also: CANDELA_KERNEL_DIR)");
-
-  auto* devices_cmd = app.add_subcommand("devices", "List OpenCL platforms and devices");
-
-  RenderArgs a;
-  auto* render = app.add_subcommand("render", "Render a glTF scene");
+CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
+  RenderArgs& a = *args;
+  auto* render = app->add_subcommand("render", "Render a glTF scene");
   render->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
   render->add_option("-o,--output", a.outputs, "Output image, .exr (linear) or .png (sRGB); repeatable")->required();
   auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(CLI::Range(1u, 1u << 24));
@@ -254,6 +245,24 @@ int main(int argc, char** argv) {
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
   render->add_option("--fov", a.fov, "Vertical field of view in degrees");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
+  return render;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"candela: a physically based path tracer running on OpenCL devices"};
+  app.set_version_flag("--version", "candela " CANDELA_VERSION);
+  app.require_subcommand(1);
+  std::string kernel_dir;
+  app.add_option("--kernel-dir", kernel_dir,
+                 "Load kernel sources from this cl/ directory instead of the embedded copy "
+                 "(also: CANDELA_KERNEL_DIR)");
+
+  auto* devices_cmd = app.add_subcommand("devices", "List OpenCL platforms and devices");
+
+  RenderArgs a;
+  add_render_command(&app, &a);
 
   try {
     app.parse(argc, argv);

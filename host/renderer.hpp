@@ -113,6 +113,7 @@ class Renderer {
 
   const CompiledScene& scene() const { return *scene_; }
   DeviceRenderer& worker() { return worker_; }
+  const DeviceRenderer& worker() const { return worker_; }
   double kernel_build_seconds() const { return worker_.kernel_build_seconds(); }
   bool kernel_from_cache() const { return worker_.kernel_from_cache(); }
   double bvh_build_seconds() const { return scene_->bvh_build_seconds; }
