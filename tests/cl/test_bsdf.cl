@@ -1,1 +1,75 @@
-// (filled in by the BSDF / light sampling tests)
+// BSDF test kernels: the real bsdf_at / bsdf_sample / bsdf_eval / bsdf_pdf at a made-up
+// shading point of material 0, so that every lobe is tested through the same dispatch the
+// integrator uses. Normals and the tangent come from the host unoriented, as a mesh has them.
+
+#define TEST_BSDF_NO_BUFFER(type, name) 0,
+
+// A scene that holds only a material table; every other buffer is null
+SceneData test_bsdf_scene(__global const Material* materials) {
+  SceneData sc = {CD_SCENE_BUFFERS(TEST_BSDF_NO_BUFFER) 0};
+  sc.materials = materials;
+  return sc;
+}
+
+// A hit of material 0 seen from wo (wo = -ray direction), oriented as surface_at does:
+// ng turned to wo's side, ns turned to ng's side
+SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo) {
+  SurfaceHit s;
+  s.p = (float3)(0.0f);
+  s.ng = normalize(ng);
+  s.front = dot(s.ng, wo) > 0.0f;
+  if (!s.front) s.ng = -s.ng;
+  s.ns = normalize(ns);
+  if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+  s.tangent = tangent;
+  s.uvs = (float4)(0.0f);
+  s.vertex_color = (float3)(1.0f);
+  s.prim = 0u;
+  s.material = 0u;
+  return s;
+}
+
+// Sample i of bsdf_sample with (uc, u.x, u.y) drawn in that order from rng_init(i, 0, seed).
+// out[3i..3i+2]: (wi, pdf), (f, eta), (bsdf_eval, bsdf_pdf) at the sampled wi, all zero
+// when sampling fails; info[i]: (returned, BSDF_DELTA set, BSDF_REFLECTION set, flags valid:
+// within bsdf_flags and exactly one of reflection and transmission), 0 where not returned
+__kernel void test_bsdf_sample(__global const Material* materials, float4 ng, float4 ns,
+                               float4 tangent, float4 wo, uint seed, __global float4* out,
+                               __global uint4* info) {
+  uint i = get_global_id(0);
+  SceneData sc = test_bsdf_scene(materials);
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz);
+  Bsdf b = bsdf_at(&sc, &s);
+  Rng rng = rng_init(i, 0u, seed);
+  float uc = rng_next(&rng);
+  float2 u;
+  u.x = rng_next(&rng);
+  u.y = rng_next(&rng);
+  BsdfSample bs;
+  bool ok = bsdf_sample(&b, wo.xyz, uc, u, &bs);
+  if (!ok) {
+    out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = (float4)(0.0f);
+    info[i] = (uint4)(0u);
+    return;
+  }
+  out[3 * i] = (float4)(bs.wi, bs.pdf);
+  out[3 * i + 1] = (float4)(bs.f, bs.eta);
+  out[3 * i + 2] = (float4)(bsdf_eval(&b, wo.xyz, bs.wi), bsdf_pdf(&b, wo.xyz, bs.wi));
+  uint side = bs.flags & (BSDF_REFLECTION | BSDF_TRANSMISSION);
+  bool valid = (bs.flags & ~bsdf_flags(&b)) == 0u && (side == BSDF_REFLECTION || side == BSDF_TRANSMISSION);
+  info[i] = (uint4)(1u, (bs.flags & BSDF_DELTA) != 0u ? 1u : 0u, side == BSDF_REFLECTION ? 1u : 0u,
+                    valid ? 1u : 0u);
+}
+
+// f and pdf for the pair (wo, wi) = (pairs[2i], pairs[2i+1]) at a hit oriented by that wo;
+// out[i] = (f, pdf)
+__kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns,
+                             float4 tangent, __global const float4* pairs,
+                             __global float4* out) {
+  uint i = get_global_id(0);
+  SceneData sc = test_bsdf_scene(materials);
+  float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo);
+  Bsdf b = bsdf_at(&sc, &s);
+  out[i] = (float4)(bsdf_eval(&b, wo, wi), bsdf_pdf(&b, wo, wi));
+}
