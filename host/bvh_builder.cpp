@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "scene.hpp"
 
@@ -88,6 +89,7 @@ class Builder {
       float lo = cbounds.lo[axis], hi = cbounds.hi[axis];
       if (!(hi > lo)) continue;
       float scale = kBins / (hi - lo);
+      if (!std::isfinite(scale)) continue;  // a denormal extent cannot be binned: as if flat
       std::array<Bounds, kBins> bins;
       std::array<uint32_t, kBins> counts{};
       for (uint32_t i = begin; i < end; ++i) {

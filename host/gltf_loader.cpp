@@ -34,8 +34,9 @@ class Warnings {
   std::set<std::string> seen_;
 };
 
-// Limit on the elements of one accessor without a bufferView (zero-filled)
-constexpr size_t kMaxZeroFilledElements = size_t(1) << 28;
+// Limit on the values (elements x components) of one accessor without a bufferView
+// (zero-filled): it takes no room in the file, so a few bytes could ask for gigabytes
+constexpr size_t kMaxZeroFilledValues = size_t(1) << 24;
 
 // One component as a float: normalized integers map to [0,1] / [-1,1] (glTF 3.11)
 float decode_float(const unsigned char* p, int ctype, bool normalized) {
@@ -139,8 +140,9 @@ std::vector<T> read_accessor_as(const tinygltf::Model& model, int index, int wan
     read_view(model, acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType,
               acc.normalized, decode, &values);
   } else {
-    if (acc.count > kMaxZeroFilledElements)
-      throw Error("glTF accessor " + std::to_string(index) + " is too large");
+    if (acc.count > kMaxZeroFilledValues / size_t(comps))
+      throw Error("glTF accessor " + std::to_string(index) + " is too large for one without a bufferView (" +
+                  std::to_string(acc.count) + " elements)");
     values.assign(acc.count * comps, T(0));
   }
   if (acc.sparse.isSparse) {
@@ -586,26 +588,145 @@ void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
   if (!model.skins.empty()) warn->add("skins are ignored (meshes render in their bind pose)");
 }
 
-}  // namespace
+// tinygltf file access that finds no file: glTF from memory without a base folder
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string no_expand_path(const std::string& path, void*) { return path; }
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+  if (err) *err += "external files are not read: " + path + "\n";
+  return false;
+}
+bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
 
-Scene load_gltf(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
-  if (fs::is_directory(path, ec)) throw Error("scene path is a directory, not a glTF file: " + path);
+// glTF images are PNG or JPEG (3.8.2). Their headers give the size before anything is
+// decoded, so a few bytes claiming a huge image cannot make stb_image allocate and fill
+// gigabytes; other formats, which stb_image would also decode, are not glTF images.
+constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;  // decoded RGBA: 16384^2 at 8 bits
+// stb_image decodes a truncated JPEG as if the rest were there. Huffman coding spends at
+// least a bit on each 8x8 block, so a whole JPEG has at most 512 texels a byte: allow twice.
+constexpr uint64_t kMaxJpegTexelsPerByte = 1024;
 
+uint32_t big_endian(const unsigned char* p, int bytes) {
+  uint32_t v = 0;
+  for (int i = 0; i < bytes; ++i) v = v << 8 | p[i];
+  return v;
+}
+
+enum class ImageFormat { Other, Png, Jpeg };
+
+// Format, width, height and bytes per channel from a PNG or JPEG header
+ImageFormat image_header(const unsigned char* p, size_t n, uint64_t* w, uint64_t* h, int* channel_bytes) {
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (n >= 26 && std::memcmp(p, kPng, 8) == 0 && std::memcmp(p + 12, "IHDR", 4) == 0) {
+    *w = big_endian(p + 16, 4);
+    *h = big_endian(p + 20, 4);
+    *channel_bytes = p[24] == 16 ? 2 : 1;
+    return ImageFormat::Png;
+  }
+  if (n < 4 || p[0] != 0xFF || p[1] != 0xD8) return ImageFormat::Other;
+  // JPEG: marker segments up to the frame header (SOF0-SOF15 but DHT, JPG and DAC)
+  for (size_t i = 2; i + 4 <= n;) {
+    unsigned char m = p[i + 1];
+    if (p[i] != 0xFF) return ImageFormat::Other;
+    if (m == 0xFF) {
+      ++i;  // fill byte
+    } else if (m == 0x01 || (m >= 0xD0 && m <= 0xD7)) {
+      i += 2;  // no length
+    } else if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) {
+      if (i + 9 > n) return ImageFormat::Other;
+      *h = big_endian(p + i + 5, 2);
+      *w = big_endian(p + i + 7, 2);
+      *channel_bytes = 1;
+      return ImageFormat::Jpeg;
+    } else if (m == 0xDA || m == 0xD9) {
+      return ImageFormat::Other;  // a scan or the end before any frame
+    } else {
+      i += 2 + big_endian(p + i + 2, 2);
+    }
+  }
+  return ImageFormat::Other;
+}
+
+// tinygltf's image decoding (to RGBA) behind those checks
+bool load_checked_image(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
+                        int req_width, int req_height, const unsigned char* bytes, int size, void*) {
+  uint64_t w = 0, h = 0;
+  int channel_bytes = 1;
+  std::string which = "glTF image " + std::to_string(index);
+  ImageFormat format = size > 0 ? image_header(bytes, size_t(size), &w, &h, &channel_bytes) : ImageFormat::Other;
+  if (format == ImageFormat::Other) {
+    if (warn) *warn += which + " is neither PNG nor JPEG: it is ignored\n";
+    return true;  // left empty: a texture using it fails in decode_image
+  }
+  std::string dims = std::to_string(w) + " x " + std::to_string(h);
+  if (w > kMaxImageBytes || h > kMaxImageBytes || w * h * 4 * uint64_t(channel_bytes) > kMaxImageBytes) {
+    if (err) *err += which + " is " + dims + ": too large (over 1 GiB decoded)";
+    return false;
+  }
+  if (format == ImageFormat::Jpeg && w * h > kMaxJpegTexelsPerByte * uint64_t(size)) {
+    if (err) *err += which + " is a JPEG of " + dims + " in only " + std::to_string(size) + " bytes: it is truncated";
+    return false;
+  }
+  return tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, nullptr);
+}
+
+// Deepest array and object nesting of JSON text, counted up to `limit` + 1. tinygltf
+// converts extras and extensions recursively: deep nesting would overflow the stack.
+size_t json_depth(const char* p, size_t n, size_t limit) {
+  size_t depth = 0, deepest = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < n && deepest <= limit; ++i) {
+    if (in_string) {
+      if (p[i] == '\\')
+        ++i;
+      else if (p[i] == '"')
+        in_string = false;
+    } else if (p[i] == '"') {
+      in_string = true;
+    } else if (p[i] == '[' || p[i] == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if ((p[i] == ']' || p[i] == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+constexpr size_t kMaxJsonDepth = 64;  // glTF itself needs under 10
+
+// Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
+// External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
+Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name) {
+  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
+  if (data.size() > UINT32_MAX) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
   tinygltf::TinyGLTF gltf;
+  if (base_dir.empty()) {
+    tinygltf::FsCallbacks fs = {};
+    fs.FileExists = no_file_exists;
+    fs.ExpandFilePath = no_expand_path;
+    fs.ReadWholeFile = no_read;
+    fs.WriteWholeFile = no_write;
+    gltf.SetFsCallbacks(fs);
+  }
+  gltf.SetImageLoader(load_checked_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   // Binary glTF starts with the magic "glTF", whatever the file is called
-  char magic[4] = {};
-  std::ifstream(path, std::ios::binary).read(magic, 4);
-  bool binary = std::memcmp(magic, "glTF", 4) == 0;
-  bool ok = binary ? gltf.LoadBinaryFromFile(&model, &err, &warn, path)
-                   : gltf.LoadASCIIFromFile(&model, &err, &warn, path);
+  bool binary = data.compare(0, 4, "glTF") == 0;
+  size_t json_begin = 0, json_size = data.size();  // a GLB's JSON is its first chunk
+  if (binary && data.size() >= 20) {
+    uint32_t length = 0;  // little-endian, at byte 12
+    for (int i = 15; i >= 12; --i) length = length << 8 | uint8_t(data[size_t(i)]);
+    json_begin = 20;
+    json_size = std::min<size_t>(length, data.size() - 20);
+  }
+  if (json_depth(data.data() + json_begin, json_size, kMaxJsonDepth) > kMaxJsonDepth)
+    throw Error("cannot load glTF scene " + name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+  bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, &warn,
+                                               reinterpret_cast<const unsigned char*>(data.data()),
+                                               unsigned(data.size()), base_dir)
+                   : gltf.LoadASCIIFromString(&model, &err, &warn, data.data(), unsigned(data.size()), base_dir);
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    throw Error("cannot load glTF scene " + path + ": " + (err.empty() ? "malformed file" : err));
+    throw Error("cannot load glTF scene " + name + ": " + (err.empty() ? "malformed file" : err));
   }
   Scene scene;
   if (!warn.empty()) {
@@ -618,6 +739,29 @@ Scene load_gltf(const std::string& path) {
   NodeReader(model, &scene, &warnings).read_scene();
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
   return scene;
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
+  if (fs::is_directory(path, ec)) throw Error("scene path is a directory, not a glTF file: " + path);
+  std::string data;
+  std::ifstream in(path, std::ios::binary);
+  uintmax_t size = fs::file_size(path, ec);
+  if (in && !ec) {
+    data.resize(size_t(size));
+    in.read(data.data(), std::streamsize(size));
+  }
+  if (!in || ec) throw Error("cannot read scene file " + path);
+  std::string dir = fs::path(path).parent_path().string();
+  return load_gltf_bytes(data, dir.empty() ? "." : dir, path);
+}
+
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir) {
+  return load_gltf_bytes(data, base_dir, "(from memory)");
 }
 
 }  // namespace candela

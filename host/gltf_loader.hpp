@@ -11,4 +11,9 @@ namespace candela {
 // on a missing or malformed file; unsupported features land in Scene::warnings.
 Scene load_gltf(const std::string& path);
 
+// The same from the bytes of a .gltf or .glb (told apart by the "glTF" magic). External
+// URIs resolve against `base_dir`; with an empty `base_dir` no file is read (only data:
+// URIs and the GLB's own BIN chunk load), as for untrusted input.
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir);
+
 }  // namespace candela

@@ -12,6 +12,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Device arithmetic is single precision and squares distances: coordinates beyond this
+// (far past any real scene) overflow it, and the image would be silently wrong
+constexpr float kMaxCoordinate = 1e15f;
+
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) {
@@ -142,6 +146,22 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   return environment;
 }
 
+bool within_range(const glm::vec3& p) {  // false for NaN too
+  return glm::all(glm::lessThanEqual(glm::abs(p), glm::vec3(kMaxCoordinate)));
+}
+
+// The geometry and the camera must fit single-precision rendering
+void check_extent(const Scene& scene, const CameraDesc& camera) {
+  Bounds b = scene.bounds();
+  if (!b.empty() && !(within_range(b.lo) && within_range(b.hi)))
+    throw Error("the scene extends beyond +-1e15 units, too far for single-precision rendering");
+  if (scene.camera && !within_range(camera.position))  // one framing the scene lies within a few radii
+    throw Error("the camera lies beyond +-1e15 units, too far for single-precision rendering");
+  float forward = glm::length(camera.forward);
+  if (!(forward > 0.0f && std::isfinite(forward)))
+    throw Error("the camera has no viewing direction (its node transform is degenerate or not finite)");
+}
+
 }  // namespace
 
 double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
@@ -193,6 +213,7 @@ CompiledScene compile_scene(const Scene& scene) {
   CompiledScene c;
   c.features = scene.features();
   c.camera = resolve_camera(scene);
+  check_extent(scene, c.camera);
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);
   compile_textures(scene, &c.buffers);

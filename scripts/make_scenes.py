@@ -8,10 +8,11 @@ Outputs (deterministic, byte-identical on every run):
   scenes/furnace/closed-sphere.gltf     emissive+diffuse sphere seen from inside
   scenes/furnace/white-objects.gltf     albedo-1 objects under a white background
 
-Every file embeds its binary buffer as a base64 data URI.  Meshes use flat
-(per-face) normals with vertices duplicated per triangle.  After writing, each
-file is read back from disk and checked (accessors, bounds, winding vs normals,
-watertightness where expected).
+Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
+a base64 data URI.  Meshes use flat (per-face) normals with vertices
+duplicated per triangle.  After writing, each file is read back from disk and
+checked (accessors, bounds, winding vs normals, watertightness where
+expected).
 """
 
 import base64
@@ -20,12 +21,10 @@ import math
 import os
 import struct
 
+from gltf_writer import (DATA_URI_PREFIX, ELEMENT_ARRAY_BUFFER, FLOAT,
+                         UNSIGNED_INT, GltfWriter)
+
 GENERATOR = "candela scripts/make_scenes.py"
-ARRAY_BUFFER = 34962
-ELEMENT_ARRAY_BUFFER = 34963
-FLOAT = 5126
-UNSIGNED_INT = 5125
-TRIANGLES = 4
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -120,113 +119,6 @@ def quad_triangles(quad):
 
 
 # ---------------------------------------------------------------------------
-# glTF document builder
-
-class GltfBuilder:
-    """Accumulates binary data and JSON objects for one glTF file."""
-
-    def __init__(self):
-        self.blob = bytearray()
-        self.doc = {
-            "asset": {"version": "2.0", "generator": GENERATOR},
-            "scene": 0,
-            "scenes": [{"nodes": []}],
-            "nodes": [],
-            "meshes": [],
-            "materials": [],
-            "cameras": [],
-            "accessors": [],
-            "bufferViews": [],
-            "buffers": [],
-        }
-
-    def _view(self, data, target):
-        while len(self.blob) % 4:
-            self.blob.append(0)
-        view = {"buffer": 0, "byteOffset": len(self.blob),
-                "byteLength": len(data), "target": target}
-        self.blob.extend(data)
-        self.doc["bufferViews"].append(view)
-        return len(self.doc["bufferViews"]) - 1
-
-    def _accessor(self, acc):
-        self.doc["accessors"].append(acc)
-        return len(self.doc["accessors"]) - 1
-
-    def vec3_accessor(self, vectors, with_bounds):
-        data = b"".join(struct.pack("<3f", *v) for v in vectors)
-        acc = {"bufferView": self._view(data, ARRAY_BUFFER),
-               "componentType": FLOAT, "count": len(vectors), "type": "VEC3"}
-        if with_bounds:
-            acc["min"] = [min(v[i] for v in vectors) for i in range(3)]
-            acc["max"] = [max(v[i] for v in vectors) for i in range(3)]
-        return self._accessor(acc)
-
-    def index_accessor(self, indices):
-        data = struct.pack("<%dI" % len(indices), *indices)
-        return self._accessor({
-            "bufferView": self._view(data, ELEMENT_ARRAY_BUFFER),
-            "componentType": UNSIGNED_INT, "count": len(indices),
-            "type": "SCALAR"})
-
-    def material(self, name, base_color, emissive=None, strength=None,
-                 double_sided=True):
-        mat = {"name": name,
-               "pbrMetallicRoughness": {"baseColorFactor": list(base_color),
-                                        "metallicFactor": 0.0,
-                                        "roughnessFactor": 1.0}}
-        if emissive is not None:
-            mat["emissiveFactor"] = list(emissive)
-        if strength is not None:
-            mat["extensions"] = {"KHR_materials_emissive_strength":
-                                 {"emissiveStrength": strength}}
-            used = self.doc.setdefault("extensionsUsed", [])
-            if "KHR_materials_emissive_strength" not in used:
-                used.append("KHR_materials_emissive_strength")
-        mat["doubleSided"] = double_sided
-        self.doc["materials"].append(mat)
-        return len(self.doc["materials"]) - 1
-
-    def mesh(self, name, triangles, material):
-        """Add a flat-shaded triangle mesh; returns the mesh index."""
-        positions, normals, indices = flat_mesh(triangles)
-        prim = {"attributes": {
-                    "POSITION": self.vec3_accessor(positions, True),
-                    "NORMAL": self.vec3_accessor(normals, False)},
-                "indices": self.index_accessor(indices),
-                "material": material,
-                "mode": TRIANGLES}
-        self.doc["meshes"].append({"name": name, "primitives": [prim]})
-        return len(self.doc["meshes"]) - 1
-
-    def camera(self, name, yfov, aspect, znear=0.01, zfar=100.0):
-        self.doc["cameras"].append({
-            "name": name, "type": "perspective",
-            "perspective": {"yfov": yfov, "aspectRatio": aspect,
-                            "znear": znear, "zfar": zfar}})
-        return len(self.doc["cameras"]) - 1
-
-    def node(self, name, root=True, **fields):
-        """Add a node (fields: mesh, camera, children, translation, ...)."""
-        node = {"name": name}
-        node.update(fields)
-        self.doc["nodes"].append(node)
-        index = len(self.doc["nodes"]) - 1
-        if root:
-            self.doc["scenes"][0]["nodes"].append(index)
-        return index
-
-    def write(self, path):
-        uri = ("data:application/octet-stream;base64,"
-               + base64.b64encode(bytes(self.blob)).decode("ascii"))
-        self.doc["buffers"] = [{"byteLength": len(self.blob), "uri": uri}]
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        with open(path, "w", encoding="utf-8", newline="\n") as f:
-            f.write(json.dumps(self.doc, indent=2))
-            f.write("\n")
-
-
-# ---------------------------------------------------------------------------
 # Cornell Box (Cornell University Program of Computer Graphics data, in mm)
 
 CORNELL_ROOM = {
@@ -287,7 +179,7 @@ def block_triangles(quads):
 
 
 def make_cornell_box(path):
-    g = GltfBuilder()
+    g = GltfWriter(GENERATOR)
     white = g.material("white", (0.725, 0.71, 0.68, 1.0))
     red = g.material("red", (0.63, 0.065, 0.05, 1.0))
     green = g.material("green", (0.14, 0.45, 0.091, 1.0))
@@ -314,7 +206,7 @@ def make_cornell_box(path):
     objects.append(("tall_block", block_triangles(CORNELL_TALL_BLOCK), white))
 
     for name, tris, mat in objects:
-        g.node(name, mesh=g.mesh(name, tris, mat))
+        g.node(name, mesh=g.mesh(name, *flat_mesh(tris), mat))
 
     # 35 mm lens on 25 mm film; look toward +Z (180 degrees about Y).
     cam = g.camera("camera", 2.0 * math.atan(12.5 / 35.0), 1.0)
@@ -395,32 +287,33 @@ def cube(side):
 
 def make_closed_sphere(path):
     """Sphere with albedo 0.5, emission 0.5, seen from inside: L = 1."""
-    g = GltfBuilder()
+    g = GltfWriter(GENERATOR)
     mat = g.material("furnace", (0.5, 0.5, 0.5, 1.0),
                      emissive=(0.5, 0.5, 0.5))
-    g.node("sphere", mesh=g.mesh("sphere", icosphere(3, inward=True), mat))
+    sphere = flat_mesh(icosphere(3, inward=True))
+    g.node("sphere", mesh=g.mesh("sphere", *sphere, mat))
     g.node("camera", camera=g.camera("camera", 1.2, 1.0))
-    g.doc["scenes"][0]["extras"] = {"candela": {"background": [0, 0, 0]}}
+    g.set_background([0, 0, 0])
     g.write(path)
 
 
 def make_white_objects(path):
     """Albedo-1 objects under a white background: L = 1 everywhere."""
-    g = GltfBuilder()
+    g = GltfWriter(GENERATOR)
     white = g.material("white", (1.0, 1.0, 1.0, 1.0))
     # Hierarchy: parent translation, child uniform scale holding unit sphere.
-    sphere_mesh = g.mesh("sphere", icosphere(3), white)
+    sphere_mesh = g.mesh("sphere", *flat_mesh(icosphere(3)), white)
     parent = g.node("sphere", translation=[-0.35, 0.0, 0.0])
     child = g.node("sphere_scaled", root=False, mesh=sphere_mesh,
                    scale=[0.5, 0.5, 0.5])
     g.doc["nodes"][parent]["children"] = [child]
     half = math.radians(30.0) / 2.0
-    g.node("cube", mesh=g.mesh("cube", cube(0.6), white),
+    g.node("cube", mesh=g.mesh("cube", *flat_mesh(cube(0.6)), white),
            translation=[0.4, 0.0, 0.1],
            rotation=[0.0, math.sin(half), 0.0, math.cos(half)])
     g.node("camera", camera=g.camera("camera", 0.8, 1.0),
            translation=[0.0, 0.0, 3.0])
-    g.doc["scenes"][0]["extras"] = {"candela": {"background": [1, 1, 1]}}
+    g.set_background([1, 1, 1])
     g.write(path)
 
 
@@ -464,10 +357,9 @@ def check_gltf(path):
     with open(path, encoding="utf-8") as f:
         doc = json.load(f)
     assert doc["asset"]["version"] == "2.0" and doc["scene"] == 0
-    prefix = "data:application/octet-stream;base64,"
     buf = doc["buffers"][0]
-    assert len(doc["buffers"]) == 1 and buf["uri"].startswith(prefix)
-    blob = base64.b64decode(buf["uri"][len(prefix):])
+    assert len(doc["buffers"]) == 1 and buf["uri"].startswith(DATA_URI_PREFIX)
+    blob = base64.b64decode(buf["uri"][len(DATA_URI_PREFIX):])
     assert len(blob) == buf["byteLength"]
     counts = {}
     for mesh in doc["meshes"]:

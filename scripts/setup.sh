@@ -1,5 +1,6 @@
 # Shared set-up for scripts/demo, scripts/test and scripts/bench (sourced, not run):
-# installs missing Debian packages, then configures and builds Release into build/.
+# installs missing Debian packages, then configures and builds Release into build/
+# (scripts/fuzz sets CANDELA_SKIP_BUILD=1: it builds build-fuzz/ with clang instead).
 set -euo pipefail
 
 CANDELA_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -11,6 +12,9 @@ CANDELA_PACKAGES=(
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev
   googletest libgtest-dev
 )
+# A script sourcing this may add packages (scripts/fuzz: clang and libFuzzer)
+read -r -a _candela_extra <<<"${CANDELA_EXTRA_PACKAGES:-}"
+CANDELA_PACKAGES+=("${_candela_extra[@]}")
 
 candela_install_packages() {
   local missing=()
@@ -33,4 +37,4 @@ candela_build() {
 }
 
 candela_install_packages
-candela_build
+[ "${CANDELA_SKIP_BUILD:-0}" = 1 ] || candela_build

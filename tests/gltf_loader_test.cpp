@@ -19,30 +19,16 @@ using nlohmann::json;
 namespace candela::test {
 namespace {
 
-// A glTF with one quad (two triangles, z = 0, facing +z, UVs with v down) as mesh 0
-json quad_gltf(float half = 1.0f) {
-  std::vector<float> pos = {-half, -half, 0, half, -half, 0, half, half, 0, -half, half, 0};
-  std::vector<float> uv = {0, 1, 1, 1, 1, 0, 0, 0};
-  std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
-  std::string bin(reinterpret_cast<const char*>(pos.data()), pos.size() * 4);
-  bin += std::string(reinterpret_cast<const char*>(uv.data()), uv.size() * 4);
-  bin += std::string(reinterpret_cast<const char*>(idx.data()), idx.size() * 2);
-  json j;
-  j["asset"] = {{"version", "2.0"}};
-  j["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
-  j["bufferViews"] = {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
-                      {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 32}},
-                      {{"buffer", 0}, {"byteOffset", 80}, {"byteLength", 12}}};
-  j["accessors"] = {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"},
-                     {"min", {-half, -half, 0}}, {"max", {half, half, 0}}},
-                    {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}},
-                    {{"bufferView", 2}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}};
-  j["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"indices", 2}, {"material", 0}}}}}};
-  j["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}}}}};
-  j["nodes"] = {{{"mesh", 0}}};
-  j["scenes"] = {{{"nodes", {0}}}};
-  j["scene"] = 0;
-  return j;
+// A quad (two triangles, z = 0, facing +z, UVs with v down) with material 0
+GltfBuilder::Primitive quad() { return quad_primitive({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, 0); }
+
+// A glTF with the primitive (accessors: 0 POSITION, 1 TEXCOORD_0, 2 indices) as mesh 0 in
+// node 0, and a grey diffuse material 0
+GltfBuilder quad_gltf(const GltfBuilder::Primitive& prim = quad()) {
+  GltfBuilder g;
+  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}}}});
+  g.add_node({{"mesh", g.add_mesh({prim})}});
+  return g;
 }
 
 class TempDir {
@@ -125,7 +111,7 @@ TEST(GltfLoader, NodeHierarchyTransformsApply) {
 
 TEST(GltfLoader, MirroringTransformKeepsFrontFacesFront) {
   TempDir dir;
-  json j = quad_gltf();
+  json j = quad_gltf().document();
   j["nodes"][0]["scale"] = {-1, 1, 1};
   Scene s = load_gltf(dir.write("mirror.gltf", j.dump()));
   ASSERT_EQ(s.triangles(), 2u);
@@ -135,18 +121,11 @@ TEST(GltfLoader, MirroringTransformKeepsFrontFacesFront) {
 
 TEST(GltfLoader, MatrixTransformAndTriangleStrip) {
   TempDir dir;
-  json j = quad_gltf();
+  GltfBuilder::Primitive strip = quad();
+  strip.indices = {0, 1, 3, 2};
+  strip.mode = 5;
+  json j = quad_gltf(strip).document();
   j["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 6, 7, 1};  // translate (5,6,7)
-  j["accessors"][2]["count"] = 4;  // indices 0 1 3 2 as a strip
-  j["meshes"][0]["primitives"][0]["mode"] = 5;
-  std::vector<uint16_t> strip = {0, 1, 3, 2};
-  std::vector<float> pos = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
-  std::vector<float> uv(8, 0.0f);
-  std::string bin(reinterpret_cast<const char*>(pos.data()), 48);
-  bin += std::string(reinterpret_cast<const char*>(uv.data()), 32);
-  bin += std::string(reinterpret_cast<const char*>(strip.data()), 8);
-  j["buffers"][0] = {{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}};
-  j["bufferViews"][2]["byteLength"] = 8;
   Scene s = load_gltf(dir.write("strip.gltf", j.dump()));
   ASSERT_EQ(s.triangles(), 2u);
   for (const auto& t : triangles_of(s)) {
@@ -158,9 +137,10 @@ TEST(GltfLoader, MatrixTransformAndTriangleStrip) {
 
 TEST(GltfLoader, TextureTransformAppliesToUvs) {
   TempDir dir;
-  json j = quad_gltf();
-  j["images"] = {{{"uri", "missing-is-not-read.png"}}};
-  j["textures"] = {{{"source", 0}}};
+  GltfBuilder g = quad_gltf();
+  g.add("images", {{"uri", "missing-is-not-read.png"}});
+  g.add("textures", {{"source", 0}});
+  json j = g.document();
   j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {
       {"index", 0},
       {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}, {"scale", {2, 2}}, {"rotation", 1.5707963267948966}}}}}};
@@ -188,18 +168,14 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
 // with red corners on the left and blue on the right shows those colours, blended across
 TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
   TempDir dir;
-  json j = quad_gltf();
+  GltfBuilder::Primitive colored = quad();
   // vertices: 0 (-1,-1) 1 (1,-1) 2 (1,1) 3 (-1,1)
-  std::string colors = {'\xff', 0, 0, '\xff', 0, 0, '\xff', '\xff', 0, 0, '\xff', '\xff', '\xff', 0, 0, '\xff'};
-  j["buffers"].push_back({{"byteLength", colors.size()}, {"uri", "data:application/octet-stream;base64," + base64(colors)}});
-  j["bufferViews"].push_back({{"buffer", 1}, {"byteLength", colors.size()}});
-  j["accessors"].push_back({{"bufferView", 3}, {"componentType", 5121}, {"normalized", true}, {"count", 4}, {"type", "VEC4"}});
-  j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 3;
+  colored.colors = {{255, 0, 0, 255}, {0, 0, 255, 255}, {0, 0, 255, 255}, {255, 0, 0, 255}};
+  GltfBuilder g = quad_gltf(colored);
+  g.add_camera({0, 0, 3}, {0, 0, 0}, 0.5f);
+  g.set_background({1, 1, 1});
+  json j = g.document();
   j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 1};
-  j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.01}}}}};
-  j["nodes"].push_back({{"camera", 0}, {"translation", {0, 0, 3}}});
-  j["scenes"][0]["nodes"] = {0, 1};
-  j["scenes"][0]["extras"] = {{"candela", {{"background", {1, 1, 1}}}}};
   Scene s = load_gltf(dir.write("colors.gltf", j.dump()));
   EXPECT_TRUE(s.features().vertex_colors);
   EXPECT_FLOAT_EQ(triangles_of(s)[0].color[0].x, 1.0f);
@@ -224,7 +200,7 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
 
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
-  json j = quad_gltf();
+  json j = quad_gltf().document();
   j["extensionsUsed"] = {"KHR_materials_clearcoat"};
   j["materials"][0]["extensions"] = {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}}};
   j["materials"].push_back(j["materials"][0]);
@@ -243,25 +219,24 @@ TEST(GltfLoader, MissingAndMalformedFilesFailClearly) {
   TempDir dir;
   EXPECT_THROW(load_gltf((dir.path / "nope.gltf").string()), Error);
   EXPECT_THROW(load_gltf(dir.write("bad.gltf", "{ this is not json")), Error);
-  json j = quad_gltf();
+  json j = quad_gltf().document();
   j["accessors"][0]["count"] = 400;  // reads past the buffer
   EXPECT_THROW(load_gltf(dir.write("short.gltf", j.dump())), Error);
-  json cyclic = quad_gltf();
+  json cyclic = quad_gltf().document();
   cyclic["nodes"] = {{{"mesh", 0}, {"children", {1, 1}}}, {{"children", {0}}}};
   EXPECT_THROW(load_gltf(dir.write("cyclic.gltf", cyclic.dump())), Error);
-  json negative = quad_gltf();
+  json negative = quad_gltf().document();
   negative["materials"][0]["emissiveFactor"] = {1, 1, 1};
   negative["materials"][0]["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", -2}}}};
   EXPECT_THROW(load_gltf(dir.write("negative.gltf", negative.dump())), Error);
-  json bad_scene = quad_gltf();
+  json bad_scene = quad_gltf().document();
   bad_scene["scene"] = 3;
   EXPECT_THROW(load_gltf(dir.write("bad-scene.gltf", bad_scene.dump())), Error);
-  json huge = quad_gltf();
+  json huge = quad_gltf().document();
   huge["accessors"][1]["count"] = 4611686018427387905ull;  // 2^62 + 1: wraps naive bounds checks
   EXPECT_THROW(load_gltf(dir.write("huge.gltf", huge.dump())), Error);
-  json empty = {{"asset", {{"version", "2.0"}}}, {"scenes", {{{"nodes", json::array()}}}}};
   try {
-    load_gltf(dir.write("empty.gltf", empty.dump()));
+    load_gltf(dir.write("empty.gltf", GltfBuilder().document().dump()));
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("no triangles"), std::string::npos);
@@ -279,17 +254,16 @@ TEST(GltfLoader, BaseColorTextureIsSrgbDecodedAndRendered) {
   ASSERT_TRUE(out && out->open(png, OIIO::ImageSpec(2, 1, 3, OIIO::TypeDesc::UINT8)));
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
   out->close();
-  json j = quad_gltf();
-  j["images"] = {{{"uri", "tex.png"}}};
-  j["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33071}}};  // clamp to edge
-  j["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  GltfBuilder g = quad_gltf();
+  g.add("images", {{"uri", "tex.png"}});
+  g.add("samplers", {{"wrapS", 33071}, {"wrapT", 33071}});  // clamp to edge
+  g.add("textures", {{"source", 0}, {"sampler", 0}});
+  g.add_camera({0, 0, 3}, {0, 0, 0}, 0.5f);
+  g.set_background({1, 1, 1});
+  json j = g.document();
   j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 1};
   j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
   j["materials"][0]["doubleSided"] = true;
-  j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.01}}}}};
-  j["nodes"].push_back({{"camera", 0}, {"translation", {0, 0, 3}}});
-  j["scenes"][0]["nodes"] = {0, 1};
-  j["scenes"][0]["extras"] = {{"candela", {{"background", {1, 1, 1}}}}};
   Scene s = load_gltf(dir.write("textured.gltf", j.dump()));
   ASSERT_EQ(s.textures.size(), 1u);
   auto srgb = [](double c) { c /= 255.0; return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };

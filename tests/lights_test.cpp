@@ -338,7 +338,9 @@ TEST_P(LightsTest, EnvironmentDirectionsMatchPdf) {
     for (size_t i = 0; i < s.size(); ++i) {
       if (!(s.flags(i) & kOk)) continue;
       double cos_n = glm::dot(s.wi(i), c.n);
-      if (hemisphere) ASSERT_GE(cos_n, -1e-6) << "below the hemisphere";
+      if (hemisphere) {
+        ASSERT_GE(cos_n, -1e-6) << "below the hemisphere";
+      }
       ASSERT_NEAR(s.pdf(i), hemisphere ? cos_n / kPi : 0.25 / kPi, 1e-6) << "sample " << i;
     }
     auto prob = cell_probabilities(c, h);

@@ -145,15 +145,17 @@ INSTANTIATE_TEST_SUITE_P(Devices, CornellTest, ::testing::Values("pocl", "rustic
 TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   std::string path = ::testing::TempDir() + "near-light.gltf";
   const float h = 0.01f, s = 0.05f;
-  std::vector<TestQuad> quads = {
-      {{{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0},  // floor, facing +y
-      {{{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1}};  // light, facing -y
-  const char* materials = R"([
+  std::vector<GltfBuilder::Primitive> quads = {
+      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),   // floor, facing +y
+      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};  // light, facing -y
+  GltfBuilder g;  // black background
+  g.add_node({{"mesh", g.add_mesh(quads)}});
+  g.doc["materials"] = nlohmann::json::parse(R"([
     {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
     {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
-     "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}])";
-  const float eye[3] = {0.0f, 0.25f, 0.3f}, target[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
-  write_quads_gltf(path, quads, materials, eye, target, 0.5f, bg);
+     "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}])");
+  g.add_camera({0.0f, 0.25f, 0.3f}, {0, 0, 0}, 0.5f);
+  g.write(path);
   Scene scene = load_gltf(path);
   RenderSettings settings;
   settings.width = settings.height = 16;
@@ -180,19 +182,21 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
   out->close();
   const float s = 0.25f, h = 0.3f;
-  std::vector<TestQuad> quads = {
-      {{{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0},
-      {{{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1}};
-  const char* materials = R"([
+  std::vector<GltfBuilder::Primitive> quads = {
+      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),
+      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};
+  GltfBuilder g;  // black background
+  g.add_node({{"mesh", g.add_mesh(quads)}});
+  g.doc["materials"] = nlohmann::json::parse(R"([
     {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
     {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
      "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0},
-     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])";
-  const char* extra = R"({"images": [{"uri": "emit.png"}],
-    "samplers": [{"magFilter": 9729, "wrapS": 33071, "wrapT": 33071}],
-    "textures": [{"source": 0, "sampler": 0}]})";
-  const float eye[3] = {0.0f, 1.2f, 0.01f}, target[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
-  write_quads_gltf(dir + "emissive-texture.gltf", quads, materials, eye, target, 1.2f, bg, extra);
+     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])");
+  g.add("images", {{"uri", "emit.png"}});
+  g.add("samplers", {{"magFilter", 9729}, {"wrapS", 33071}, {"wrapT", 33071}});
+  g.add("textures", {{"source", 0}, {"sampler", 0}});
+  g.add_camera({0.0f, 1.2f, 0.01f}, {0, 0, 0}, 1.2f);
+  g.write(dir + "emissive-texture.gltf");
   Scene scene = load_gltf(dir + "emissive-texture.gltf");
   ASSERT_NE(scene.materials[1].emission_texture.index, NO_TEXTURE);
   RenderSettings settings;

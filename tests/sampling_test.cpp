@@ -174,7 +174,9 @@ TEST_F(SamplingTest, LightSelectionMatchesItsPmf) {
   for (double w : weights) wsum += w;
   for (size_t i = 0; i < pmf.size(); ++i) {
     EXPECT_GE(pmf[i], 0x1.0p-32) << "light " << i << " can never be picked";
-    if (weights[i] / wsum > 1e-6) EXPECT_NEAR(pmf[i], weights[i] / wsum, 1e-9);
+    if (weights[i] / wsum > 1e-6) {
+      EXPECT_NEAR(pmf[i], weights[i] / wsum, 1e-9);
+    }
     total += pmf[i];
   }
   EXPECT_DOUBLE_EQ(total, 1.0);

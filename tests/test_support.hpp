@@ -8,6 +8,7 @@
 
 #include "device.hpp"
 #include "device_types.hpp"
+#include "gltf_builder.hpp"
 #include "scene_compiler.hpp"
 
 namespace candela::test {
@@ -48,21 +49,5 @@ struct SceneOnDevice {
 };
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
-
-std::string base64(const std::string& bytes);
-
-// A quad p0 p1 p2 p3 (counter-clockwise seen from its front) with a material index
-struct TestQuad {
-  float p[4][3];
-  int material;
-};
-
-// Writes a self-contained .gltf with the quads (TEXCOORD_0 (0,1) (1,1) (1,0) (0,0) at
-// p0..p3), the given materials (a JSON array text), a perspective camera at `eye`
-// looking at `target`, a scene background, and the top-level members of `extra_json`
-// (e.g. images, textures, samplers)
-void write_quads_gltf(const std::string& path, const std::vector<TestQuad>& quads,
-                      const std::string& materials_json, const float eye[3], const float target[3],
-                      float yfov, const float background[3], const std::string& extra_json = "{}");
 
 }  // namespace candela::test

@@ -1,0 +1,130 @@
+"""A small glTF 2.0 writer: one binary buffer, accessors, meshes, materials,
+cameras and nodes.
+
+The buffer is embedded as a base64 data URI, or written beside the .gltf as a
+.bin.  JSON members keep their insertion order, so output is deterministic.
+Used by scripts/make_scenes.py.
+"""
+
+import base64
+import json
+import os
+import struct
+
+ARRAY_BUFFER = 34962
+ELEMENT_ARRAY_BUFFER = 34963
+FLOAT = 5126
+UNSIGNED_INT = 5125
+TRIANGLES = 4
+DATA_URI_PREFIX = "data:application/octet-stream;base64,"
+
+
+class GltfWriter:
+    """Accumulates binary data and JSON objects for one glTF file."""
+
+    def __init__(self, generator):
+        self.blob = bytearray()
+        self.doc = {
+            "asset": {"version": "2.0", "generator": generator},
+            "scene": 0,
+            "scenes": [{"nodes": []}],
+            "nodes": [],
+            "meshes": [],
+            "materials": [],
+            "cameras": [],
+            "accessors": [],
+            "bufferViews": [],
+            "buffers": [],
+        }
+
+    def _append(self, member, item):
+        self.doc[member].append(item)
+        return len(self.doc[member]) - 1
+
+    def _view(self, data, target):
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.blob),
+                "byteLength": len(data), "target": target}
+        self.blob.extend(data)
+        return self._append("bufferViews", view)
+
+    def vec3_accessor(self, vectors, with_bounds):
+        data = b"".join(struct.pack("<3f", *v) for v in vectors)
+        acc = {"bufferView": self._view(data, ARRAY_BUFFER),
+               "componentType": FLOAT, "count": len(vectors), "type": "VEC3"}
+        if with_bounds:
+            acc["min"] = [min(v[i] for v in vectors) for i in range(3)]
+            acc["max"] = [max(v[i] for v in vectors) for i in range(3)]
+        return self._append("accessors", acc)
+
+    def index_accessor(self, indices):
+        data = struct.pack("<%dI" % len(indices), *indices)
+        return self._append("accessors", {
+            "bufferView": self._view(data, ELEMENT_ARRAY_BUFFER),
+            "componentType": UNSIGNED_INT, "count": len(indices),
+            "type": "SCALAR"})
+
+    def material(self, name, base_color, emissive=None, strength=None,
+                 double_sided=True):
+        """A diffuse material (metallic 0, roughness 1), maybe emissive."""
+        mat = {"name": name,
+               "pbrMetallicRoughness": {"baseColorFactor": list(base_color),
+                                        "metallicFactor": 0.0,
+                                        "roughnessFactor": 1.0}}
+        if emissive is not None:
+            mat["emissiveFactor"] = list(emissive)
+        if strength is not None:
+            mat["extensions"] = {"KHR_materials_emissive_strength":
+                                 {"emissiveStrength": strength}}
+            used = self.doc.setdefault("extensionsUsed", [])
+            if "KHR_materials_emissive_strength" not in used:
+                used.append("KHR_materials_emissive_strength")
+        mat["doubleSided"] = double_sided
+        return self._append("materials", mat)
+
+    def mesh(self, name, positions, normals, indices, material):
+        """Add a one-primitive triangle mesh; normals may be None."""
+        attributes = {"POSITION": self.vec3_accessor(positions, True)}
+        if normals is not None:
+            attributes["NORMAL"] = self.vec3_accessor(normals, False)
+        prim = {"attributes": attributes,
+                "indices": self.index_accessor(indices),
+                "material": material,
+                "mode": TRIANGLES}
+        return self._append("meshes", {"name": name, "primitives": [prim]})
+
+    def camera(self, name, yfov, aspect, znear=0.01, zfar=100.0):
+        return self._append("cameras", {
+            "name": name, "type": "perspective",
+            "perspective": {"yfov": yfov, "aspectRatio": aspect,
+                            "znear": znear, "zfar": zfar}})
+
+    def node(self, name, root=True, **fields):
+        """Add a node (fields: mesh, camera, children, translation, ...)."""
+        node = {"name": name}
+        node.update(fields)
+        index = self._append("nodes", node)
+        if root:
+            self.doc["scenes"][0]["nodes"].append(index)
+        return index
+
+    def set_background(self, rgb):
+        """candela's scene background radiance (scene extras)."""
+        extras = {"candela": {"background": list(rgb)}}
+        self.doc["scenes"][0]["extras"] = extras
+
+    def write(self, path, embed=True):
+        """Write the .gltf; embed=False puts the buffer in a .bin beside it."""
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        if embed:
+            uri = DATA_URI_PREFIX + base64.b64encode(self.blob).decode("ascii")
+        else:
+            bin_path = os.path.splitext(path)[0] + ".bin"
+            with open(bin_path, "wb") as f:
+                f.write(self.blob)
+            uri = os.path.basename(bin_path)
+        self.doc["buffers"] = [{"byteLength": len(self.blob), "uri": uri}]
+        with open(path, "w", encoding="utf-8", newline="\n") as f:
+            f.write(json.dumps(self.doc, indent=2))
+            f.write("\n")

@@ -1,0 +1,87 @@
+// libFuzzer target over everything a scene file reaches on the host: the glTF loader
+// (tinygltf included) and the compile step. candela::Error is the expected answer to
+// bad input; anything else is a finding: a crash, an ASan or UBSan report, another
+// exception, a hang, or compiled buffers that would make a kernel read out of bounds.
+// Built with -DCANDELA_FUZZ=ON (clang); run by scripts/fuzz.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "bvh_builder.hpp"
+#include "error.hpp"
+#include "gltf_loader.hpp"
+#include "scene_compiler.hpp"
+
+namespace {
+
+void require(bool ok, const char* what) {
+  if (ok) return;
+  std::fprintf(stderr, "gltf_fuzz: compiled scene breaks an invariant: %s\n", what);
+  std::abort();
+}
+
+bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// What the kernels assume of the scene buffers: every index lands inside its array
+void check_compiled(const candela::CompiledScene& c) {
+  const candela::dev::SceneBuffers& b = c.buffers;
+  size_t vertices = b.positions.size() / 3;
+  require(b.positions.size() == 3 * vertices && b.normals.size() == b.positions.size(), "vertex arrays");
+  require(c.triangles == b.prims.size() && c.vertices == vertices, "counts");
+  for (float p : b.positions) require(std::isfinite(p), "finite positions");
+  for (const auto& p : b.prims) {
+    for (unsigned v : p.v) require(v < vertices, "prim vertex index");
+    require(p.material < b.materials.size(), "prim material index");
+  }
+  for (const auto& m : b.materials)
+    for (const auto* t : {&m.base_color_texture, &m.emission_texture}) {
+      require(t->index == NO_TEXTURE || (t->index >= 0 && size_t(t->index) < b.textures.size()), "texture index");
+      require(t->index == NO_TEXTURE || t->texcoord <= 1, "texcoord set");
+    }
+  for (const auto& t : b.textures) {
+    size_t texels = (t.flags & TEXTURE_FLOAT) ? b.texelsf.size() : b.texels8.size();
+    require(t.width > 0 && t.height > 0, "texture size");
+    require(size_t(t.offset) + size_t(t.width) * t.height <= texels, "texture texels");
+  }
+  require(b.lights.empty() ? b.light_thresholds.empty() : b.light_thresholds.size() + 1 == b.lights.size(),
+          "light thresholds");
+  double pmf = 0.0;
+  for (const auto& l : b.lights) {
+    require(l.type != LIGHT_TRIANGLE || l.index < b.prims.size(), "light primitive index");
+    require(l.pmf > 0.0f && l.pmf <= 1.0f, "light pmf");
+    pmf += l.pmf;
+  }
+  require(b.lights.empty() || std::fabs(pmf - 1.0) < 1e-4, "light pmfs sum to 1");
+  require(c.environment_light == NO_LIGHT ||
+              (c.environment_light >= 0 && size_t(c.environment_light) < b.lights.size()),
+          "environment light index");
+  for (const auto& t : b.bvh_tris) require(t.prim < b.prims.size(), "BVH triangle prim");
+  for (const auto& n : b.bvh_nodes) {
+    if (n.right < 0)
+      require(n.left >= 0 && size_t(n.left) + size_t(-int64_t(n.right)) <= b.bvh_tris.size(), "BVH leaf range");
+    else
+      require(n.left > 0 && size_t(n.left) < b.bvh_nodes.size() && size_t(n.right) < b.bvh_nodes.size(),
+              "BVH child index");
+  }
+  require(c.bvh_depth <= candela::kMaxBvhDepth, "BVH depth");
+  require(finite3(c.camera.position) && finite3(c.camera.forward) && finite3(c.camera.up), "finite camera");
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  std::string bytes(reinterpret_cast<const char*>(data), size);
+  try {
+    // No base folder: external URIs cannot reach the file system
+    candela::Scene scene = candela::load_gltf_from_memory(bytes, "");
+    candela::CompiledScene compiled = candela::compile_scene(scene);
+    check_compiled(compiled);
+    candela::make_device_camera(compiled.camera, 64, 48);
+  } catch (const candela::Error& e) {
+    require(e.what()[0] != '\0', "an Error without a message");  // expected: bad input, told clearly
+  }
+  return 0;
+}
