@@ -1,33 +1,102 @@
-// BSDF interface: one record per shading point holding the shading frame, the geometric
-// normal and the material's evaluated parameters; sample / eval / pdf dispatched by a
-// switch on the material type. Lobes (bsdf_*.cl) work in the local frame (z = shading
-// normal, turned to the side wo comes from); this file converts world <-> local and makes
-// the geometric-normal side test, once, for every lobe: a direction on wo's side of the
+// BSDF interface: bsdf_at evaluates the material at a shading point into a Bsdf record
+// (bsdf_common.cl); sample / eval / pdf are dispatched by a switch on the material type.
+// Lobes (bsdf_*.cl) work in the local frame (z = shading normal, turned to the geometric
+// side wo comes from; where the shading normal bends away, wo may still lie below it and
+// glossy lobes then return nothing). This file converts world <-> local and makes the
+// geometric-normal side test, once, for every lobe: a direction on wo's side of the
 // surface can only be reflected into, one on the other side only transmitted into.
 
-typedef struct {
-  Frame frame;  // shading frame; frame.n is the shading normal on wo's side
-  float3 ng;  // geometric normal on wo's side
-  bool entering;  // wo is on the front face (dielectrics: outside -> inside)
-  uint type;  // MATERIAL_*
-  float3 base_color;  // glTF base color: factor x texture x COLOR_0
-} Bsdf;
+float4 bsdf_texture(const SceneData* sc, __global const Material* m, int slot, const SurfaceHit* s) {
+  return textures_lookup(sc, &m->textures[slot], s->uvs);
+}
+
+// The shading frame: the interpolated normal and tangent, then the normal map in the
+// glTF tangent space (bitangent = sign * n x t; back faces mirror it). A mapped normal
+// that would face away from wo's side of the geometry is bent back to just above it, so
+// no light leaks through and no black fringe appears (the method is to clamp the
+// mapped normal to the geometric hemisphere, as many renderers do).
+Frame bsdf_shading_frame(const SceneData* sc, __global const Material* m, const SurfaceHit* s) {
+  Frame f = frame_from_z_x(s->ns, s->tangent);
+  float handed = s->tangent_sign * (s->front ? 1.0f : -1.0f);
+  f.b *= handed;
+#if CD_FEATURE_TEXTURES
+  if (m->textures[TEX_NORMAL].index != NO_TEXTURE) {
+    float3 t = bsdf_texture(sc, m, TEX_NORMAL, s).xyz * 2.0f - 1.0f;
+    t.xy *= m->normal_scale;
+    float3 n = frame_from_local(&f, (float3)(t.x, s->front ? t.y : -t.y, t.z));
+    float len = length(n);
+    if (len > 0.0f && isfinite(len)) {
+      n /= len;
+      float c = dot(n, s->ng);
+      if (c < 0.01f) n = normalize(n + (0.01f - c) * s->ng);
+      f = frame_from_z_x(n, f.t);
+      f.b *= handed;
+    }
+  }
+#endif
+  return f;
+}
+
+void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
+  float4 mr = bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s);
+  b->metallic = m->metallic * mr.z;
+  float roughness = m->roughness * mr.y;
+  // KHR_materials_anisotropy: strength and a direction in the tangent plane, rotated
+  float4 an = bsdf_texture(sc, m, TEX_ANISOTROPY, s);
+  float2 dir = m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.xy * 2.0f - 1.0f : (float2)(1.0f, 0.0f);
+  float strength = m->anisotropy_strength * (m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.z : 1.0f);
+  if (strength > 0.0f) {
+    float cr, sr = sincos(m->anisotropy_rotation, &cr);
+    float3 t = (cr * dir.x - sr * dir.y) * b->frame.t + (sr * dir.x + cr * dir.y) * b->frame.b;
+    float hand = dot(cross(b->frame.n, b->frame.t), b->frame.b) < 0.0f ? -1.0f : 1.0f;
+    b->frame = frame_from_z_x(b->frame.n, t);
+    b->frame.b *= hand;
+  }
+  b->ggx = ggx_from_roughness(roughness, strength);
+  b->transmission = m->transmission * bsdf_texture(sc, m, TEX_TRANSMISSION, s).x;
+  b->thin = (m->flags & MATERIAL_THIN_WALLED) != 0u;
+  // KHR_materials_specular: F0 = min(F0(ior) x colour, 1) x specular, F90 = specular
+  float spec = m->specular_color[3] * bsdf_texture(sc, m, TEX_SPECULAR, s).w;
+  float r = (m->ior - 1.0f) / (m->ior + 1.0f);
+  float3 tint = load3(m->specular_color) * bsdf_texture(sc, m, TEX_SPECULAR_COLOR, s).xyz;
+  b->spec_f0 = fmin(r * r * tint, (float3)(1.0f)) * spec;
+  b->spec_f90 = spec;
+  b->eta = b->entering ? m->ior : 1.0f / m->ior;
+  b->coat = m->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
+  float coat_rough = m->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
+  b->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);
+}
 
 Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   __global const Material* m = &sc->materials[s->material];
   Bsdf b;
-  b.frame = frame_from_z_x(s->ns, s->tangent);
+  b.frame = bsdf_shading_frame(sc, m, s);
   b.ng = s->ng;
   b.entering = s->front;
   b.type = m->type;
-  b.base_color = load3(m->base_color) * textures_lookup(sc, &m->base_color_texture, s->uvs).xyz *
-                 s->vertex_color;
+  b.base_color = load3(m->base_color) * bsdf_texture(sc, m, TEX_BASE_COLOR, s).xyz * s->vertex_color;
+  b.metallic = 0.0f;
+  b.transmission = 0.0f;
+  b.coat = 0.0f;
+  b.ggx = ggx_from_roughness(m->roughness, 0.0f);
+  b.coat_ggx = b.ggx;
+  b.eta = 1.0f;
+  b.thin = false;
+  b.spec_f0 = (float3)(0.0f);
+  b.spec_f90 = 0.0f;
+  b.cond_eta = load3(m->conductor_eta);
+  b.cond_k = load3(m->conductor_k);
+  if (m->type == MATERIAL_GLTF) bsdf_gltf_params(sc, m, s, &b);
   return b;
 }
 
 // The kinds of lobe this BSDF has (BSDF_* flags); light sampling and the integrator ask
 uint bsdf_flags(const Bsdf* b) {
   switch (b->type) {
+    case MATERIAL_GLTF:
+      return bsdf_gltf_flags(b);
+    case MATERIAL_CONDUCTOR:
+      return BSDF_REFLECTION | (ggx_is_delta(b->ggx) ? BSDF_DELTA : BSDF_GLOSSY);
     case MATERIAL_DIFFUSE:
     default:
       return BSDF_REFLECTION | BSDF_DIFFUSE;
@@ -37,24 +106,33 @@ uint bsdf_flags(const Bsdf* b) {
 // The geometric side test: wi lies on wo's side of the surface
 bool bsdf_is_reflection(const Bsdf* b, float3 wi) { return dot(wi, b->ng) > 0.0f; }
 
-float3 bsdf_eval(const Bsdf* b, float3 wo, float3 wi) {
+// f(wo, wi) of the non-delta lobes, and their pdf for bsdf_sample in *pdf
+float3 bsdf_eval_pdf(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   float3 wo_l = frame_to_local(&b->frame, wo), wi_l = frame_to_local(&b->frame, wi);
-  bool reflect = bsdf_is_reflection(b, wi);
+  *pdf = 0.0f;
+  // The local side must agree with the geometric one
+  if (bsdf_is_reflection(b, wi) != (wi_l.z > 0.0f)) return (float3)(0.0f);
   switch (b->type) {
+    case MATERIAL_GLTF:
+      return bsdf_gltf_eval(b, wo_l, wi_l, pdf);
+    case MATERIAL_CONDUCTOR:
+      return bsdf_conductor_eval(b, wo_l, wi_l, pdf);
     case MATERIAL_DIFFUSE:
     default:
-      return reflect ? bsdf_diffuse_eval(b->base_color, wo_l, wi_l) : (float3)(0.0f);
+      *pdf = bsdf_diffuse_pdf(wo_l, wi_l);
+      return bsdf_diffuse_eval(b->base_color, wo_l, wi_l);
   }
 }
 
+float3 bsdf_eval(const Bsdf* b, float3 wo, float3 wi) {
+  float pdf;
+  return bsdf_eval_pdf(b, wo, wi, &pdf);
+}
+
 float bsdf_pdf(const Bsdf* b, float3 wo, float3 wi) {
-  float3 wo_l = frame_to_local(&b->frame, wo), wi_l = frame_to_local(&b->frame, wi);
-  bool reflect = bsdf_is_reflection(b, wi);
-  switch (b->type) {
-    case MATERIAL_DIFFUSE:
-    default:
-      return reflect ? bsdf_diffuse_pdf(wo_l, wi_l) : 0.0f;
-  }
+  float pdf;
+  bsdf_eval_pdf(b, wo, wi, &pdf);
+  return pdf;
 }
 
 // Samples bs->wi (world space) from uc (lobe choice) and u; false when the path ends here
@@ -62,13 +140,21 @@ bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   float3 wo_l = frame_to_local(&b->frame, wo);
   bool ok;
   switch (b->type) {
+    case MATERIAL_GLTF:
+      ok = bsdf_gltf_sample(b, wo_l, uc, u, bs);
+      break;
+    case MATERIAL_CONDUCTOR:
+      ok = bsdf_conductor_sample(b, wo_l, u, bs);
+      break;
     case MATERIAL_DIFFUSE:
     default:
       ok = bsdf_diffuse_sample(b->base_color, wo_l, u, bs);
   }
   if (!ok) return false;
+  bool local_reflection = bs->wi.z > 0.0f;
   bs->wi = frame_from_local(&b->frame, bs->wi);
   // A direction whose geometric side disagrees with its lobe carries nothing
   if (bsdf_is_reflection(b, bs->wi) != ((bs->flags & BSDF_REFLECTION) != 0u)) return false;
+  if (local_reflection != ((bs->flags & BSDF_REFLECTION) != 0u)) return false;
   return bs->pdf > 0.0f && max_component(bs->f) > 0.0f;
 }

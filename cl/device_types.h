@@ -8,7 +8,28 @@
 #define CANDELA_DEVICE_TYPES_H
 
 // Material types (switch-dispatched in bsdf.cl)
-#define MATERIAL_DIFFUSE 0u
+#define MATERIAL_DIFFUSE 0u  // Lambertian, albedo = base color
+#define MATERIAL_GLTF 1u  // glTF metallic-roughness with its KHR_materials_* extensions
+#define MATERIAL_CONDUCTOR 2u  // measured conductor: complex index eta + i k, GGX roughness
+
+// Material flags
+#define MATERIAL_DOUBLE_SIDED 1u
+#define MATERIAL_THIN_WALLED 2u  // transmission through a sheet (no KHR_materials_volume)
+#define MATERIAL_ALPHA_MASK 4u  // alphaMode MASK: cut out below alpha_cutoff
+#define MATERIAL_ALPHA_BLEND 8u  // alphaMode BLEND: stochastic opacity
+
+// Texture slots of a material (Material.textures)
+#define TEX_BASE_COLOR 0
+#define TEX_METALLIC_ROUGHNESS 1  // B metallic, G roughness
+#define TEX_NORMAL 2
+#define TEX_EMISSION 3
+#define TEX_TRANSMISSION 4  // R
+#define TEX_SPECULAR 5  // A
+#define TEX_SPECULAR_COLOR 6  // RGB
+#define TEX_CLEARCOAT 7  // R
+#define TEX_CLEARCOAT_ROUGHNESS 8  // G
+#define TEX_ANISOTROPY 9  // RG direction in tangent space, B strength
+#define TEX_SLOTS 10
 
 // Light types (lights.cl)
 #define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
@@ -64,17 +85,20 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Material, 128 bytes. Colours are linear RGB.
+// Material, 448 bytes. Colours are linear RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;  // MATERIAL_*
-  unsigned int double_sided;
-  unsigned int pad0;
-  unsigned int pad1;
+  unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
+  float alpha_cutoff;  // alphaMode MASK
+  float ior;  // KHR_materials_ior (1.5)
   float base_color[4];  // rgba factor
   float emission[4];  // rgb radiance (factor x strength), w unused
-  float params[4];  // reserved for the materials issue: roughness, metallic, ior, anisotropy
-  TextureRef base_color_texture;
-  TextureRef emission_texture;  // scales `emission`
+  float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
+  float conductor_eta[4];  // MATERIAL_CONDUCTOR: eta per channel
+  float conductor_k[4];  // MATERIAL_CONDUCTOR: k per channel
+  float metallic, roughness, transmission, normal_scale;
+  float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
+  TextureRef textures[TEX_SLOTS];  // TEX_* slots
 } Material;
 
 // A texture inside one of the shared texel arrays, 16 bytes.
@@ -173,9 +197,11 @@ typedef struct {
   FIELD(BvhTriangle, v2, 32)                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
-  SIZE(Material, 128) FIELD(Material, base_color, 16) FIELD(Material, emission, 32)         \
-  FIELD(Material, params, 48) FIELD(Material, base_color_texture, 64)                       \
-  FIELD(Material, emission_texture, 96)                                                     \
+  SIZE(Material, 448) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \
+  FIELD(Material, emission, 32) FIELD(Material, specular_color, 48)                         \
+  FIELD(Material, conductor_k, 80) FIELD(Material, metallic, 96)                            \
+  FIELD(Material, clearcoat, 112) FIELD(Material, anisotropy_rotation, 124)                 \
+  FIELD(Material, textures, 128)                                                            \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
   SIZE(TexelF, 16)                                                                          \

@@ -16,6 +16,7 @@ typedef struct {
   float3 ng;  // geometric normal, turned to the side the ray came from
   float3 ns;  // shading normal, on the same side as ng
   float3 tangent;  // shading tangent direction (TANGENT, else dp/du); 0 when unknown
+  float tangent_sign;  // glTF bitangent = tangent_sign * (n x tangent), front face
   float4 uvs;  // TEXCOORD_0 in xy, TEXCOORD_1 in zw
   float3 vertex_color;  // COLOR_0, white without CD_FEATURE_VERTEX_COLORS
   uint prim;
@@ -35,23 +36,24 @@ float4 surface_uvs(const SceneData* sc, __global const Prim* pr, float b1, float
 #endif
 }
 
-// Tangent from glTF TANGENT when the vertices have one, else dp/du from TEXCOORD_0
-float3 surface_tangent(const SceneData* sc, __global const Prim* pr, float b1, float b2, float3 p0,
+// Tangent (xyz) and bitangent sign (w) from glTF TANGENT when the vertices have one, else
+// dp/du from TEXCOORD_0 with sign +1 (as the glTF sample viewer derives them)
+float4 surface_tangent(const SceneData* sc, __global const Prim* pr, float b1, float b2, float3 p0,
                        float3 p1, float3 p2) {
   float b0 = 1.0f - b1 - b2;
 #if CD_FEATURE_TANGENTS
-  float3 t = b0 * vload4(pr->v[0], sc->tangents).xyz + b1 * vload4(pr->v[1], sc->tangents).xyz +
-             b2 * vload4(pr->v[2], sc->tangents).xyz;
-  if (dot(t, t) > 0.0f) return t;
+  float4 t0 = vload4(pr->v[0], sc->tangents);
+  float4 t = b0 * t0 + b1 * vload4(pr->v[1], sc->tangents) + b2 * vload4(pr->v[2], sc->tangents);
+  if (dot(t.xyz, t.xyz) > 0.0f) return (float4)(t.xyz, t0.w < 0.0f ? -1.0f : 1.0f);
 #endif
 #if CD_FEATURE_UVS
   // dp/du from the triangle's edges and UV differences (pbrt-v4, Triangle::InteractionFromIntersection)
   float2 a0 = vload2(pr->v[0], sc->uv0), a1 = vload2(pr->v[1], sc->uv0), a2 = vload2(pr->v[2], sc->uv0);
   float2 d02 = a0 - a2, d12 = a1 - a2;
   float det = d02.x * d12.y - d02.y * d12.x;
-  if (fabs(det) > 1e-12f) return (d12.y * (p0 - p2) - d02.y * (p1 - p2)) / det;
+  if (fabs(det) > 1e-12f) return (float4)((d12.y * (p0 - p2) - d02.y * (p1 - p2)) / det, 1.0f);
 #endif
-  return (float3)(0.0f);
+  return (float4)(0.0f, 0.0f, 0.0f, 1.0f);
 }
 
 SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3 ray_dir) {
@@ -71,7 +73,9 @@ SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3
   s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
   s.uvs = surface_uvs(sc, pr, b1, b2);
-  s.tangent = surface_tangent(sc, pr, b1, b2, v0, v1, v2);
+  float4 tangent = surface_tangent(sc, pr, b1, b2, v0, v1, v2);
+  s.tangent = tangent.xyz;
+  s.tangent_sign = tangent.w;
 #if CD_FEATURE_VERTEX_COLORS
   s.vertex_color = b0 * vload3(pr->v[0], sc->colors) + b1 * vload3(pr->v[1], sc->colors) +
                    b2 * vload3(pr->v[2], sc->colors);
@@ -85,6 +89,6 @@ SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3
 
 // Radiance a surface emits toward the side `front` names, at texture coordinates uvs
 float3 surface_emission(const SceneData* sc, __global const Material* m, bool front, float4 uvs) {
-  if (!front && !m->double_sided) return (float3)(0.0f);
-  return load3(m->emission) * textures_lookup(sc, &m->emission_texture, uvs).xyz;
+  if (!front && !(m->flags & MATERIAL_DOUBLE_SIDED)) return (float3)(0.0f);
+  return load3(m->emission) * textures_lookup(sc, &m->textures[TEX_EMISSION], uvs).xyz;
 }

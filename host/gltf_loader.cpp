@@ -20,7 +20,24 @@ namespace {
 
 // Extensions this loader implements fully; any other one is named in a warning
 const std::set<std::string> kSupportedExtensions = {
-    "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization"};
+    "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization",
+    "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
+    "KHR_materials_volume", "KHR_materials_clearcoat", "KHR_materials_anisotropy"};
+
+// Measured conductors as RGB complex indices of refraction (eta + i k at about 650, 550
+// and 450 nm), selectable by name in a material's extras.candela.conductor
+struct ConductorPreset {
+  const char* name;
+  glm::vec3 eta, k;
+};
+const ConductorPreset kConductors[] = {
+    {"gold", {0.143119f, 0.374957f, 1.44248f}, {3.98316f, 2.38572f, 1.60322f}},
+    {"silver", {0.155265f, 0.116723f, 0.138342f}, {4.82835f, 3.12225f, 2.14696f}},
+    {"copper", {0.200438f, 0.924033f, 1.10221f}, {3.91295f, 2.45285f, 2.14219f}},
+    {"aluminium", {1.65746f, 0.880369f, 0.521229f}, {9.22387f, 6.26952f, 4.837f}},
+    {"chromium", {4.36968f, 2.9167f, 1.6547f}, {5.20637f, 4.23137f, 3.75491f}},
+    {"iron", {2.91140f, 2.94970f, 2.58450f}, {3.08930f, 2.93180f, 2.76700f}},
+};
 
 class Warnings {
  public:
@@ -231,49 +248,143 @@ class MaterialReader {
     const auto& pbr = gm.pbrMetallicRoughness;
     MaterialDesc m;
     for (int c = 0; c < 4; ++c) m.base_color[c] = float(pbr.baseColorFactor[c]);
-    if (pbr.baseColorTexture.index >= 0)
-      m.base_color_texture = texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                         pbr.baseColorTexture.extensions, true);
-    if (gm.emissiveTexture.index >= 0)
-      m.emission_texture = texture_ref(gm.emissiveTexture.index, gm.emissiveTexture.texCoord,
-                                       gm.emissiveTexture.extensions, true);
-    float strength = 1.0f;
-    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
-    if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
-      strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    m.metallic = float(pbr.metallicFactor);
+    m.roughness = float(pbr.roughnessFactor);
+    set_slot(&m, TEX_BASE_COLOR, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+             pbr.baseColorTexture.extensions, true);
+    set_slot(&m, TEX_METALLIC_ROUGHNESS, pbr.metallicRoughnessTexture.index,
+             pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions, false);
+    set_slot(&m, TEX_NORMAL, gm.normalTexture.index, gm.normalTexture.texCoord, gm.normalTexture.extensions, false);
+    m.normal_scale = float(gm.normalTexture.scale);
+    set_slot(&m, TEX_EMISSION, gm.emissiveTexture.index, gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions, true);
+    float strength = float(number_or(extension(gm, "KHR_materials_emissive_strength"), "emissiveStrength", -1, 1.0));
     for (int c = 0; c < 3; ++c) {
       m.emission[c] = float(gm.emissiveFactor[c]) * strength;
       if (!(m.emission[c] >= 0.0f) || !std::isfinite(m.emission[c]))
         throw Error(name + " has a negative or non-finite emission (emissiveFactor x emissiveStrength)");
     }
     m.double_sided = gm.doubleSided;
-    warn_unsupported(gm, name);
+    m.alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::Mask : gm.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+    m.alpha_cutoff = float(gm.alphaCutoff);
+    read_extensions(gm, &m);
+    read_extras(gm.extras, name, &m);
+    check_ranges(name, &m);
+    warn_unsupported(gm);
     return m;
   }
 
-  void warn_unsupported(const tinygltf::Material& gm, const std::string& name) {
-    const auto& pbr = gm.pbrMetallicRoughness;
-    if (pbr.metallicFactor > 0.0)
-      warn_.add("metallic materials are not supported yet: rendered as diffuse with their base color (" + name + ", metallicFactor " + std::to_string(pbr.metallicFactor) + ")");
-    if (pbr.metallicRoughnessTexture.index >= 0)
-      warn_.add("metallicRoughnessTexture is not supported yet and is ignored");
-    if (gm.normalTexture.index >= 0) warn_.add("normalTexture is not supported yet and is ignored");
+  static const tinygltf::Value& extension(const tinygltf::Material& gm, const char* name) {
+    static const tinygltf::Value none;
+    auto it = gm.extensions.find(name);
+    return it == gm.extensions.end() ? none : it->second;
+  }
+
+  // KHR_materials_ior, _specular, _transmission, _volume, _clearcoat, _anisotropy
+  void read_extensions(const tinygltf::Material& gm, MaterialDesc* m) {
+    m->ior = float(number_or(extension(gm, "KHR_materials_ior"), "ior", -1, 1.5));
+    const tinygltf::Value& spec = extension(gm, "KHR_materials_specular");
+    m->specular = float(number_or(spec, "specularFactor", -1, 1.0));
+    for (int c = 0; c < 3; ++c) m->specular_color[c] = float(number_or(spec, "specularColorFactor", c, 1.0));
+    value_slot(m, TEX_SPECULAR, spec, "specularTexture", false);
+    value_slot(m, TEX_SPECULAR_COLOR, spec, "specularColorTexture", true);
+    const tinygltf::Value& tr = extension(gm, "KHR_materials_transmission");
+    m->transmission = float(number_or(tr, "transmissionFactor", -1, 0.0));
+    value_slot(m, TEX_TRANSMISSION, tr, "transmissionTexture", false);
+    const tinygltf::Value& vol = extension(gm, "KHR_materials_volume");
+    m->thin_walled = !(number_or(vol, "thicknessFactor", -1, 0.0) > 0.0);
+    if (vol.Has("attenuationDistance") || vol.Has("attenuationColor"))
+      warn_.add("KHR_materials_volume attenuation is not rendered yet (the volumes issue): volumes are clear");
+    const tinygltf::Value& cc = extension(gm, "KHR_materials_clearcoat");
+    m->clearcoat = float(number_or(cc, "clearcoatFactor", -1, 0.0));
+    m->clearcoat_roughness = float(number_or(cc, "clearcoatRoughnessFactor", -1, 0.0));
+    value_slot(m, TEX_CLEARCOAT, cc, "clearcoatTexture", false);
+    value_slot(m, TEX_CLEARCOAT_ROUGHNESS, cc, "clearcoatRoughnessTexture", false);
+    if (cc.Has("clearcoatNormalTexture"))
+      warn_.add("KHR_materials_clearcoat clearcoatNormalTexture is not supported yet: the coat uses the base's normal");
+    const tinygltf::Value& an = extension(gm, "KHR_materials_anisotropy");
+    m->anisotropy_strength = float(number_or(an, "anisotropyStrength", -1, 0.0));
+    m->anisotropy_rotation = float(number_or(an, "anisotropyRotation", -1, 0.0));
+    value_slot(m, TEX_ANISOTROPY, an, "anisotropyTexture", false);
+  }
+
+  // extras.candela.conductor: a preset name or {"eta": [r, g, b], "k": [r, g, b]}
+  void read_extras(const tinygltf::Value& extras, const std::string& name, MaterialDesc* m) {
+    if (!extras.Has("candela") || !extras.Get("candela").Has("conductor")) return;
+    const tinygltf::Value& c = extras.Get("candela").Get("conductor");
+    m->type = MATERIAL_CONDUCTOR;
+    if (c.IsString()) {
+      for (const auto& p : kConductors)
+        if (c.Get<std::string>() == p.name) {
+          m->conductor_eta = p.eta;
+          m->conductor_k = p.k;
+          return;
+        }
+      std::string names;
+      for (const auto& p : kConductors) names += std::string(names.empty() ? "" : ", ") + p.name;
+      throw Error(name + ": unknown conductor '" + c.Get<std::string>() + "' (known: " + names + ")");
+    }
+    for (int i = 0; i < 3; ++i) {
+      m->conductor_eta[i] = float(number_or(c, "eta", i, -1.0));
+      m->conductor_k[i] = float(number_or(c, "k", i, -1.0));
+    }
+  }
+
+  static void check_ranges(const std::string& name, MaterialDesc* m) {
+    auto in = [&](float v, float lo, float hi, const char* what) {
+      if (!(v >= lo && v <= hi)) throw Error(name + ": " + what + " must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    };
+    for (int c = 0; c < 4; ++c) in(m->base_color[c], 0.0f, 1.0f, "baseColorFactor");
+    in(m->metallic, 0.0f, 1.0f, "metallicFactor");
+    in(m->roughness, 0.0f, 1.0f, "roughnessFactor");
+    in(m->transmission, 0.0f, 1.0f, "transmissionFactor");
+    in(m->specular, 0.0f, 1.0f, "specularFactor");
+    in(m->clearcoat, 0.0f, 1.0f, "clearcoatFactor");
+    in(m->clearcoat_roughness, 0.0f, 1.0f, "clearcoatRoughnessFactor");
+    in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
+    in(m->ior, 0.0f, 10.0f, "ior");
+    for (int c = 0; c < 3; ++c) {
+      in(m->specular_color[c], 0.0f, 1e6f, "specularColorFactor");
+      if (m->type == MATERIAL_CONDUCTOR) {
+        in(m->conductor_eta[c], 0.0f, 100.0f, "conductor eta");
+        in(m->conductor_k[c], 0.0f, 100.0f, "conductor k");
+      }
+    }
+    // ior 0 stands for an infinite index (a perfect mirror); keep the kernel's arithmetic finite
+    m->ior = m->ior == 0.0f ? 1e4f : std::max(m->ior, 1.0f + 1e-4f);
+  }
+
+  void warn_unsupported(const tinygltf::Material& gm) {
     if (gm.occlusionTexture.index >= 0)
       warn_.add("occlusionTexture is ignored (a path tracer computes occlusion itself)");
-    if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
-      warn_.add("alphaMode " + gm.alphaMode + " is not supported yet: surfaces are opaque");
     for (const auto& e : gm.extensions)
       if (!kSupportedExtensions.count(e.first))
         warn_.add("glTF extension " + e.first + " is not supported yet and is ignored");
   }
 
-  TextureSlot texture_ref(int gltf_texture, int texcoord, const tinygltf::ExtensionMap& extensions,
-                         bool srgb) {
+  void set_slot(MaterialDesc* m, int slot, int gltf_texture, int texcoord,
+                const tinygltf::ExtensionMap& extensions, bool srgb) {
+    if (gltf_texture < 0) return;
+    auto tt = extensions.find("KHR_texture_transform");
+    m->textures[slot] = texture_ref(gltf_texture, texcoord, tt == extensions.end() ? nullptr : &tt->second, srgb);
+  }
+
+  // A textureInfo inside an extension (a plain JSON object to tinygltf)
+  void value_slot(MaterialDesc* m, int slot, const tinygltf::Value& ext, const char* key, bool srgb) {
+    if (!ext.Has(key)) return;
+    const tinygltf::Value& info = ext.Get(key);
+    int index = int(number_or(info, "index", -1, -1.0));
+    if (index < 0) throw Error(std::string("glTF ") + key + " has no texture index");
+    const tinygltf::Value* tt = nullptr;
+    if (info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
+      tt = &info.Get("extensions").Get("KHR_texture_transform");
+    m->textures[slot] = texture_ref(index, int(number_or(info, "texCoord", -1, 0.0)), tt, srgb);
+  }
+
+  TextureSlot texture_ref(int gltf_texture, int texcoord, const tinygltf::Value* transform, bool srgb) {
     TextureSlot ref;
     ref.index = texture_index(gltf_texture, srgb);
     ref.texcoord = texcoord;
-    auto tt = extensions.find("KHR_texture_transform");
-    if (tt != extensions.end()) read_texture_transform(tt->second, &ref);
+    if (transform) read_texture_transform(*transform, &ref);
     if (ref.texcoord < 0 || ref.texcoord > 1) {
       warn_.add("textures on TEXCOORD_" + std::to_string(ref.texcoord) + " are not supported (only TEXCOORD_0 and TEXCOORD_1): the texture is ignored");
       ref.index = NO_TEXTURE;

@@ -45,7 +45,7 @@ Bounds Scene::bounds() const {
 SceneFeatures Scene::features() const {
   SceneFeatures f;
   for (const auto& m : materials)
-    f.textures |= m.base_color_texture.index != NO_TEXTURE || m.emission_texture.index != NO_TEXTURE;
+    for (const auto& t : m.textures) f.textures |= t.index != NO_TEXTURE;
   for (const auto& m : meshes) {
     f.uvs |= !m.uv0.empty() || !m.uv1.empty();
     f.tangents |= !m.tangents.empty();
@@ -59,7 +59,7 @@ bool Scene::has_emission() const {
   for (const auto& mesh : meshes) {
     const MaterialDesc& m = materials.at(mesh.material);
     bool factor = m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;
-    int tex = m.emission_texture.index;
+    int tex = m.texture(TEX_EMISSION).index;
     if (factor && (tex == NO_TEXTURE || textures.at(size_t(tex)).mean_luminance() > 0.0)) return true;
   }
   return false;

@@ -21,13 +21,29 @@ struct TextureSlot {
   }
 };
 
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// A material as glTF describes it (defaults: the glTF specification's), or a measured
+// conductor; factors multiply the textures of the same name
 struct MaterialDesc {
-  uint32_t type = MATERIAL_DIFFUSE;
-  glm::vec4 base_color{1.0f};  // linear rgba factor
-  TextureSlot base_color_texture;
+  uint32_t type = MATERIAL_GLTF;
+  glm::vec4 base_color{1.0f};  // linear rgba
+  float metallic = 1.0f, roughness = 1.0f;
   glm::vec3 emission{0.0f};  // radiance: emissiveFactor x emissive strength
-  TextureSlot emission_texture;
+  float ior = 1.5f;  // KHR_materials_ior
+  float specular = 1.0f;  // KHR_materials_specular
+  glm::vec3 specular_color{1.0f};
+  float transmission = 0.0f;  // KHR_materials_transmission
+  bool thin_walled = true;  // no KHR_materials_volume (or thickness 0): a sheet, not a solid
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
+  float anisotropy_strength = 0.0f, anisotropy_rotation = 0.0f;  // KHR_materials_anisotropy
+  float normal_scale = 1.0f;
+  glm::vec3 conductor_eta{0.0f}, conductor_k{0.0f};  // MATERIAL_CONDUCTOR
   bool double_sided = false;
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  TextureSlot textures[TEX_SLOTS];  // TEX_* slots
+  const TextureSlot& texture(int slot) const { return textures[slot]; }
 };
 
 struct TextureDesc {

@@ -72,11 +72,28 @@ void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
   for (const MaterialDesc& m : scene.materials) {
     dev::Material d{};
     d.type = m.type;
-    d.double_sided = m.double_sided ? 1u : 0u;
+    d.flags = (m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.thin_walled ? MATERIAL_THIN_WALLED : 0u) |
+              (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
+              (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
+    d.alpha_cutoff = m.alpha_cutoff;
+    d.ior = m.ior;
     for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
-    for (int c = 0; c < 3; ++c) d.emission[c] = m.emission[c];
-    d.base_color_texture = compile_texture_ref(m.base_color_texture);
-    d.emission_texture = compile_texture_ref(m.emission_texture);
+    for (int c = 0; c < 3; ++c) {
+      d.emission[c] = m.emission[c];
+      d.specular_color[c] = m.specular_color[c];
+      d.conductor_eta[c] = m.conductor_eta[c];
+      d.conductor_k[c] = m.conductor_k[c];
+    }
+    d.specular_color[3] = m.specular;
+    d.metallic = m.metallic;
+    d.roughness = m.roughness;
+    d.transmission = m.transmission;
+    d.normal_scale = m.normal_scale;
+    d.clearcoat = m.clearcoat;
+    d.clearcoat_roughness = m.clearcoat_roughness;
+    d.anisotropy_strength = m.anisotropy_strength;
+    d.anisotropy_rotation = m.anisotropy_rotation;
+    for (int slot = 0; slot < TEX_SLOTS; ++slot) d.textures[slot] = compile_texture_ref(m.textures[slot]);
     b->materials.push_back(d);
   }
 }
@@ -116,7 +133,7 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     const MaterialDesc& m = scene.materials[p.material];
     if (!(dev::luminance_rgb(m.emission.x, m.emission.y, m.emission.z) > 0.0f)) continue;
     double scale = 1.0;
-    if (int tex = m.emission_texture.index; tex != NO_TEXTURE) {
+    if (int tex = m.texture(TEX_EMISSION).index; tex != NO_TEXTURE) {
       if (texture_mean[size_t(tex)] < 0.0) texture_mean[size_t(tex)] = scene.textures[size_t(tex)].mean_luminance();
       scale = texture_mean[size_t(tex)];
     }
@@ -171,7 +188,7 @@ double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, do
       // Diffuse emitter: power = pi * L * A per emitting side
       const dev::Material& m = buffers.materials[buffers.prims[light.index].material];
       double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
-      return kPi * lum * light.params[0] * (m.double_sided ? 2.0 : 1.0);
+      return kPi * lum * light.params[0] * ((m.flags & MATERIAL_DOUBLE_SIDED) ? 2.0 : 1.0);
     }
     case LIGHT_ENVIRONMENT:
       // A constant environment's power through the scene's bounding sphere

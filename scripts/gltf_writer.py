@@ -58,6 +58,11 @@ class GltfWriter:
             acc["max"] = [max(v[i] for v in vectors) for i in range(3)]
         return self._append("accessors", acc)
 
+    def _use(self, extension):
+        used = self.doc.setdefault("extensionsUsed", [])
+        if extension not in used:
+            used.append(extension)
+
     def index_accessor(self, indices):
         data = struct.pack("<%dI" % len(indices), *indices)
         return self._append("accessors", {
@@ -67,19 +72,19 @@ class GltfWriter:
 
     def material(self, name, base_color, emissive=None, strength=None,
                  double_sided=True):
-        """A diffuse material (metallic 0, roughness 1), maybe emissive."""
+        """A Lambertian material (metallic 0, roughness 1, no specular layer:
+        KHR_materials_specular's specularFactor 0), maybe emissive."""
         mat = {"name": name,
                "pbrMetallicRoughness": {"baseColorFactor": list(base_color),
                                         "metallicFactor": 0.0,
-                                        "roughnessFactor": 1.0}}
+                                        "roughnessFactor": 1.0},
+               "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}
+        self._use("KHR_materials_specular")
         if emissive is not None:
             mat["emissiveFactor"] = list(emissive)
         if strength is not None:
-            mat["extensions"] = {"KHR_materials_emissive_strength":
-                                 {"emissiveStrength": strength}}
-            used = self.doc.setdefault("extensionsUsed", [])
-            if "KHR_materials_emissive_strength" not in used:
-                used.append("KHR_materials_emissive_strength")
+            mat["extensions"]["KHR_materials_emissive_strength"] = {"emissiveStrength": strength}
+            self._use("KHR_materials_emissive_strength")
         mat["doubleSided"] = double_sided
         return self._append("materials", mat)
 

@@ -58,9 +58,10 @@ dev::Material make_material(unsigned type, glm::dvec3 base_color) {
   m.type = type;
   for (int c = 0; c < 3; ++c) m.base_color[c] = float(base_color[c]);
   m.base_color[3] = 1.0f;
-  for (dev::TextureRef* t : {&m.base_color_texture, &m.emission_texture}) {
-    t->index = NO_TEXTURE;
-    t->m[0] = t->m[4] = 1.0f;
+  m.ior = 1.5f;
+  for (dev::TextureRef& t : m.textures) {
+    t.index = NO_TEXTURE;
+    t.m[0] = t.m[4] = 1.0f;
   }
   return m;
 }

@@ -23,10 +23,11 @@ namespace {
 GltfBuilder::Primitive quad() { return quad_primitive({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, 0); }
 
 // A glTF with the primitive (accessors: 0 POSITION, 1 TEXCOORD_0, 2 indices) as mesh 0 in
-// node 0, and a grey diffuse material 0
+// node 0, and a grey Lambertian material 0 (no specular layer)
 GltfBuilder quad_gltf(const GltfBuilder::Primitive& prim = quad()) {
   GltfBuilder g;
-  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}}}});
+  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0}}},
+                      {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0}}}}}});
   g.add_node({{"mesh", g.add_mesh({prim})}});
   return g;
 }
@@ -157,7 +158,7 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
   Scene s = load_gltf(dir.write("tt.gltf", j.dump()));
   // Raw UVs reach the device; the slot's transform maps uv (1, 1): scaled (2, 2), rotated
   // by pi/2 (u' = u cos + v sin, v' = -u sin + v cos) to (2, -2), offset to (2.5, -2)
-  const TextureSlot& ref = s.materials[0].base_color_texture;
+  const TextureSlot& ref = s.materials[0].texture(TEX_BASE_COLOR);
   EXPECT_EQ(ref.texcoord, 0);
   glm::vec2 uv = glm::vec2(ref.transform * glm::vec3(1.0f, 1.0f, 1.0f));
   EXPECT_NEAR(uv.x, 2.5f, 1e-5f);
@@ -201,18 +202,21 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf().document();
-  j["extensionsUsed"] = {"KHR_materials_clearcoat"};
-  j["materials"][0]["extensions"] = {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}}};
+  j["extensionsUsed"] = {"KHR_materials_sheen"};
+  j["materials"][0]["extensions"] = {{"KHR_materials_sheen", {{"sheenRoughnessFactor", 1}}}};
   j["materials"].push_back(j["materials"][0]);
-  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
+  j["materials"][0]["occlusionTexture"] = {{"index", 0}};
+  j["materials"][1]["occlusionTexture"] = {{"index", 0}};
+  j["textures"] = {{{"source", 0}}};
+  j["images"] = {{{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="}}};
   Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
-  int clearcoat = 0, metallic = 0;
+  int sheen = 0, occlusion = 0;
   for (const auto& w : s.warnings) {
-    clearcoat += w.find("KHR_materials_clearcoat") != std::string::npos;
-    metallic += w.find("metallic") != std::string::npos;
+    sheen += w.find("KHR_materials_sheen") != std::string::npos;
+    occlusion += w.find("occlusionTexture") != std::string::npos;
   }
-  EXPECT_EQ(clearcoat, 1);
-  EXPECT_EQ(metallic, 1);
+  EXPECT_EQ(sheen, 1);
+  EXPECT_EQ(occlusion, 1);
 }
 
 TEST(GltfLoader, MissingAndMalformedFilesFailClearly) {

@@ -151,7 +151,8 @@ TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   GltfBuilder g;  // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
+    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
+     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
     {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
      "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}])");
   g.add_camera({0.0f, 0.25f, 0.3f}, {0, 0, 0}, 0.5f);
@@ -188,7 +189,8 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   GltfBuilder g;  // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
+    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
+     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
     {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
      "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0},
      "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])");
@@ -198,7 +200,7 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   g.add_camera({0.0f, 1.2f, 0.01f}, {0, 0, 0}, 1.2f);
   g.write(dir + "emissive-texture.gltf");
   Scene scene = load_gltf(dir + "emissive-texture.gltf");
-  ASSERT_NE(scene.materials[1].emission_texture.index, NO_TEXTURE);
+  ASSERT_NE(scene.materials[1].texture(TEX_EMISSION).index, NO_TEXTURE);
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 2;

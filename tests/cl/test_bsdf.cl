@@ -22,6 +22,7 @@ SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo) {
   s.ns = normalize(ns);
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
   s.tangent = tangent;
+  s.tangent_sign = 1.0f;
   s.uvs = (float4)(0.0f);
   s.vertex_color = (float3)(1.0f);
   s.prim = 0u;

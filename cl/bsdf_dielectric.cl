@@ -1,0 +1,83 @@
+// Dielectric interface in the local frame (wo.z > 0), eta = eta_t / eta_i seen from wo:
+// reflection and refraction chosen by the exact Fresnel term, Snell's law, total internal
+// reflection, radiance scaled by 1 / eta^2 on refraction, transmitted light tinted. Rough
+// surfaces follow Walter et al. 2007 (Microfacet Models for Refraction through Rough
+// Surfaces) with visible-normal sampling; below GGX_DELTA_ALPHA the lobes are Dirac.
+// `thin`: a thin-walled sheet, whose transmission leaves straight through (mirrored
+// reflection lobe) without bending.
+
+// The non-delta part: f(wo, wi) and the pdf of bsdf_dielectric_sample
+float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo, float3 wi,
+                            float* pdf) {
+  *pdf = 0.0f;
+  if (ggx_is_delta(g) || wo.z <= 0.0f || wi.z == 0.0f) return (float3)(0.0f);
+  if (wi.z > 0.0f || thin) {
+    // Reflection, or a thin sheet's transmission as the reflection mirrored through the sheet
+    float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
+    float cos_oh;
+    float f = ggx_reflection_eval(g, wo, wr, pdf, &cos_oh);
+    float r = fresnel_dielectric(cos_oh, eta);
+    float share = wi.z > 0.0f ? r : 1.0f - r;
+    *pdf *= share;
+    return (wi.z > 0.0f ? (float3)(1.0f) : tint) * (f * share);
+  }
+  // Refraction: generalized half vector h ~ wo + eta wi, turned up
+  float3 h = wo + eta * wi;
+  if (dot(h, h) == 0.0f) return (float3)(0.0f);
+  h = normalize(h);
+  if (h.z < 0.0f) h = -h;
+  float cos_oh = dot(wo, h), cos_ih = dot(wi, h);
+  if (cos_oh <= 0.0f || cos_ih >= 0.0f) return (float3)(0.0f);
+  float t = 1.0f - fresnel_dielectric(cos_oh, eta);
+  float denom = cos_ih + cos_oh / eta;
+  denom *= denom;
+  *pdf = t * ggx_visible_d(g, wo, h) * fabs(cos_ih) / denom;  // dh/dwi = |wi.h| / denom
+  float f = t * ggx_d(g, h) * ggx_g(g, wo, wi) * fabs(cos_ih * cos_oh / (wi.z * wo.z * denom));
+  return tint * (f / (eta * eta));
+}
+
+// Smooth interface: reflect with probability R, else refract (or pass a thin sheet)
+bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo, float uc,
+                                   BsdfSample* bs) {
+  float r = fresnel_dielectric(wo.z, eta);
+  if (thin && r < 1.0f) r += (1.0f - r) * (1.0f - r) * r / (1.0f - r * r);  // inter-reflections in the sheet
+  bs->eta = 1.0f;
+  if (uc < r) {
+    bs->wi = (float3)(-wo.x, -wo.y, wo.z);
+    bs->f = (float3)(r / wo.z);
+    bs->pdf = r;
+    bs->flags = BSDF_REFLECTION | BSDF_DELTA;
+    return r > 0.0f;
+  }
+  if (thin) {
+    bs->wi = -wo;
+    bs->f = tint * ((1.0f - r) / wo.z);
+  } else {
+    if (!fresnel_refract(wo, (float3)(0.0f, 0.0f, 1.0f), eta, &bs->wi)) return false;
+    bs->f = tint * ((1.0f - r) / (fabs(bs->wi.z) * eta * eta));
+    bs->eta = eta;
+  }
+  bs->pdf = 1.0f - r;
+  bs->flags = BSDF_TRANSMISSION | BSDF_DELTA;
+  return true;
+}
+
+bool bsdf_dielectric_sample(Ggx g, float eta, bool thin, float3 tint, float3 wo, float uc,
+                            float2 u, BsdfSample* bs) {
+  if (wo.z <= 0.0f) return false;
+  if (ggx_is_delta(g)) return bsdf_dielectric_sample_smooth(eta, thin, tint, wo, uc, bs);
+  float3 h = ggx_sample_visible(g, wo, u);
+  float r = fresnel_dielectric(dot(wo, h), eta);
+  if (uc < r || thin) {
+    bs->wi = fresnel_reflect(wo, h);
+    if (bs->wi.z <= 0.0f) return false;
+    if (uc >= r) bs->wi.z = -bs->wi.z;  // thin sheet: straight through
+  } else if (!fresnel_refract(wo, h, eta, &bs->wi) || bs->wi.z >= 0.0f) {
+    return false;
+  }
+  bool transmits = bs->wi.z < 0.0f;
+  bs->f = bsdf_dielectric_eval(g, eta, thin, tint, wo, bs->wi, &bs->pdf);
+  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | BSDF_GLOSSY;
+  bs->eta = transmits && !thin ? eta : 1.0f;
+  return bs->pdf > 0.0f;
+}
