@@ -55,11 +55,13 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   float cos_h = wo.z;  // wo.h of reflections; the coat's attenuation uses it
   float d = 0.0f, p = 0.0f;
   if (wi.z > 0.0f) {
-    d = ggx_reflection_eval(b->ggx, wo, wi, &p, &cos_h);
-    float3 fd = fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_h);
+    // The microfacet terms only where a specular layer exists (not for pure Lambert)
+    bool glossy = m > 0.0f || b->spec_f90 > 0.0f || b->coat > 0.0f;
+    if (glossy) d = ggx_reflection_eval(b->ggx, wo, wi, &p, &cos_h);
+    float3 fd = glossy ? fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_h) : (float3)(0.0f);
     under = (1.0f - m) * (1.0f - t) * (1.0f - max_component(fd)) * b->base_color * INV_PI_F;
     *pdf += w.diffuse * sample_cosine_hemisphere_pdf(wi.z);
-    if (!ggx_is_delta(b->ggx)) {
+    if (glossy && !ggx_is_delta(b->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
       *pdf += (w.metal + w.spec) * p;
     }
@@ -133,7 +135,7 @@ uint bsdf_gltf_flags(const Bsdf* b) {
   bool plastic = b->metallic < 1.0f && b->transmission < 1.0f;
   if (plastic && max_component(b->base_color) > 0.0f) flags |= BSDF_DIFFUSE;
   bool spec_delta = ggx_is_delta(b->ggx), coat_delta = b->coat > 0.0f && ggx_is_delta(b->coat_ggx);
-  flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (b->metallic > 0.0f || b->spec_f90 > 0.0f || b->transmission > 0.0f) flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (b->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (b->transmission > 0.0f && b->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
   return flags;
