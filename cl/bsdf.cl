@@ -86,7 +86,12 @@ Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   b.spec_f90 = 0.0f;
   b.cond_eta = load3(m->conductor_eta);
   b.cond_k = load3(m->conductor_k);
-  if (m->type == MATERIAL_GLTF) bsdf_gltf_params(sc, m, s, &b);
+  if (m->type == MATERIAL_GLTF) {
+    bsdf_gltf_params(sc, m, s, &b);
+    // No specular layer, metal, glass or coat: exactly Lambertian, so take the short path
+    if (b.metallic == 0.0f && b.spec_f90 == 0.0f && b.transmission == 0.0f && b.coat == 0.0f)
+      b.type = MATERIAL_DIFFUSE;
+  }
   return b;
 }
 
