@@ -55,10 +55,13 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
   return contrib;
 }
 
-// Russian roulette on throughput x eta_scale; false when the path ends
+// Russian roulette on throughput x eta_scale (pbrt-v4's rule): a path whose throughput
+// is below 1 survives with that probability; one at or above 1 always survives, so paths
+// that carry all their energy (white walls, glass) are not cut short. False: path ends.
 bool path_survives_roulette(PathState* ps, uint rr_depth, Rng* rng) {
   if (ps->depth + 1u < rr_depth) return true;
-  float q = fmin(max_component(ps->beta) * ps->eta_scale, 0.95f);
+  float q = max_component(ps->beta) * ps->eta_scale;
+  if (q >= 1.0f) return true;
   if (rng_next(rng) >= q) return false;
   ps->beta /= q;
   return true;
@@ -95,7 +98,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     float2 u = (float2)(rng_next(rng), rng_next(rng));
     BsdfSample bs;
     if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
-    ps.beta *= bs.f * (fabs(dot(bs.wi, s.ns)) / bs.pdf);
+    ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
     ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u;
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;

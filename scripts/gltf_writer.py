@@ -10,6 +10,7 @@ import base64
 import json
 import os
 import struct
+import zlib
 
 ARRAY_BUFFER = 34962
 ELEMENT_ARRAY_BUFFER = 34963
@@ -63,6 +64,13 @@ class GltfWriter:
         if extension not in used:
             used.append(extension)
 
+    def vec_accessor(self, vectors, n):
+        """VEC2/VEC3/VEC4 float accessor without bounds."""
+        data = b"".join(struct.pack("<%df" % n, *v) for v in vectors)
+        return self._append("accessors", {
+            "bufferView": self._view(data, ARRAY_BUFFER), "componentType": FLOAT,
+            "count": len(vectors), "type": "VEC%d" % n})
+
     def index_accessor(self, indices):
         data = struct.pack("<%dI" % len(indices), *indices)
         return self._append("accessors", {
@@ -87,6 +95,44 @@ class GltfWriter:
             self._use("KHR_materials_emissive_strength")
         mat["doubleSided"] = double_sided
         return self._append("materials", mat)
+
+    def pbr_material(self, name, pbr, extensions=None, **fields):
+        """A material from its pbrMetallicRoughness dict, KHR extensions (marked
+        as used) and other glTF material members (doubleSided, normalTexture, ...)."""
+        mat = {"name": name, "pbrMetallicRoughness": pbr}
+        if extensions:
+            mat["extensions"] = extensions
+            for ext in extensions:
+                self._use(ext)
+        mat.update(fields)
+        return self._append("materials", mat)
+
+    def png_texture(self, width, height, rgba, srgb_hint="", nearest=False):
+        """A texture of an RGBA8 image (bytes, rows top to bottom) embedded as PNG."""
+        raw = b"".join(b"\x00" + bytes(rgba[4 * width * y:4 * width * (y + 1)])
+                       for y in range(height))
+
+        def chunk(tag, data):
+            body = tag + data
+            return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+        png = (b"\x89PNG\r\n\x1a\n" +
+               chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)) +
+               chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+        image = self._append_member("images", {
+            "uri": "data:image/png;base64," + base64.b64encode(png).decode("ascii")})
+        sampler = {"magFilter": 9728 if nearest else 9729, "minFilter": 9729}
+        return self._append_member("textures", {
+            "source": image, "sampler": self._append_member("samplers", sampler)})
+
+    def _append_member(self, member, item):
+        self.doc.setdefault(member, [])
+        return self._append(member, item)
+
+    def mesh_from_accessors(self, name, attributes, indices, material):
+        """A one-primitive mesh over existing accessors (meshes may share them)."""
+        prim = {"attributes": dict(attributes), "indices": indices,
+                "material": material, "mode": TRIANGLES}
+        return self._append("meshes", {"name": name, "primitives": [prim]})
 
     def mesh(self, name, positions, normals, indices, material):
         """Add a one-primitive triangle mesh; normals may be None."""

@@ -370,6 +370,7 @@ def check_gltf(path):
             normals = read_vec3s(doc, blob, attrs["NORMAL"])
             indices = read_indices(doc, blob, prim["indices"])
             assert len(positions) == len(normals)
+            smooth = mesh["name"].startswith("smooth-")
             assert len(indices) % 3 == 0
             assert all(i < len(positions) for i in indices)
             for i in range(3):
@@ -379,11 +380,168 @@ def check_gltf(path):
                 a, b, c = (positions[i] for i in indices[k:k + 3])
                 n = tri_normal(a, b, c)
                 for i in indices[k:k + 3]:
-                    assert dot(n, normals[i]) > 0.999, "winding/normal mismatch"
+                    assert dot(n, normals[i]) > (0.5 if smooth else 0.999), "winding/normal mismatch"
             if mesh["name"] in ("sphere", "cube"):
                 check_watertight(positions, indices)
             counts[mesh["name"]] = len(indices) // 3
     return counts
+
+
+# ---------------------------------------------------------------------------
+# Materials scene
+
+def uv_sphere(radius, segments=48, rings=24):
+    """Smooth UV sphere: positions, normals, TEXCOORD_0, outward-facing indices."""
+    positions, normals, uvs, indices = [], [], [], []
+    for r in range(rings + 1):
+        theta = math.pi * r / rings
+        for k in range(segments + 1):
+            phi = 2.0 * math.pi * k / segments
+            n = (math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi))
+            normals.append(f32v(n))
+            positions.append(f32v(scale(n, radius)))
+            uvs.append((k / segments, r / rings))
+    for r in range(rings):
+        for k in range(segments):
+            a, b = r * (segments + 1) + k, (r + 1) * (segments + 1) + k
+            if r > 0:
+                indices += [a, b, a + 1]
+            if r < rings - 1:
+                indices += [a + 1, b, b + 1]
+    return positions, normals, uvs, indices
+
+
+def rgba_image(width, height, texel):
+    """RGBA8 bytes of an image whose texel(x, y) gives 4 values in [0, 1]."""
+    out = bytearray()
+    for y in range(height):
+        for x in range(width):
+            out += bytes(max(0, min(255, int(round(255 * c)))) for c in texel(x, y))
+    return out
+
+
+def bump_normal(x, y, size=64, cells=6, depth=0.6):
+    """Tangent-space normal of a field of round bumps (glTF: +x right, +y up)."""
+    u, v = (x + 0.5) / size * cells, (y + 0.5) / size * cells
+    du, dv = u - math.floor(u) - 0.5, v - math.floor(v) - 0.5
+    r2 = du * du + dv * dv
+    if r2 > 0.16:
+        return (0.5, 0.5, 1.0, 1.0)
+    # height h = depth * (0.16 - r2): slope along +u is -2 du depth, along +y (image up) 2 dv depth
+    n = normalize((2.0 * du * depth, -2.0 * dv * depth, 1.0))
+    return (0.5 + 0.5 * n[0], 0.5 + 0.5 * n[1], 0.5 + 0.5 * n[2], 1.0)
+
+
+def material_rows(g):
+    """Materials of the sphere grid, back row first, five a row."""
+    spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
+    glass_volume = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                    "KHR_materials_volume": {"thicknessFactor": 0.8}}
+
+    def pbr(base, metallic, roughness):
+        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
+                "roughnessFactor": roughness}
+
+    def conductor(name, roughness):
+        return g.pbr_material("%s-%.2f" % (name, roughness), pbr((1, 1, 1), 1.0, roughness),
+                              extras={"candela": {"conductor": name}})
+    bumps = g.png_texture(64, 64, rgba_image(64, 64, bump_normal))
+    rows = [
+        [conductor("gold", r) for r in (0.0, 0.25, 0.5, 0.75, 1.0)],
+        [conductor(n, 0.2) for n in ("silver", "copper", "aluminium", "chromium", "iron")],
+        [g.pbr_material("glass", pbr((1, 1, 1), 0.0, 0.0), glass_volume),
+         g.pbr_material("rough-glass", pbr((1, 1, 1), 0.0, 0.3), glass_volume),
+         g.pbr_material("thin-glass", pbr((0.9, 1, 0.95), 0.0, 0.0),
+                        {"KHR_materials_transmission": {"transmissionFactor": 1.0}}),
+         g.pbr_material("red-plastic", pbr((0.8, 0.05, 0.05), 0.0, 0.2)),
+         g.pbr_material("blue-plastic", pbr((0.05, 0.1, 0.7), 0.0, 0.6))],
+        [g.pbr_material("clearcoat", pbr((0.9, 0.35, 0.05), 0.0, 0.6),
+                        {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0,
+                                                     "clearcoatRoughnessFactor": 0.05}}),
+         g.pbr_material("anisotropic-metal", pbr((0.9, 0.9, 0.9), 1.0, 0.5),
+                        {"KHR_materials_anisotropy": {"anisotropyStrength": 0.8}}),
+         g.pbr_material("normal-mapped", pbr((0.7, 0.7, 0.7), 0.0, 0.4),
+                        normalTexture={"index": bumps}),
+         None,  # the alpha-masked card stands here
+         g.pbr_material("brass", pbr((1.0, 0.8, 0.4), 1.0, 0.3))],
+    ]
+    return rows, spec0
+
+
+def make_materials(path):
+    """A grid of spheres: conductor presets over roughness, glass (refracting,
+    rough, thin-walled), plastics, clearcoat, anisotropic metal, a normal-mapped
+    sphere and an alpha-masked card, over a checker floor under an area light."""
+    g = GltfWriter(GENERATOR)
+    rows, spec0 = material_rows(g)
+    radius = 0.38
+    pos, nrm, uv, idx = uv_sphere(radius)
+    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
+              "TEXCOORD_0": g.vec_accessor(uv, 2)}
+    sphere_indices = g.index_accessor(idx)
+    for r, row in enumerate(rows):
+        for c, mat in enumerate(row):
+            if mat is None:
+                continue
+            name = g.doc["materials"][mat]["name"]
+            mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
+            g.node(name, mesh=mesh, translation=[c - 2.0, radius, r - 1.5])
+    # Alpha-masked card: a quad with a cut-out checker, standing in the front row
+    holes = g.png_texture(8, 8, rgba_image(8, 8, lambda x, y: (0.2, 0.6, 0.2, float((x + y) % 2))),
+                          nearest=True)
+    card = g.pbr_material("masked-card", {"baseColorTexture": {"index": holes}, "metallicFactor": 0.0},
+                          spec0, alphaMode="MASK", doubleSided=True)
+    card_pos = [f32v(p) for p in ((-0.35, 0.0, 0.0), (0.35, 0.0, 0.0), (0.35, 0.7, 0.0), (-0.35, 0.7, 0.0))]
+    card_mesh = g.mesh_from_accessors(
+        "card", {"POSITION": g.vec3_accessor(card_pos, True),
+                 "NORMAL": g.vec3_accessor([(0.0, 0.0, 1.0)] * 4, False),
+                 "TEXCOORD_0": g.vec_accessor([(0, 1), (1, 1), (1, 0), (0, 0)], 2)},
+        g.index_accessor([0, 1, 2, 0, 2, 3]), card)
+    g.node("masked-card", mesh=card_mesh, translation=[1.0, 0.0, 1.5])
+    # Checker floor and the light
+    checker = g.png_texture(2, 2, rgba_image(2, 2, lambda x, y: (0.75, 0.75, 0.75, 1) if (x + y) % 2 else (0.3, 0.3, 0.3, 1)),
+                            nearest=True)
+    floor_mat = g.pbr_material("floor", {"baseColorTexture": {"index": checker}, "metallicFactor": 0.0}, spec0)
+    s = 5.0
+    floor_pos = [f32v(p) for p in ((-s, 0, s), (s, 0, s), (s, 0, -s), (-s, 0, -s))]
+    floor = g.mesh_from_accessors(
+        "floor", {"POSITION": g.vec3_accessor(floor_pos, True),
+                  "NORMAL": g.vec3_accessor([(0.0, 1.0, 0.0)] * 4, False),
+                  "TEXCOORD_0": g.vec_accessor([(0, 10), (10, 10), (10, 0), (0, 0)], 2)},
+        g.index_accessor([0, 1, 2, 0, 2, 3]), floor_mat)
+    g.node("floor", mesh=floor)
+    light = g.material("light", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 0.95, 0.85), strength=8.0,
+                       double_sided=False)
+    h, w = 4.0, 1.5
+    light_pos = [f32v(p) for p in ((-w, h, -w), (w, h, -w), (w, h, w), (-w, h, w))]
+    g.node("light", mesh=g.mesh("light", light_pos, [(0.0, -1.0, 0.0)] * 4, [0, 1, 2, 0, 2, 3], light))
+    # Camera above the front edge, looking down the grid
+    eye, target = (0.0, 3.2, 6.0), (0.0, 0.2, 0.3)
+    f = normalize(sub(target, eye))
+    right = normalize(cross(f, (0.0, 1.0, 0.0)))
+    up = cross(right, f)
+    g.node("camera", camera=g.camera("camera", 0.55, 1.5), translation=list(eye),
+           rotation=quat_from_basis(right, up, scale(f, -1.0)))
+    g.set_background([0.08, 0.09, 0.11])
+    g.write(path)
+
+
+def quat_from_basis(x, y, z):
+    """Unit quaternion [x, y, z, w] of the rotation with columns x, y, z."""
+    m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0:
+        s = 0.5 / math.sqrt(trace + 1.0)
+        return [(m[2][1] - m[1][2]) * s, (m[0][2] - m[2][0]) * s, (m[1][0] - m[0][1]) * s, 0.25 / s]
+    i = max(range(3), key=lambda k: m[k][k])
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(1.0 + m[i][i] - m[j][j] - m[k][k])
+    q = [0.0, 0.0, 0.0, 0.0]
+    q[i] = 0.25 * s
+    q[j] = (m[j][i] + m[i][j]) / s
+    q[k] = (m[k][i] + m[i][k]) / s
+    q[3] = (m[k][j] - m[j][k]) / s
+    return q
 
 
 # ---------------------------------------------------------------------------
@@ -392,6 +550,7 @@ SCENES = [
     ("scenes/cornell-box/cornell-box.gltf", make_cornell_box),
     ("scenes/furnace/closed-sphere.gltf", make_closed_sphere),
     ("scenes/furnace/white-objects.gltf", make_white_objects),
+    ("scenes/materials/materials.gltf", make_materials),
 ]
 
 

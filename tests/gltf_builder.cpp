@@ -3,6 +3,7 @@
 #include <fstream>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <map>
 
 namespace candela::test {
 
@@ -110,6 +111,41 @@ GltfBuilder::Primitive quad_primitive(const float (&p)[4][3], int material) {
   q.indices = {0, 1, 2, 0, 2, 3};
   q.material = material;
   return q;
+}
+
+GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions,
+                                        int material) {
+  const float t = 1.6180339887f;
+  std::vector<glm::vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<glm::ivec3> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (auto& x : v) x = glm::normalize(x);
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      auto key = std::minmax(a, b);
+      if (auto it = mid.find(key); it != mid.end()) return it->second;
+      v.push_back(glm::normalize(v[size_t(a)] + v[size_t(b)]));
+      return mid[key] = int(v.size()) - 1;
+    };
+    std::vector<glm::ivec3> next;
+    for (auto tri : f) {
+      int a = midpoint(tri.x, tri.y), b = midpoint(tri.y, tri.z), c = midpoint(tri.z, tri.x);
+      next.insert(next.end(), {{tri.x, a, c}, {tri.y, b, a}, {tri.z, c, b}, {a, b, c}});
+    }
+    f = next;
+  }
+  GltfBuilder::Primitive p;
+  for (const auto& x : v) p.positions.push_back(center + radius * x);
+  for (auto tri : f) {
+    glm::vec3 a = v[size_t(tri.x)], b = v[size_t(tri.y)], c = v[size_t(tri.z)];
+    bool outward = glm::dot(glm::cross(b - a, c - a), a + b + c) > 0.0f;
+    for (int k : {tri.x, outward ? tri.y : tri.z, outward ? tri.z : tri.y}) p.indices.push_back(uint16_t(k));
+  }
+  p.material = material;
+  return p;
 }
 
 }  // namespace candela::test

@@ -48,4 +48,8 @@ class GltfBuilder {
 // TEXCOORD_0 (0,1) (1,1) (1,0) (0,0) at p0..p3
 GltfBuilder::Primitive quad_primitive(const float (&p)[4][3], int material);
 
+// A closed icosphere (flat-shaded, shared vertices, outward winding)
+GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions,
+                                        int material);
+
 }  // namespace candela::test

@@ -14,38 +14,6 @@
 namespace candela::test {
 namespace {
 
-struct Estimate {
-  double mean = 0.0;
-  double standard_error = 0.0;
-};
-
-// Mean over pixels [x0,x1) x [y0,y1) of channel c, with its standard error from the
-// per-pixel sample variances
-Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1) {
-  double sum = 0.0, var = 0.0;
-  int n = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      size_t i = size_t(y) * f.width + x;
-      sum += f.pixel(i)[c];
-      var += f.variance_of_mean(i)[c];
-      ++n;
-    }
-  return {sum / n, std::sqrt(var) / n};
-}
-
-Estimate image_mean(const Film& f) {
-  Estimate e;
-  double var = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    Estimate ec = region_mean(f, c, 0, f.width, 0, f.height);
-    e.mean += ec.mean / 3.0;
-    var += ec.standard_error * ec.standard_error / 9.0;  // channels treated as independent: conservative enough for a z-test
-  }
-  e.standard_error = std::sqrt(var);
-  return e;
-}
-
 RenderResult render_scene(const DeviceEntry& device, const std::string& scene_file, Strategy s,
                           int size, uint32_t spp, uint32_t max_depth = 1000, uint32_t seed = 1) {
   Scene scene = load_gltf(scene_path(scene_file));

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <cmath>
+
 #include "error.hpp"
 #include "kernel_sources.hpp"
 #include "program_cache.hpp"
@@ -50,6 +52,31 @@ cl_uint SceneOnDevice::bind(cl::Kernel& kernel, cl_uint first_arg) const {
   for (const cl::Buffer& b : buffers) kernel.setArg(arg++, b);
   kernel.setArg(arg++, params);
   return arg;
+}
+
+Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1) {
+  double sum = 0.0, var = 0.0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      size_t i = size_t(y) * f.width + x;
+      sum += f.pixel(i)[c];
+      var += f.variance_of_mean(i)[c];
+      ++n;
+    }
+  return {sum / n, std::sqrt(var) / n};
+}
+
+Estimate image_mean(const Film& f) {
+  Estimate e;
+  double var = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    Estimate ec = region_mean(f, c, 0, f.width, 0, f.height);
+    e.mean += ec.mean / 3.0;
+    var += ec.standard_error * ec.standard_error / 9.0;  // channels as independent: conservative enough for a z-test
+  }
+  e.standard_error = std::sqrt(var);
+  return e;
 }
 
 std::string scene_path(const std::string& relative) {

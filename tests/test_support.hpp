@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "device.hpp"
+#include "film.hpp"
 #include "device_types.hpp"
 #include "gltf_builder.hpp"
 #include "scene_compiler.hpp"
@@ -47,6 +48,14 @@ struct SceneOnDevice {
   SceneOnDevice(KernelRig& rig, const CompiledScene& scene);
   cl_uint bind(cl::Kernel& kernel, cl_uint first_arg) const;
 };
+
+// A mean over pixels with its standard error from the per-pixel sample variances
+struct Estimate {
+  double mean = 0.0;
+  double standard_error = 0.0;
+};
+Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1);  // channel c
+Estimate image_mean(const Film& f);  // all pixels, channels averaged
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
 
