@@ -61,7 +61,8 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   float3 tint = load3(m->specular_color) * bsdf_texture(sc, m, TEX_SPECULAR_COLOR, s).xyz;
   b->spec_f0 = fmin(r * r * tint, (float3)(1.0f)) * spec;
   b->spec_f90 = spec;
-  b->eta = b->entering ? m->ior : 1.0f / m->ior;
+  // A thin sheet has air on both sides: light meets air -> glass from either face
+  b->eta = b->entering || b->thin ? m->ior : 1.0f / m->ior;
   b->coat = m->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
   float coat_rough = m->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
   b->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);

@@ -48,7 +48,8 @@ json glass(double roughness, bool volume) {
 struct FurnaceCase {
   const char* label;
   json material;
-  double tolerance;  // allowed deficit beyond 4 standard errors (float rounding)
+  double tolerance;  // allowed deficit beyond 4 standard errors
+  bool bsdf_only = false;  // nee is heavy-tailed here (light sampling of a near-delta lobe)
 };
 
 class MaterialFurnace : public ::testing::TestWithParam<std::tuple<int, Strategy>> {};
@@ -58,6 +59,10 @@ const std::vector<FurnaceCase>& furnace_cases() {
       {"white_lambert", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}}, 1e-6},
       {"smooth_glass", glass(0.0, true), 1e-5},
       {"smooth_thin_glass", glass(0.0, false), 1e-5},
+      // Rough dielectrics lose what single scattering misses (about 0.7% here, mostly at
+      // the silhouette); their lobes have no multiple-scattering compensation yet
+      {"rough_glass", glass(0.2, true), 0.012, true},
+      {"rough_thin_glass", glass(0.2, false), 0.012},
   };
   return cases;
 }
@@ -69,10 +74,12 @@ const std::vector<FurnaceCase>& furnace_cases() {
 TEST_P(MaterialFurnace, InvisibleUnderUniformBackground) {
   const FurnaceCase& c = furnace_cases()[size_t(std::get<0>(GetParam()))];
   Strategy s = std::get<1>(GetParam());
+  if (c.bsdf_only && s == Strategy::Nee) GTEST_SKIP() << "nee is heavy-tailed on near-delta glass";
   Scene scene = furnace_scene(c.material, std::string("furnace-") + c.label + ".gltf");
   Film f = render(scene, s, 16, 256, 1000, 7);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
+  EXPECT_LE(e.mean, 1.0 + 4.0 * e.standard_error + 1e-5) << c.label << " " << name(s) << " creates energy";
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + c.tolerance) << c.label << " " << name(s) << " SE " << e.standard_error;
   for (int by = 0; by < 16; by += 4)
     for (int bx = 0; bx < 16; bx += 4) {
