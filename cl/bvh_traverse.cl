@@ -1,8 +1,19 @@
 // BVH traversal: a short stack, nearer child first, any-hit early exit for shadow rays.
 // The node and leaf layout (BvhNode, BvhTriangle) is private to this file and
 // host/bvh_builder.cpp; everything else sees hits by stable primitive index.
+// Hits on triangles flagged BVH_TRI_ALPHA_TEST count only where the scene's alpha test
+// says so (cut-outs, stochastic opacity): that code is compiled in with CD_FEATURE_ALPHA.
 
 #define BVH_STACK_SIZE 64
+
+#ifndef CD_FEATURE_ALPHA
+#define CD_FEATURE_ALPHA 1
+#endif
+
+// Does the hit at barycentrics (b1, b2) of primitive `prim` along `ray` count? Defined by
+// the scene (cl/alpha.cl); the traversal passes `sc` through without reading it.
+struct SceneData;
+bool scene_alpha_passes(const struct SceneData* sc, uint prim, float b1, float b2, Ray ray);
 
 // Plain compares instead of fmin/fmax: the slab distances below are never NaN
 float max4_f(float a, float b, float c, float d) {
@@ -47,9 +58,9 @@ float3 safe_inverse(float3 d) {
                   1.0f / (fabs(d.z) > tiny ? d.z : copysign(tiny, d.z)));
 }
 
-// Closest hit in (0, tmax), or with any_hit the first hit found.
-Hit bvh_intersect(__global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
-                  float tmax, bool any_hit) {
+// Closest hit in (0, tmax), or with any_hit the first hit found; `sc` goes to the alpha test
+Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes,
+                  __global const BvhTriangle* tris, Ray ray, float tmax, bool any_hit) {
   Hit hit;
   hit.t = tmax;
   hit.prim = -1;
@@ -69,6 +80,10 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const BvhTriangle* tri
       for (int i = node->left; i < end; ++i) {
         float t, b1, b2;
         if (bvh_leaf_triangle_hit(&wr, &tris[i], hit.t, &t, &b1, &b2)) {
+#if CD_FEATURE_ALPHA
+          if ((tris[i].flags & BVH_TRI_ALPHA_TEST) && !scene_alpha_passes(sc, tris[i].prim, b1, b2, ray))
+            continue;
+#endif
           hit.t = t;
           hit.b1 = b1;
           hit.b2 = b2;
@@ -98,7 +113,7 @@ Hit bvh_intersect(__global const BvhNode* nodes, __global const BvhTriangle* tri
   }
 }
 
-bool bvh_occluded(__global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
-                  float tmax) {
-  return bvh_intersect(nodes, tris, ray, tmax, true).prim >= 0;
+bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes,
+                  __global const BvhTriangle* tris, Ray ray, float tmax) {
+  return bvh_intersect(sc, nodes, tris, ray, tmax, true).prim >= 0;
 }

@@ -40,12 +40,13 @@
 #define STRATEGY_BSDF 1u
 
 // Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
-// colour encoding and texel storage
+// colour encoding, texel storage and filter
 #define WRAP_REPEAT 0u
 #define WRAP_CLAMP 1u
 #define WRAP_MIRROR 2u
 #define TEXTURE_SRGB 0x10000u  // RGBA8 texels hold sRGB-encoded colour (alpha linear)
 #define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
+#define TEXTURE_NEAREST 0x40000u  // nearest-texel lookup (glTF magFilter NEAREST), else bilinear
 
 #define NO_TEXTURE (-1)
 #define NO_LIGHT (-1)
@@ -60,11 +61,12 @@ typedef struct {
 } BvhNode;
 
 // A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
+#define BVH_TRI_ALPHA_TEST 1u  // hits must pass scene_alpha_passes (alphaMode MASK / BLEND)
 typedef struct {
   float v0[3];
   unsigned int prim;  // stable primitive index (Prim array)
   float v1[3];
-  unsigned int pad0;
+  unsigned int flags;  // BVH_TRI_*
   float v2[3];
   unsigned int pad1;
 } BvhTriangle;
@@ -106,7 +108,7 @@ typedef struct {
   unsigned int offset;  // first texel
   unsigned int width;
   unsigned int height;
-  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB | TEXTURE_FLOAT
+  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB | TEXTURE_FLOAT | TEXTURE_NEAREST
 } TextureInfo;
 
 // RGBA8 texel, 4 bytes
@@ -194,7 +196,7 @@ typedef struct {
   SIZE(BvhNode, 32) FIELD(BvhNode, left, 12) FIELD(BvhNode, bmax, 16)                       \
   FIELD(BvhNode, right, 28)                                                                 \
   SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16)             \
-  FIELD(BvhTriangle, v2, 32)                                                                \
+  FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
   SIZE(Material, 448) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \

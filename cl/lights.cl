@@ -23,7 +23,7 @@ LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) 
   LightSampleContext ctx;
   ctx.p = s->p;
   ctx.n = s->ng;
-  ctx.ns = s->ns;
+  ctx.ns = b->frame.n;  // the BSDF's shading normal (normal-mapped)
   ctx.transmits = (bsdf_flags(b) & BSDF_TRANSMISSION) != 0u;
   return ctx;
 }
@@ -85,6 +85,8 @@ bool lights_sample_triangle(const SceneData* sc, __global const Light* light,
   bool front = dot(n, ls->wi) < 0.0f;
   __global const Prim* pr = &sc->prims[light->index];
   ls->radiance = surface_emission(sc, &sc->materials[pr->material], front, surface_uvs(sc, pr, b1, b2));
+  // Where alpha lets rays through, BSDF-sampled rays find the emitter only that often
+  ls->radiance *= alpha_coverage(sc, light->index, b1, b2);
   ls->pdf = lights_triangle_solid_angle_pdf(ctx->p, y, n, light->params[0]);
   ls->at_infinity = false;
   ls->target = offset_ray_origin(y, front ? n : -n);

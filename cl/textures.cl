@@ -1,6 +1,7 @@
-// Bilinear lookup of textures in two shared texel arrays (RGBA8 and float RGBA). sRGB
-// texels are decoded through a 256-entry table before filtering, so filtering happens in
-// linear space. Each material slot is a TextureRef: texture, UV set and transform.
+// Bilinear (or nearest-texel) lookup of textures in two shared texel arrays (RGBA8 and
+// float RGBA). sRGB texels are decoded through a 256-entry table before filtering, so
+// filtering happens in linear space. Each material slot is a TextureRef: texture, UV set
+// and transform.
 
 #ifndef CD_FEATURE_TEXTURES
 #define CD_FEATURE_TEXTURES 1
@@ -33,12 +34,15 @@ float4 texture_texel(const SceneData* sc, __global const TextureInfo* tex, int x
 
 // uv in glTF convention: (0, 0) is the top-left corner of the image
 float4 texture_sample(const SceneData* sc, __global const TextureInfo* tex, float2 uv) {
-  float x = uv.x * (float)tex->width - 0.5f;
-  float y = uv.y * (float)tex->height - 0.5f;
+  // Texel centres at half-integers for bilinear filtering; nearest takes the texel uv lies in
+  float centre = (tex->flags & TEXTURE_NEAREST) ? 0.0f : 0.5f;
+  float x = uv.x * (float)tex->width - centre;
+  float y = uv.y * (float)tex->height - centre;
   // Keep huge coordinates in range before converting to int
   x = fmod(x, 8388608.0f);
   y = fmod(y, 8388608.0f);
   float fx = floor(x), fy = floor(y);
+  if (tex->flags & TEXTURE_NEAREST) return texture_texel(sc, tex, (int)fx, (int)fy);
   float ax = x - fx, ay = y - fy;
   int ix = (int)fx, iy = (int)fy;
   float4 c00 = texture_texel(sc, tex, ix, iy);

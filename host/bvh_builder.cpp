@@ -181,8 +181,14 @@ class Builder {
 
 }  // namespace
 
-Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims) {
-  return Builder(positions, prims).build();
+Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
+              const std::vector<bool>& alpha_tested) {
+  Bvh bvh = Builder(positions, prims).build();
+  for (dev::BvhTriangle& t : bvh.tris) {
+    uint32_t material = prims[t.prim].material;
+    if (material < alpha_tested.size() && alpha_tested[material]) t.flags |= BVH_TRI_ALPHA_TEST;
+  }
+  return bvh;
 }
 
 }  // namespace candela

@@ -20,7 +20,10 @@ struct Bvh {
 // the tree shallower than that.
 constexpr int kMaxBvhDepth = 60;
 
-// `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order)
-Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims);
+// `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order);
+// `alpha_tested`: by Prim::material, whether hits on its triangles call the kernel's alpha
+// test (BVH_TRI_ALPHA_TEST); empty for none
+Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
+              const std::vector<bool>& alpha_tested = {});
 
 }  // namespace candela

@@ -232,8 +232,10 @@ void read_texture_transform(const tinygltf::Value& ext, TextureSlot* ref) {
 // Materials and the textures they use
 class MaterialReader {
  public:
-  MaterialReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
-      : model_(model), scene_(scene), warn_(*warn) {}
+  // `image_errors`: why each image that load_checked_image left empty was not decoded
+  MaterialReader(const tinygltf::Model& model, const std::map<int, std::string>& image_errors, Scene* scene,
+                 Warnings* warn)
+      : model_(model), image_errors_(image_errors), scene_(scene), warn_(*warn) {}
 
   // Reads every material, then the default one (index = model's material count)
   void read_all() {
@@ -399,36 +401,61 @@ class MaterialReader {
     if (gltf_texture < 0 || gltf_texture >= (int)model_.textures.size())
       throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
     const tinygltf::Texture& tex = model_.textures[size_t(gltf_texture)];
-    if (tex.source < 0 || tex.source >= (int)model_.images.size()) {
-      warn_.add("glTF texture " + std::to_string(gltf_texture) +
-                " has no PNG or JPEG source (e.g. only KHR_texture_basisu): it is ignored");
-      return NO_TEXTURE;
+    TextureDesc t;
+    std::string why;
+    int& index = texture_cache_[key];
+    index = NO_TEXTURE;
+    if (decode_source(tex, srgb, &t, &why)) {
+      read_sampler(tex.sampler, &t);
+      index = int(scene_->textures.size());
+      scene_->textures.push_back(std::move(t));
+    } else {
+      warn_.add("glTF texture " + std::to_string(gltf_texture) + " has no image candela can decode (" + why +
+                "): it is ignored, as if the material had no such texture");
     }
-    TextureDesc t = decode_image(tex.source, srgb);
-    read_sampler(tex.sampler, &t);
-    int index = int(scene_->textures.size());
-    scene_->textures.push_back(std::move(t));
-    texture_cache_[key] = index;
     return index;
   }
 
+  // The texture's core `source`, else the image of EXT_texture_webp, KHR_texture_basisu or
+  // MSFT_texture_dds if that one decodes; false with the first image's reason when none does
+  bool decode_source(const tinygltf::Texture& tex, bool srgb, TextureDesc* t, std::string* why) {
+    std::vector<int> sources;
+    if (tex.source >= 0) sources.push_back(tex.source);
+    for (const char* ext : {"EXT_texture_webp", "KHR_texture_basisu", "MSFT_texture_dds"})
+      if (auto it = tex.extensions.find(ext); it != tex.extensions.end())
+        if (double source = number_or(it->second, "source", -1, -1.0); source >= 0.0)
+          sources.push_back(int(std::min(source, 1e9)));
+    for (int source : sources) {
+      if (source >= (int)model_.images.size()) throw Error("glTF image " + std::to_string(source) + " does not exist");
+      std::string reason = decode_image(source, srgb, t);
+      if (reason.empty()) return true;
+      if (why->empty()) *why = "image " + std::to_string(source) + " " + reason;
+    }
+    if (why->empty()) *why = "it has no source";
+    return false;
+  }
+
   // tinygltf decodes every image to 4 channels of 8 or 16 bits: 8-bit images stay RGBA8
-  // (sRGB decoded in the kernel), 16-bit ones become float texels, decoded here
-  TextureDesc decode_image(int source, bool srgb) {
+  // (sRGB decoded in the kernel), 16-bit ones become float texels, decoded here. Returns
+  // why the image cannot be used, or "".
+  std::string decode_image(int source, bool srgb, TextureDesc* out) {
     const tinygltf::Image& img = model_.images[size_t(source)];
-    if (img.width <= 0 || img.height <= 0 || img.image.empty())
-      throw Error("glTF image " + std::to_string(source) + " ('" + img.uri + "') could not be decoded");
-    TextureDesc t;
+    if (img.width <= 0 || img.height <= 0 || img.image.empty()) {
+      if (auto it = image_errors_.find(source); it != image_errors_.end()) return it->second;
+      return img.uri.empty() ? "could not be decoded" : "('" + img.uri + "') could not be read or decoded";
+    }
+    TextureDesc& t = *out;
+    t = TextureDesc();
     t.width = img.width;
     t.height = img.height;
     size_t n = t.texels();
     if (img.component != 4 || (img.bits != 8 && img.bits != 16) ||
         img.image.size() < n * 4 * size_t(img.bits / 8))
-      throw Error("glTF image " + std::to_string(source) + " has an unexpected pixel layout");
+      return "has an unexpected pixel layout";
     if (img.bits == 8) {
       t.srgb = srgb;
       t.rgba8.assign(img.image.begin(), img.image.begin() + ptrdiff_t(4 * n));
-      return t;
+      return "";
     }
     t.rgbaf.resize(4 * n);
     for (size_t i = 0; i < 4 * n; ++i) {
@@ -437,7 +464,7 @@ class MaterialReader {
       float c = v / 65535.0f;
       t.rgbaf[i] = srgb && i % 4 != 3 ? dev::srgb_to_linear(c) : c;
     }
-    return t;
+    return "";
   }
 
   void read_sampler(int sampler_index, TextureDesc* t) {
@@ -450,11 +477,12 @@ class MaterialReader {
     };
     t->wrap_s = mode(sampler.wrapS);
     t->wrap_t = mode(sampler.wrapT);
-    if (sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
-      warn_.add("texture filter NEAREST is not supported yet: textures are filtered bilinearly");
+    // Without mip-maps magFilter picks every lookup (nearest or bilinear); minFilter is unused
+    t->nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
   }
 
   const tinygltf::Model& model_;
+  const std::map<int, std::string>& image_errors_;
   Scene* scene_;
   Warnings& warn_;
   std::map<std::pair<int, bool>, int> texture_cache_;
@@ -541,7 +569,7 @@ class MeshReader {
     read_colors(prim, n, m);
   }
 
-  // COLOR_0: RGB or RGBA (alpha unused while surfaces are opaque), linear, in [0, 1]
+  // COLOR_0: RGB or RGBA (its alpha is not used, alphaMode reads the base colour's), linear, in [0, 1]
   void read_colors(const tinygltf::Primitive& prim, size_t n, MeshDesc* m) {
     int comps = 0;
     std::vector<float> col = attribute(prim, "COLOR_0", 0, n, &comps);
@@ -757,27 +785,33 @@ ImageFormat image_header(const unsigned char* p, size_t n, uint64_t* w, uint64_t
   return ImageFormat::Other;
 }
 
-// tinygltf's image decoding (to RGBA) behind those checks
-bool load_checked_image(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
-                        int req_width, int req_height, const unsigned char* bytes, int size, void*) {
+// tinygltf's image decoding (to RGBA) behind those checks. An image that fails them or
+// does not decode is left empty, never an error: `errors` (std::map<int, std::string>,
+// the user data) records why, and a texture using it falls back or is dropped.
+bool load_checked_image(tinygltf::Image* image, const int index, std::string*, std::string* warn,
+                        int req_width, int req_height, const unsigned char* bytes, int size, void* errors) {
+  std::string why;
   uint64_t w = 0, h = 0;
   int channel_bytes = 1;
-  std::string which = "glTF image " + std::to_string(index);
   ImageFormat format = size > 0 ? image_header(bytes, size_t(size), &w, &h, &channel_bytes) : ImageFormat::Other;
-  if (format == ImageFormat::Other) {
-    if (warn) *warn += which + " is neither PNG nor JPEG: it is ignored\n";
-    return true;  // left empty: a texture using it fails in decode_image
-  }
   std::string dims = std::to_string(w) + " x " + std::to_string(h);
-  if (w > kMaxImageBytes || h > kMaxImageBytes || w * h * 4 * uint64_t(channel_bytes) > kMaxImageBytes) {
-    if (err) *err += which + " is " + dims + ": too large (over 1 GiB decoded)";
-    return false;
+  if (format == ImageFormat::Other) {
+    why = "is neither PNG nor JPEG";
+  } else if (w > kMaxImageBytes || h > kMaxImageBytes || w * h * 4 * uint64_t(channel_bytes) > kMaxImageBytes) {
+    why = "is " + dims + ": too large (over 1 GiB decoded)";
+  } else if (format == ImageFormat::Jpeg && w * h > kMaxJpegTexelsPerByte * uint64_t(size)) {
+    why = "is a JPEG of " + dims + " in only " + std::to_string(size) + " bytes: it is truncated";
+  } else {
+    std::string decode_err;
+    if (tinygltf::LoadImageData(image, index, &decode_err, warn, req_width, req_height, bytes, size, nullptr))
+      return true;
+    while (!decode_err.empty() && (decode_err.back() == '\n' || decode_err.back() == ' ')) decode_err.pop_back();
+    why = "could not be decoded: " + decode_err;
   }
-  if (format == ImageFormat::Jpeg && w * h > kMaxJpegTexelsPerByte * uint64_t(size)) {
-    if (err) *err += which + " is a JPEG of " + dims + " in only " + std::to_string(size) + " bytes: it is truncated";
-    return false;
-  }
-  return tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, nullptr);
+  (*static_cast<std::map<int, std::string>*>(errors))[index] = why;
+  image->image.clear();
+  image->width = image->height = 0;
+  return true;
 }
 
 // Deepest array and object nesting of JSON text, counted up to `limit` + 1. tinygltf
@@ -817,7 +851,8 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
     fs.WriteWholeFile = no_write;
     gltf.SetFsCallbacks(fs);
   }
-  gltf.SetImageLoader(load_checked_image, nullptr);
+  std::map<int, std::string> image_errors;  // filled by load_checked_image
+  gltf.SetImageLoader(load_checked_image, &image_errors);
   tinygltf::Model model;
   std::string err, warn;
   // Binary glTF starts with the magic "glTF", whatever the file is called
@@ -846,7 +881,7 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   }
   Warnings warnings(&scene.warnings);
   warn_model_wide(model, &warnings);
-  MaterialReader(model, &scene, &warnings).read_all();
+  MaterialReader(model, image_errors, &scene, &warnings).read_all();
   NodeReader(model, &scene, &warnings).read_scene();
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
   return scene;

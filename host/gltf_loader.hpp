@@ -8,7 +8,8 @@
 namespace candela {
 
 // Loads the default scene (or the first) with node transforms applied. Throws Error
-// on a missing or malformed file; unsupported features land in Scene::warnings.
+// on a missing or malformed file; unsupported features land in Scene::warnings, and so
+// do images that cannot be decoded (their textures fall back or are dropped).
 Scene load_gltf(const std::string& path);
 
 // The same from the bytes of a .gltf or .glb (told apart by the "glTF" magic). External

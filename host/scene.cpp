@@ -7,7 +7,15 @@ namespace candela {
 std::string SceneFeatures::build_options() const {
   auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
   return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
-         flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors);
+         flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
+         flag("CD_FEATURE_ALPHA", alpha);
+}
+
+bool MaterialDesc::alpha_tested() const {
+  bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
+  if (alpha_mode == AlphaMode::Mask) return textured || base_color.a < alpha_cutoff;
+  if (alpha_mode == AlphaMode::Blend) return textured || base_color.a < 1.0f;
+  return false;
 }
 
 double TextureDesc::mean_luminance() const {
@@ -50,6 +58,7 @@ SceneFeatures Scene::features() const {
     f.uvs |= !m.uv0.empty() || !m.uv1.empty();
     f.tangents |= !m.tangents.empty();
     for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
+    f.alpha |= materials.at(m.material).alpha_tested();
   }
   return f;
 }

@@ -44,12 +44,15 @@ struct MaterialDesc {
   float alpha_cutoff = 0.5f;
   TextureSlot textures[TEX_SLOTS];  // TEX_* slots
   const TextureSlot& texture(int slot) const { return textures[slot]; }
+  // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
+  bool alpha_tested() const;
 };
 
 struct TextureDesc {
   int width = 0, height = 0;
   uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
   bool srgb = false;  // rgba8 holds sRGB-encoded colour (alpha linear)
+  bool nearest = false;  // nearest-texel lookup (sampler magFilter NEAREST), else bilinear
   std::vector<uint8_t> rgba8;  // 4 per texel, or
   std::vector<float> rgbaf;  // 4 per texel (float images)
   size_t texels() const { return size_t(width) * height; }
@@ -98,6 +101,7 @@ struct SceneFeatures {
   bool uvs = false;  // some mesh has TEXCOORD_0 or TEXCOORD_1
   bool tangents = false;  // some mesh has TANGENT
   bool vertex_colors = false;  // some COLOR_0 is not white
+  bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
   std::string build_options() const;
 };
 

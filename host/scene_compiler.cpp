@@ -107,7 +107,8 @@ void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
     info.offset = uint32_t(offset);
     info.width = uint32_t(t.width);
     info.height = uint32_t(t.height);
-    info.flags = t.wrap_s | (t.wrap_t << 8) | (t.srgb ? TEXTURE_SRGB : 0u) | (is_float ? TEXTURE_FLOAT : 0u);
+    info.flags = t.wrap_s | (t.wrap_t << 8) | (t.srgb ? TEXTURE_SRGB : 0u) | (is_float ? TEXTURE_FLOAT : 0u) |
+                 (t.nearest ? TEXTURE_NEAREST : 0u);
     for (size_t i = 0; i < t.texels(); ++i) {
       if (is_float)
         b->texelsf.push_back({{t.rgbaf[4 * i], t.rgbaf[4 * i + 1], t.rgbaf[4 * i + 2], t.rgbaf[4 * i + 3]}});
@@ -236,7 +237,9 @@ CompiledScene compile_scene(const Scene& scene) {
   compile_textures(scene, &c.buffers);
   c.environment_light = compile_lights(scene, &c.buffers);
   auto bvh_start = Clock::now();
-  Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims);
+  std::vector<bool> alpha_tested;
+  for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());
+  Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims, alpha_tested);
   c.bvh_build_seconds = seconds_since(bvh_start);
   c.bvh_depth = bvh.depth;
   c.buffers.bvh_nodes = std::move(bvh.nodes);

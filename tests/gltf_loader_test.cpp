@@ -73,6 +73,12 @@ std::vector<Tri> triangles_of(const Scene& s) {
 
 glm::vec3 winding_normal(const Tri& t) { return glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]); }
 
+std::string join(const std::vector<std::string>& lines) {
+  std::string all;
+  for (const auto& l : lines) all += l + "\n";
+  return all;
+}
+
 }  // namespace
 
 TEST(GltfLoader, CornellBoxHasPublishedLightCameraAndSize) {
@@ -145,8 +151,10 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
   j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {
       {"index", 0},
       {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}, {"scale", {2, 2}}, {"rotation", 1.5707963267948966}}}}}};
-  // The image cannot be decoded: the loader must say so, not render garbage
-  EXPECT_THROW(load_gltf(dir.write("tt.gltf", j.dump())), Error);
+  // The image cannot be read: the loader says so and drops the texture, not the scene
+  Scene missing = load_gltf(dir.write("tt.gltf", j.dump()));
+  EXPECT_EQ(missing.materials[0].texture(TEX_BASE_COLOR).index, NO_TEXTURE);
+  EXPECT_NE(join(missing.warnings).find("missing-is-not-read.png"), std::string::npos) << join(missing.warnings);
 
   unsigned char px[3] = {255, 255, 255};
   std::string png = (dir.path / "white.png").string();
@@ -294,6 +302,131 @@ TEST(GltfLoader, BaseColorTextureIsSrgbDecodedAndRendered) {
     EXPECT_NEAR(f.pixel(rt).x, srgb(20), se(rt, 0));
     EXPECT_NEAR(f.pixel(rt).z, srgb(100), se(rt, 2));
   }
+}
+
+}  // namespace candela::test
+
+namespace candela::test {
+namespace {
+
+std::string write_png(const TempDir& dir, const std::string& name, int w, int h, int channels,
+                      const unsigned char* px) {
+  std::string path = (dir.path / name).string();
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out || !out->open(path, OIIO::ImageSpec(w, h, channels, OIIO::TypeDesc::UINT8))) return "";
+  out->write_image(OIIO::TypeDesc::UINT8, px);
+  out->close();
+  return path;
+}
+
+int count_containing(const std::vector<std::string>& lines, const std::string& part) {
+  int n = 0;
+  for (const auto& l : lines) n += l.find(part) != std::string::npos;
+  return n;
+}
+
+}  // namespace
+
+// glTF 3.6.2: an accessor without a bufferView reads as zeros, and sparse values replace
+// some of them. TEXCOORD_0 loses its bufferView; POSITION is zeros but for vertices 0-2,
+// substituted by sparse indices (the index buffer's first three entries: 0 1 2) and values
+// (the original positions): vertex 3 falls to the origin and triangle (0, 2, 3) degenerates
+TEST(GltfLoader, AccessorWithoutBufferViewReadsAsZeros) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  j["accessors"][1].erase("bufferView");
+  json& pos = j["accessors"][0];
+  pos.erase("bufferView");
+  pos["sparse"] = {{"count", 3},
+                   {"indices", {{"bufferView", 2}, {"componentType", 5123}}},
+                   {"values", {{"bufferView", 0}}}};
+  Scene s = load_gltf(dir.write("zeros.gltf", j.dump()));
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const MeshDesc& m = s.meshes[0];
+  ASSERT_EQ(m.uv0.size(), 4u);
+  for (const auto& uv : m.uv0) EXPECT_EQ(uv, glm::vec2(0.0f));
+  EXPECT_EQ(m.positions[1], glm::vec3(1, -1, 0));
+  EXPECT_EQ(m.positions[2], glm::vec3(1, 1, 0));
+  EXPECT_EQ(m.positions[3], glm::vec3(0.0f));
+  EXPECT_EQ(s.triangles(), 1u);
+}
+
+// An image candela cannot decode never fails the scene: a texture uses its core source
+// when an extension's image (EXT_texture_webp) cannot be decoded; a texture without any
+// decodable image (only WebP, a corrupt PNG, a PNG header claiming 40000^2 texels) is
+// dropped with one warning however many slots use it, and those slots are untextured
+TEST(GltfLoader, UndecodableImagesFallBackToTheCoreSourceOrAreDropped) {
+  TempDir dir;
+  const unsigned char white[3] = {255, 255, 255};
+  ASSERT_FALSE(write_png(dir, "white.png", 1, 1, 3, white).empty());
+  dir.write("fake.webp", std::string("RIFF\x24\0\0\0WEBPVP8 \x18\0\0\0", 20) + std::string(24, '\0'));
+  const unsigned char png_header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+  std::string ihdr_small = std::string("\0\0\0\4\0\0\0\4\x08\x06\0\0\0", 13);  // 4 x 4, RGBA8
+  std::string ihdr_huge = std::string("\0\0\x9c\x40\0\0\x9c\x40\x08\x06\0\0\0", 13);  // 40000 x 40000
+  std::string header(reinterpret_cast<const char*>(png_header), sizeof png_header);
+  dir.write("corrupt.png", header + ihdr_small + "not a zlib stream at all");
+  dir.write("huge.png", header + ihdr_huge + std::string(16, '\0'));
+  GltfBuilder g = quad_gltf();
+  g.add("images", {{"uri", "white.png"}});
+  g.add("images", {{"uri", "fake.webp"}, {"mimeType", "image/webp"}});
+  g.add("images", {{"uri", "corrupt.png"}});
+  g.add("images", {{"uri", "huge.png"}});
+  g.add("textures", {{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}});
+  g.add("textures", {{"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}});
+  g.add("textures", {{"source", 2}});
+  g.add("textures", {{"source", 3}});
+  json j = g.document();
+  j["extensionsUsed"] = {"EXT_texture_webp"};
+  json& m0 = j["materials"][0];
+  m0["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  m0["emissiveFactor"] = {1, 1, 1};
+  m0["emissiveTexture"] = {{"index", 1}};
+  m0["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 2}};
+  j["materials"].push_back(j["materials"][0]);
+  j["materials"][1]["normalTexture"] = {{"index", 2}};
+  j["materials"][1]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 3}};
+  Scene s = load_gltf(dir.write("fallback.gltf", j.dump()));
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 1);
+  EXPECT_EQ(s.materials[0].texture(TEX_BASE_COLOR).index, 0);
+  EXPECT_EQ(s.materials[0].texture(TEX_EMISSION).index, NO_TEXTURE);
+  EXPECT_EQ(s.materials[0].texture(TEX_METALLIC_ROUGHNESS).index, NO_TEXTURE);
+  EXPECT_EQ(s.materials[1].texture(TEX_NORMAL).index, NO_TEXTURE);
+  EXPECT_EQ(s.materials[1].texture(TEX_BASE_COLOR).index, NO_TEXTURE);
+  EXPECT_EQ(count_containing(s.warnings, "glTF texture 0 "), 0);
+  EXPECT_EQ(count_containing(s.warnings, "glTF texture 1 "), 1);
+  EXPECT_EQ(count_containing(s.warnings, "glTF texture 2 "), 1);
+  EXPECT_EQ(count_containing(s.warnings, "glTF texture 3 "), 1);
+  EXPECT_EQ(count_containing(s.warnings, "neither PNG nor JPEG"), 1);
+  EXPECT_EQ(count_containing(s.warnings, "too large"), 1);
+  EXPECT_GT(compile_scene(s).triangles, 0u);
+}
+
+// Sampler magFilter NEAREST (9728) selects nearest-texel lookups; LINEAR (9729) and no
+// sampler stay bilinear; neither warns
+TEST(GltfLoader, SamplerMagFilterNearestSelectsNearestLookups) {
+  TempDir dir;
+  const unsigned char white[3] = {255, 255, 255};
+  ASSERT_FALSE(write_png(dir, "white.png", 1, 1, 3, white).empty());
+  GltfBuilder g = quad_gltf();
+  g.add("images", {{"uri", "white.png"}});
+  g.add("samplers", {{"magFilter", 9728}});
+  g.add("samplers", {{"magFilter", 9729}, {"minFilter", 9728}});
+  g.add("textures", {{"source", 0}, {"sampler", 0}});
+  g.add("textures", {{"source", 0}, {"sampler", 1}});
+  json j = g.document();
+  j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  j["materials"][0]["emissiveFactor"] = {1, 1, 1};
+  j["materials"][0]["emissiveTexture"] = {{"index", 1}};
+  Scene s = load_gltf(dir.write("nearest.gltf", j.dump()));
+  ASSERT_EQ(s.textures.size(), 2u);
+  EXPECT_TRUE(s.textures[size_t(s.materials[0].texture(TEX_BASE_COLOR).index)].nearest);
+  EXPECT_FALSE(s.textures[size_t(s.materials[0].texture(TEX_EMISSION).index)].nearest);
+  EXPECT_EQ(count_containing(s.warnings, "NEAREST"), 0);
+  CompiledScene c = compile_scene(s);
+  EXPECT_EQ(c.buffers.textures[size_t(s.materials[0].texture(TEX_BASE_COLOR).index)].flags & TEXTURE_NEAREST,
+            TEXTURE_NEAREST);
+  EXPECT_EQ(c.buffers.textures[size_t(s.materials[0].texture(TEX_EMISSION).index)].flags & TEXTURE_NEAREST, 0u);
 }
 
 }  // namespace candela::test

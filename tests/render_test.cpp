@@ -36,7 +36,8 @@ class FurnaceTest : public ::testing::TestWithParam<DeviceStrategy> {};
 void expect_unit_radiance(const RenderResult& r, Strategy s) {
   Estimate e = image_mean(r.film);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
-  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error) << name(s) << " SE " << e.standard_error;
+  // (plus float rounding: albedo-1 paths have no variance left to hide it)
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-6) << name(s) << " SE " << e.standard_error;
   EXPECT_EQ(r.film.dropped_samples(), 0u);
 }
 
