@@ -87,6 +87,8 @@ Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   b.spec_f90 = 0.0f;
   b.cond_eta = load3(m->conductor_eta);
   b.cond_k = load3(m->conductor_k);
+  b.ggx_albedo = sc->ggx_albedo;
+  if (m->type == MATERIAL_CONDUCTOR) bsdf_conductor_params(&b);
   if (m->type == MATERIAL_GLTF) {
     bsdf_gltf_params(sc, m, s, &b);
     // No specular layer, metal, glass or coat: exactly Lambertian, so take the short path
@@ -150,7 +152,7 @@ bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
       ok = bsdf_gltf_sample(b, wo_l, uc, u, bs);
       break;
     case MATERIAL_CONDUCTOR:
-      ok = bsdf_conductor_sample(b, wo_l, u, bs);
+      ok = bsdf_conductor_sample(b, wo_l, uc, u, bs);
       break;
     case MATERIAL_DIFFUSE:
     default:

@@ -33,4 +33,6 @@ typedef struct {
   float coat;  // clearcoat weight
   Ggx coat_ggx;
   float3 cond_eta, cond_k;  // MATERIAL_CONDUCTOR
+  float3 cond_f_avg;  // MATERIAL_CONDUCTOR: hemispherical average of its Fresnel term
+  __global const float* ggx_albedo;  // GGX albedo table (energy.cl); 0: no energy compensation
 } Bsdf;

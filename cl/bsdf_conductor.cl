@@ -1,15 +1,35 @@
 // Measured conductor (complex index eta + i k per channel) with a Trowbridge-Reitz
-// microfacet surface, in the local frame; a perfect mirror below GGX_DELTA_ALPHA.
+// microfacet surface, in the local frame; a perfect mirror below GGX_DELTA_ALPHA. With the
+// GGX albedo table, the multiple scattering of energy.cl (Kulla & Conty 2017) is added
+// and sampled by the cosine with probability ms_share, so that eval and pdf stay one mixture.
+
+void bsdf_conductor_params(Bsdf* b) {
+  b->cond_f_avg = (float3)(1.0f);
+  if (b->ggx_albedo && !ggx_is_delta(b->ggx)) b->cond_f_avg = energy_conductor_average(b->cond_eta, b->cond_k);
+}
+
+// Probability of sampling the multiple-scattering lobe: its share of the albedo at wo
+float bsdf_conductor_ms_share(const Bsdf* b, const GgxEnergy* e, float3 f_ms) {
+  float ms = energy_ms_albedo(e) * luminance(f_ms);
+  float total = e->e_o * luminance(b->cond_f_avg) + ms;
+  return total > 0.0f ? ms / total : 0.0f;
+}
 
 float3 bsdf_conductor_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
   if (ggx_is_delta(b->ggx)) return (float3)(0.0f);
   float cos_oh;
   float f = ggx_reflection_eval(b->ggx, wo, wi, pdf, &cos_oh);
-  return f * fresnel_conductor(cos_oh, b->cond_eta, b->cond_k);
+  float3 single = f * fresnel_conductor(cos_oh, b->cond_eta, b->cond_k);
+  GgxEnergy e = energy_ggx(b->ggx_albedo, b->ggx, wo.z);
+  if (!e.table || wo.z <= 0.0f || wi.z <= 0.0f) return single;
+  float3 f_ms = energy_ms_fresnel(&e, b->cond_f_avg);
+  float q = bsdf_conductor_ms_share(b, &e, f_ms);
+  *pdf = (1.0f - q) * *pdf + q * sample_cosine_hemisphere_pdf(wi.z);
+  return single + f_ms * energy_ms(&e, wi.z);
 }
 
-bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float2 u, BsdfSample* bs) {
+bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   bs->eta = 1.0f;
   if (ggx_is_delta(b->ggx)) {
     if (wo.z <= 0.0f) return false;
@@ -19,7 +39,13 @@ bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float2 u, BsdfSample* bs) {
     bs->flags = BSDF_REFLECTION | BSDF_DELTA;
     return true;
   }
-  if (!ggx_reflection_sample(b->ggx, wo, u, &bs->wi)) return false;
+  if (wo.z <= 0.0f) return false;
+  GgxEnergy e = energy_ggx(b->ggx_albedo, b->ggx, wo.z);
+  float q = e.table ? bsdf_conductor_ms_share(b, &e, energy_ms_fresnel(&e, b->cond_f_avg)) : 0.0f;
+  if (uc < q)
+    bs->wi = sample_cosine_hemisphere(u.x, u.y);
+  else if (!ggx_reflection_sample(b->ggx, wo, u, &bs->wi))
+    return false;
   bs->f = bsdf_conductor_eval(b, wo, bs->wi, &bs->pdf);
   bs->flags = BSDF_REFLECTION | BSDF_GLOSSY;
   return bs->pdf > 0.0f;

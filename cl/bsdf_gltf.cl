@@ -7,12 +7,16 @@
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
 //   glass:   (1 - metallic) * transmission * dielectric(ior), base-tinted transmission,
 //            thin-walled or refracting (bsdf_dielectric.cl, exact Fresnel)
+//   ms:      with the GGX albedo table, the multiple scattering of the metal and plastic
+//            GGX lobes (energy.cl, Kulla & Conty 2017), each coloured by its Schlick
+//            term's average; the plastic's diffuse weighting stays 1 - max F_d (energy-
+//            correct layering is not attempted). Neither the coat nor the glass has one.
 // Sampling picks a component with a probability from its estimated weight at wo (the
 // lecture's combined BSDF); eval and pdf sum every non-delta component, so sampling and
 // evaluation describe the same mixture.
 
 typedef struct {
-  float coat, metal, spec, diffuse, glass;  // selection probabilities, summing to 1
+  float coat, metal, spec, diffuse, ms, glass;  // selection probabilities, summing to 1
 } GltfLobes;
 
 float schlick_weight(float cos_i) {
@@ -21,23 +25,39 @@ float schlick_weight(float cos_i) {
   return m2 * m2 * m;
 }
 
-GltfLobes gltf_lobes(const Bsdf* b, float cos_o) {
+// The GGX albedo table looked up for the metal and plastic specular lobes, if any
+GgxEnergy gltf_energy(const Bsdf* b, float cos_o) {
+  bool specular = b->metallic > 0.0f || (b->transmission < 1.0f && b->spec_f90 > 0.0f);
+  return energy_ggx(specular ? b->ggx_albedo : 0, b->ggx, cos_o);
+}
+
+// Colour of the multiple-scattering lobe: each lobe's weight times its F_ms
+float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
+  float m = b->metallic, t = b->transmission;
+  float3 metal = energy_ms_fresnel(e, energy_schlick_average(b->base_color, (float3)(1.0f)));
+  float3 spec = energy_ms_fresnel(e, energy_schlick_average(b->spec_f0, (float3)(b->spec_f90)));
+  return m * metal + (1.0f - m) * (1.0f - t) * spec;
+}
+
+GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e) {
   float m = b->metallic, t = b->transmission;
   float fc = b->coat * (0.04f + 0.96f * schlick_weight(cos_o));
   float fs = luminance(fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_o));
   float rest = 1.0f - fc;
   GltfLobes w;
   w.coat = fc;
-  w.metal = rest * m;
-  w.spec = rest * (1.0f - m) * (1.0f - t) * fs;
+  w.metal = rest * m * e->e_o;
+  w.spec = rest * (1.0f - m) * (1.0f - t) * fs * e->e_o;
   w.diffuse = rest * (1.0f - m) * (1.0f - t) * (1.0f - fs) * luminance(b->base_color);
+  w.ms = e->table ? rest * energy_ms_albedo(e) * luminance(gltf_ms_fresnel(b, e)) : 0.0f;
   w.glass = rest * (1.0f - m) * t;
-  float sum = w.coat + w.metal + w.spec + w.diffuse + w.glass;
+  float sum = w.coat + w.metal + w.spec + w.diffuse + w.ms + w.glass;
   float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
   w.coat *= inv;
   w.metal *= inv;
   w.spec *= inv;
   w.diffuse *= inv;
+  w.ms *= inv;
   w.glass *= inv;
   return w;
 }
@@ -49,7 +69,8 @@ float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->coat * (0.04f + 
 float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
   if (wo.z <= 0.0f) return (float3)(0.0f);
-  GltfLobes w = gltf_lobes(b, wo.z);
+  GgxEnergy e = gltf_energy(b, wo.z);
+  GltfLobes w = gltf_lobes(b, wo.z, &e);
   float m = b->metallic, t = b->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
   float cos_h = wo.z;  // wo.h of reflections; the coat's attenuation uses it
@@ -64,6 +85,10 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
     if (glossy && !ggx_is_delta(b->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
       *pdf += (w.metal + w.spec) * p;
+    }
+    if (e.table) {
+      under += gltf_ms_fresnel(b, &e) * energy_ms(&e, wi.z);
+      *pdf += w.ms * sample_cosine_hemisphere_pdf(wi.z);
     }
   }
   if (t > 0.0f) {
@@ -93,12 +118,16 @@ bool gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
 
 bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
-  GltfLobes w = gltf_lobes(b, wo.z);
+  GgxEnergy e = gltf_energy(b, wo.z);
+  GltfLobes w = gltf_lobes(b, wo.z, &e);
   float m = b->metallic, t = b->transmission;
-  // Component by uc; uc is then rescaled to [0, 1) within the component for reuse
-  float cdf[4] = {w.coat, w.coat + w.metal, w.coat + w.metal + w.spec, w.coat + w.metal + w.spec + w.diffuse};
-  int c = uc < cdf[0] ? 0 : uc < cdf[1] ? 1 : uc < cdf[2] ? 2 : uc < cdf[3] ? 3 : 4;
-  float lo = c == 0 ? 0.0f : cdf[c - 1], width = (c == 4 ? 1.0f : cdf[c]) - lo;
+  // Component by uc (coat, metal, spec, diffuse, ms, glass); uc is then rescaled to [0, 1)
+  // within the component for reuse
+  float cdf[5] = {w.coat, w.coat + w.metal, w.coat + w.metal + w.spec, w.coat + w.metal + w.spec + w.diffuse,
+                  w.coat + w.metal + w.spec + w.diffuse + w.ms};
+  int c = 0;
+  while (c < 5 && uc >= cdf[c]) ++c;
+  float lo = c == 0 ? 0.0f : cdf[c - 1], width = (c == 5 ? 1.0f : cdf[c]) - lo;
   float uc2 = width > 0.0f ? clamp((uc - lo) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
   float coat_att = 1.0f - gltf_coat_fresnel(b, wo.z);
   if (c == 0) {
@@ -111,7 +140,7 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
       return gltf_mirror(wo, coat_att * weight, c == 1 ? w.metal : w.spec, bs);
     }
     if (!ggx_reflection_sample(b->ggx, wo, u, &bs->wi)) return false;
-  } else if (c == 3) {
+  } else if (c == 3 || c == 4) {
     bs->wi = sample_cosine_hemisphere(u.x, u.y);
   } else {
     if (!bsdf_dielectric_sample(b->ggx, b->eta, b->thin, b->base_color, wo, uc2, u, bs)) return false;

@@ -48,6 +48,12 @@
 #define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
 #define TEXTURE_NEAREST 0x40000u  // nearest-texel lookup (glTF magFilter NEAREST), else bilinear
 
+// GGX albedo table (cl/energy.cl): E at GGX_ALBEDO_N x GGX_ALBEDO_N nodes (y, roughness),
+// y fastest (y: energy.cl's coordinate for mu), then E_avg at GGX_ALBEDO_N roughnesses
+#define GGX_ALBEDO_N 32
+#define GGX_ALBEDO_SIZE (GGX_ALBEDO_N * (GGX_ALBEDO_N + 1))
+#define GGX_ALBEDO_QUADRATURE 64  // quadrature points per side of each entry
+
 #define NO_TEXTURE (-1)
 #define NO_LIGHT (-1)
 #define NO_MEDIUM (-1)
@@ -149,7 +155,7 @@ typedef struct {
   float pad3;
 } Camera;
 
-// Everything one launch needs besides buffers, 112 bytes.
+// Everything one launch needs besides buffers, 116 bytes.
 typedef struct {
   Camera camera;
   unsigned int width;
@@ -164,13 +170,15 @@ typedef struct {
   unsigned int sample_count;  // samples per pixel in this launch
   unsigned int pixel_begin;  // first pixel of this launch (row-major)
   unsigned int pixel_end;  // one past the last pixel of this launch
+  unsigned int energy_compensation;  // 1: multiple-scattering compensation of GGX lobes (energy.cl)
 } RenderParams;
 
 // Every scene buffer, in kernel-argument order: X(element type, name). This one list
 // generates the kernel's parameters and SceneData (cl/scene_data.cl) and the host's
 // SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
 // Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
-// vertex; an array the scene does not need holds one dummy element.
+// vertex; an array the scene does not need holds one dummy element. ggx_albedo is no part
+// of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
 #define CD_SCENE_BUFFERS(X)  \
   X(BvhNode, bvh_nodes)      \
   X(BvhTriangle, bvh_tris)   \
@@ -187,7 +195,8 @@ typedef struct {
   X(TexelF, texelsf)         \
   X(float, srgb_to_linear)   \
   X(Light, lights)           \
-  X(unsigned int, light_thresholds)
+  X(unsigned int, light_thresholds) \
+  X(float, ggx_albedo)
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
 // FIELD(type, field, offset). The host static_asserts these; tests/cl checks them on
@@ -210,8 +219,9 @@ typedef struct {
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
   SIZE(Camera, 64) FIELD(Camera, forward, 16) FIELD(Camera, right, 32) FIELD(Camera, up, 48) \
-  SIZE(RenderParams, 112) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
+  SIZE(RenderParams, 116) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
   FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \
-  FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)
+  FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)                 \
+  FIELD(RenderParams, energy_compensation, 112)
 
 #endif  // CANDELA_DEVICE_TYPES_H

@@ -113,6 +113,7 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
   uint pixel = params->pixel_begin + (uint)get_global_id(0);
   if (pixel >= params->pixel_end) return;
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint px = pixel % params->width, py = pixel / params->width;
 
   // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones

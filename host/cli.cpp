@@ -37,6 +37,7 @@ struct RenderArgs {
   uint32_t seed = 0;
   uint32_t max_depth = 16;
   std::string strategy = "nee";
+  bool no_energy_compensation = false;
   std::string background;
   std::string stats;
   float exposure = 0.0f;
@@ -165,6 +166,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"width", settings.width},
                       {"height", settings.height},
                       {"strategy", a.strategy},
+                      {"energy_compensation", settings.energy_compensation},
                       {"max_depth", a.max_depth},
                       {"seed", a.seed},
                       {"interrupted", r.interrupted},
@@ -182,6 +184,7 @@ int run_render(const RenderArgs& a) {
   resolve_size(a, scene, &settings.width, &settings.height);
   settings.seed = a.seed;
   settings.max_depth = a.max_depth;
+  settings.energy_compensation = !a.no_energy_compensation;
 
   DeviceEntry device = select_device(a.device);
   if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
@@ -208,7 +211,8 @@ int run_render(const RenderArgs& a) {
       {"spp", std::to_string(r.spp)},          {"seconds", std::to_string(r.seconds)},
       {"device", device.description()},        {"seed", std::to_string(a.seed)},
       {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
-      {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene}};
+      {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene},
+      {"energy_compensation", settings.energy_compensation ? "on" : "off"}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
@@ -237,6 +241,8 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--seed", a.seed, "Random seed (default 0)");
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
   render->add_option("--strategy", a.strategy, "nee (next-event estimation, default) or bsdf (BSDF sampling only)");
+  render->add_flag("--no-energy-compensation", a.no_energy_compensation,
+                   "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
   render->add_option("--background", a.background, "Constant background radiance R,G,B (overrides the scene's)");
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
   render->add_option("--exposure", a.exposure, "PNG exposure in stops (default 0)");

@@ -37,4 +37,9 @@ struct SceneBuffers {
 #define CD_COUNT_BUFFER(type, name) +1
 constexpr unsigned kSceneBufferCount = 0 CD_SCENE_BUFFERS(CD_COUNT_BUFFER);
 #undef CD_COUNT_BUFFER
+
+// Position of each scene buffer in CD_SCENE_BUFFERS: SceneBuffer::name
+#define CD_BUFFER_INDEX(type, name) name,
+enum class SceneBuffer : unsigned { CD_SCENE_BUFFERS(CD_BUFFER_INDEX) };
+#undef CD_BUFFER_INDEX
 }  // namespace candela::dev

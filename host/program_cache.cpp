@@ -101,6 +101,10 @@ bool try_build_from_binary(const cl::Context& context, const DeviceEntry& device
 
 }  // namespace
 
+std::vector<unsigned char> read_cache_entry(const std::string& path) { return read_entry(path); }
+
+void write_cache_entry(const std::string& path, const std::vector<unsigned char>& data) { write_entry(path, data); }
+
 std::string kernel_cache_dir() {
   if (const char* dir = std::getenv("CANDELA_CACHE_DIR")) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)

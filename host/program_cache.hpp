@@ -6,6 +6,7 @@
 
 #include <CL/opencl.hpp>
 #include <string>
+#include <vector>
 
 #include "device.hpp"
 
@@ -25,5 +26,11 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
                            const std::string& source, const std::string& options);
 
 std::string kernel_cache_dir();
+
+// Other data kept in the cache beside a program (e.g. under ProgramBuild::cache_file plus a
+// suffix), with the binaries' checks: the payload, or empty when missing or corrupt (a
+// corrupt entry is removed); writing is atomic and an unwritable cache is not an error
+std::vector<unsigned char> read_cache_entry(const std::string& path);
+void write_cache_entry(const std::string& path, const std::vector<unsigned char>& data);
 
 }  // namespace candela

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <thread>
 
+#include "energy.hpp"
 #include "error.hpp"
 #include "kernel_sources.hpp"
 #include "program_cache.hpp"
@@ -81,6 +82,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
 #define CD_UPLOAD(type, name) scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
+  if (settings.energy_compensation)
+    scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
+        ggx_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
 
   params_host_.camera = make_device_camera(scene.camera, settings.width, settings.height);
   params_host_.width = uint32_t(settings.width);
@@ -91,6 +95,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.strategy = uint32_t(settings.strategy);
   params_host_.num_lights = uint32_t(scene.buffers.lights.size());
   params_host_.environment_light = scene.environment_light;
+  params_host_.energy_compensation = settings.energy_compensation ? 1u : 0u;
 
   size_t pixels = size_t(settings.width) * settings.height;
   chunk_ = std::min(pixels, std::max<size_t>(local_size_, 4096));

@@ -29,6 +29,7 @@ struct RenderSettings {
   uint32_t max_depth = 16;  // scattering events
   uint32_t rr_depth = 3;  // Russian roulette after this many bounces
   Strategy strategy = Strategy::Nee;
+  bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/energy.cl)
   double launch_seconds = 0.2;  // target duration of one launch
 };
 
@@ -51,7 +52,8 @@ struct RenderResult {
 // One device's worker: renders ranges of sample indices of a compiled scene into its film
 class DeviceRenderer {
  public:
-  // Builds the kernel program for the scene's features and uploads the scene buffers
+  // Builds the kernel program for the scene's features, uploads the scene buffers and,
+  // with energy compensation, the GGX albedo table (host/energy.hpp)
   DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings);
 
   // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches

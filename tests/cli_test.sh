@@ -79,10 +79,21 @@ missing = [k for k in need if k not in s]
 assert not missing, missing
 assert s["spp"] == 4 and s["triangles"] == 32 and s["samples_per_second"] > 0, s
 assert s["width"] == 64 and s["height"] == 48, s
+assert s["energy_compensation"] is True, s
 PY
 then pass "stats JSON fields"; else fail "stats JSON fields"; fi
 if command -v oiiotool >/dev/null; then
   if oiiotool --info -v "$tmp/cb.exr" | grep -q 'candela:spp: "4"'; then pass "EXR metadata"; else fail "EXR metadata"; fi
+fi
+
+# --no-energy-compensation is recorded in the EXR metadata and the stats
+if "$bin" render "$scene" -o "$tmp/nec.exr" --spp 1 --width 16 --height 16 --device pocl --no-energy-compensation \
+    --stats "$tmp/nec.json" -q >/dev/null 2>"$tmp/err" &&
+  python3 -c "import json,sys; assert json.load(open('$tmp/nec.json'))['energy_compensation'] is False" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/nec.exr" | grep -q 'candela:energy_compensation: "off"'; }; then
+  pass "--no-energy-compensation recorded"
+else
+  fail "--no-energy-compensation recorded"; cat "$tmp/err"
 fi
 
 # Ctrl-C during a long render writes what was rendered and exits 130

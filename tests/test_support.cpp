@@ -5,6 +5,7 @@
 #include "error.hpp"
 #include "kernel_sources.hpp"
 #include "program_cache.hpp"
+#include "energy.hpp"
 
 namespace candela::test {
 
@@ -25,7 +26,9 @@ std::optional<DeviceEntry> device_by_name(const std::string& name) {
 KernelRig::KernelRig(const DeviceEntry& d) : device(d) {
   context = cl::Context(device.device);
   queue = cl::CommandQueue(context, device.device);
-  program = build_program(context, device, test_program_source(), "-cl-std=CL1.2").program;
+  ProgramBuild build = build_program(context, device, test_program_source(), "-cl-std=CL1.2");
+  program = build.program;
+  program_cache_file = build.cache_file;
 }
 
 namespace {
@@ -41,8 +44,11 @@ SceneOnDevice::SceneOnDevice(KernelRig& rig, const CompiledScene& scene) {
 #define CD_TEST_UPLOAD(type, name) buffers.push_back(upload_or_dummy(rig.context, scene.buffers.name));
   CD_SCENE_BUFFERS(CD_TEST_UPLOAD)
 #undef CD_TEST_UPLOAD
+  buffers[unsigned(dev::SceneBuffer::ggx_albedo)] =
+      ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file).buffer;
   params_host.num_lights = cl_uint(scene.buffers.lights.size());
   params_host.environment_light = scene.environment_light;
+  params_host.energy_compensation = 1u;  // as renderers have it by default, with the table above
   params_host.width = params_host.height = 1;
   params = cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof params_host, &params_host);
 }

@@ -35,6 +35,7 @@ struct KernelRig {
   cl::Context context;
   cl::CommandQueue queue;
   cl::Program program;
+  std::string program_cache_file;  // its entry in the kernel cache (ProgramBuild::cache_file)
   explicit KernelRig(const DeviceEntry& d);
 };
 

@@ -11,9 +11,9 @@ SceneData test_bsdf_scene(__global const Material* materials) {
   return sc;
 }
 
-// A hit of material 0 seen from wo (wo = -ray direction), oriented as surface_at does:
+// A hit of `material` seen from wo (wo = -ray direction), oriented as surface_at does:
 // ng turned to wo's side, ns turned to ng's side
-SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo) {
+SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo, uint material) {
   SurfaceHit s;
   s.p = (float3)(0.0f);
   s.ng = normalize(ng);
@@ -26,7 +26,7 @@ SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo) {
   s.uvs = (float4)(0.0f);
   s.vertex_color = (float3)(1.0f);
   s.prim = 0u;
-  s.material = 0u;
+  s.material = material;
   return s;
 }
 
@@ -39,7 +39,7 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
                                __global uint4* info) {
   uint i = get_global_id(0);
   SceneData sc = test_bsdf_scene(materials);
-  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz);
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz, 0u);
   Bsdf b = bsdf_at(&sc, &s);
   Rng rng = rng_init(i, 0u, seed);
   float uc = rng_next(&rng);
@@ -63,14 +63,38 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
 }
 
 // f and pdf for the pair (wo, wi) = (pairs[2i], pairs[2i+1]) at a hit oriented by that wo;
-// out[i] = (f, pdf)
+// out[i] = (f, pdf), from one bsdf_eval_pdf (test_bsdf_sample covers bsdf_eval and bsdf_pdf)
 __kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns,
                              float4 tangent, __global const float4* pairs,
                              __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = test_bsdf_scene(materials);
   float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
-  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo);
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo, 0u);
   Bsdf b = bsdf_at(&sc, &s);
-  out[i] = (float4)(bsdf_eval(&b, wo, wi), bsdf_pdf(&b, wo, wi));
+  float pdf;
+  out[i] = (float4)(bsdf_eval_pdf(&b, wo, wi, &pdf), pdf);
+}
+
+// Albedo samples: work-item i estimates configuration c = i / per_config, material
+// c / n_wo seen from wos[c % n_wo]. out[i] = (f |cos| / pdf * eta^2, returned), where
+// eta = bs.eta (eta_wi / eta_wo) undoes the 1 / eta^2 radiance scaling of refraction
+__kernel void test_bsdf_albedo(__global const Material* materials, float4 ng, float4 ns,
+                               float4 tangent, __global const float4* wos, uint n_wo,
+                               uint per_config, uint seed, __global float4* out) {
+  uint i = get_global_id(0), c = i / per_config;
+  SceneData sc = test_bsdf_scene(materials);
+  float3 wo = wos[c % n_wo].xyz;
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo, c / n_wo);
+  Bsdf b = bsdf_at(&sc, &s);
+  Rng rng = rng_init(i, 0u, seed);
+  float uc = rng_next(&rng);
+  float2 u;
+  u.x = rng_next(&rng);
+  u.y = rng_next(&rng);
+  BsdfSample bs;
+  out[i] = (float4)(0.0f);
+  if (!bsdf_sample(&b, wo, uc, u, &bs)) return;
+  float w = fabs(dot(bs.wi, b.frame.n)) / bs.pdf * bs.eta * bs.eta;
+  out[i] = (float4)(bs.f * w, 1.0f);
 }
