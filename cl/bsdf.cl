@@ -37,11 +37,10 @@ Frame bsdf_shading_frame(const SceneData* sc, __global const Material* m, const 
   return f;
 }
 
-void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
-  float4 mr = bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s);
-  b->metallic = m->metallic * mr.z;
-  float roughness = m->roughness * mr.y;
-  // KHR_materials_anisotropy: strength and a direction in the tangent plane, rotated
+// Roughness (x metallicRoughnessTexture G) and KHR_materials_anisotropy: the strength, and
+// a direction in the tangent plane, rotated, that the frame's tangent turns to
+void bsdf_roughness_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
+  float roughness = m->roughness * bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s).y;
   float4 an = bsdf_texture(sc, m, TEX_ANISOTROPY, s);
   float2 dir = m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.xy * 2.0f - 1.0f : (float2)(1.0f, 0.0f);
   float strength = m->anisotropy_strength * (m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.z : 1.0f);
@@ -53,6 +52,11 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
     b->frame.b *= hand;
   }
   b->ggx = ggx_from_roughness(roughness, strength);
+}
+
+void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
+  b->metallic = m->metallic * bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s).z;
+  bsdf_roughness_params(sc, m, s, b);
   b->transmission = m->transmission * bsdf_texture(sc, m, TEX_TRANSMISSION, s).x;
   b->thin = (m->flags & MATERIAL_THIN_WALLED) != 0u;
   // KHR_materials_specular: F0 = min(F0(ior) x colour, 1) x specular, F90 = specular
@@ -88,7 +92,10 @@ Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   b.cond_eta = load3(m->conductor_eta);
   b.cond_k = load3(m->conductor_k);
   b.ggx_albedo = sc->ggx_albedo;
-  if (m->type == MATERIAL_CONDUCTOR) bsdf_conductor_params(&b);
+  if (m->type == MATERIAL_CONDUCTOR) {
+    bsdf_roughness_params(sc, m, s, &b);
+    bsdf_conductor_params(&b);
+  }
   if (m->type == MATERIAL_GLTF) {
     bsdf_gltf_params(sc, m, s, &b);
     // No specular layer, metal, glass or coat: exactly Lambertian, so take the short path

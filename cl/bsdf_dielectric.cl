@@ -6,6 +6,10 @@
 // `thin`: a thin-walled sheet, whose transmission leaves straight through (mirrored
 // reflection lobe) without bending.
 
+// Reflectance of a thin sheet from the interface's R, inter-reflections inside included:
+// R' = R + T^2 R / (1 - R^2) = 2R / (1 + R) (pbrt-v4's ThinDielectricBxDF)
+float dielectric_sheet_reflectance(float r) { return 2.0f * r / (1.0f + r); }
+
 // The non-delta part: f(wo, wi) and the pdf of bsdf_dielectric_sample
 float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo, float3 wi,
                             float* pdf) {
@@ -17,6 +21,7 @@ float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo,
     float cos_oh;
     float f = ggx_reflection_eval(g, wo, wr, pdf, &cos_oh);
     float r = fresnel_dielectric(cos_oh, eta);
+    if (thin) r = dielectric_sheet_reflectance(r);
     float share = wi.z > 0.0f ? r : 1.0f - r;
     *pdf *= share;
     return (wi.z > 0.0f ? (float3)(1.0f) : tint) * (f * share);
@@ -40,7 +45,7 @@ float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo,
 bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo, float uc,
                                    BsdfSample* bs) {
   float r = fresnel_dielectric(wo.z, eta);
-  if (thin && r < 1.0f) r += (1.0f - r) * (1.0f - r) * r / (1.0f - r * r);  // inter-reflections in the sheet
+  if (thin) r = dielectric_sheet_reflectance(r);
   bs->eta = 1.0f;
   if (uc < r) {
     bs->wi = (float3)(-wo.x, -wo.y, wo.z);
@@ -68,6 +73,7 @@ bool bsdf_dielectric_sample(Ggx g, float eta, bool thin, float3 tint, float3 wo,
   if (ggx_is_delta(g)) return bsdf_dielectric_sample_smooth(eta, thin, tint, wo, uc, bs);
   float3 h = ggx_sample_visible(g, wo, u);
   float r = fresnel_dielectric(dot(wo, h), eta);
+  if (thin) r = dielectric_sheet_reflectance(r);
   if (uc < r || thin) {
     bs->wi = fresnel_reflect(wo, h);
     if (bs->wi.z <= 0.0f) return false;

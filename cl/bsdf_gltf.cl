@@ -96,6 +96,8 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
     under += (1.0f - m) * t * bsdf_dielectric_eval(b->ggx, b->eta, b->thin, b->base_color, wo, wi, &glass_p);
     *pdf += w.glass * glass_p;
   }
+  // Transmitted light crosses the coat once, at the angle of the direction outside
+  if (wi.z < 0.0f) cos_h = b->entering ? wo.z : -wi.z;
   float3 f = (1.0f - gltf_coat_fresnel(b, cos_h)) * under;
   if (wi.z > 0.0f && b->coat > 0.0f && !ggx_is_delta(b->coat_ggx)) {
     float coat_p, coat_h;
@@ -145,7 +147,7 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
   } else {
     if (!bsdf_dielectric_sample(b->ggx, b->eta, b->thin, b->base_color, wo, uc2, u, bs)) return false;
     if (bs->flags & BSDF_DELTA) {
-      float att = bs->wi.z > 0.0f ? 1.0f - gltf_coat_fresnel(b, wo.z) : coat_att;
+      float att = bs->wi.z > 0.0f || b->entering ? coat_att : 1.0f - gltf_coat_fresnel(b, -bs->wi.z);
       bs->f *= att * (1.0f - m) * t;
       bs->pdf *= w.glass;
       return bs->pdf > 0.0f;

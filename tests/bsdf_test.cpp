@@ -315,9 +315,6 @@ MaterialCase delta_case(std::string name, dev::Material m, std::function<std::op
   return {name, m, false, albedo, {}, {}, {}};
 }
 
-const std::string kConductorAnisotropyBug =
-    "BUG: bsdf_at ignores anisotropy_strength/_rotation (and the roughness texture) for MATERIAL_CONDUCTOR; "
-    "fix: give conductors the glTF roughness/anisotropy setup (bsdf_gltf_params' texture and frame code)";
 
 // Energy created at grazing incidence (white base at 85 degrees: albedo up to 1.6 for plastic,
 // 1.4 for a smooth coat over metal, 1.8 for both): see BsdfEnergy
@@ -326,15 +323,6 @@ const std::string kPlasticEnergyBug =
     "(glTF Appendix B's fresnel_mix with VdotH) while the specular lobe reflects F_d at near-grazing wo.h; "
     "fix: scale it by (1 - max F_d(wo.z)) (1 - max F_d(wi.z)) (reciprocal, bounded by 1 - F_d(wo.z)), "
     "or by 1 - E_spec as energy compensation does (Kelemen & Szirmay-Kalos 2001)";
-const std::string kRoughThinSheetBug =
-    "BUG: rough thin sheets reflect R (bsdf_dielectric_eval, bsdf_dielectric_sample) where smooth ones "
-    "reflect 2R / (1 + R) (inter-reflections in the sheet): reflectance jumps at GGX_DELTA_ALPHA; fix: "
-    "if (thin) r = 2.0f * r / (1.0f + r) after both fresnel_dielectric calls of the rough path";
-const std::string kCoatTransmissionBug =
-    "BUG: a clearcoat over transmission attenuates refracted light by 1 - F_c(wo.z) whatever side wo is on "
-    "(bsdf_gltf_eval, and coat_att in bsdf_gltf_sample's delta glass), which breaks the generalized "
-    "reciprocity by up to a few percent; the coat sits outside, crossed once at the outside direction's "
-    "angle: fix: attenuate transmission by 1 - F_c(b->entering ? wo.z : -wi.z)";
 const std::string kCoatEnergyBug =
     "BUG: the clearcoat creates energy at grazing incidence: the layers below are attenuated by "
     "1 - F_c(wo.h) of each pair's half vector while the coat reflects F_c at wo; KHR_materials_clearcoat's "
@@ -364,15 +352,8 @@ std::vector<MaterialCase> make_materials() {
   CellSpec straight = kNarrow;
   straight.transmission = Focus::Straight;
   MaterialCase thin = gltf_case("thin_glass_r03", gltf(white, 0.0, 0.3, 1.0, true), straight);
-  for (const char* g : {"normal", "grazing", "backfacing", "bumped", "backgrazing"})
-    thin.bugs[std::string("reference/") + g] = kRoughThinSheetBug;
   MaterialCase aniso = conductor_case("conductor_aniso", gold(0.5, 0.8), kGlossy);
-  for (const char* g : {"normal", "grazing", "backfacing", "bumped", "backgrazing"})
-    aniso.bugs[std::string("reference/") + g] = kConductorAnisotropyBug;
   MaterialCase coat_glass_case = gltf_case("coat_glass", coat_glass, kNarrow);
-  for (const char* g : {"normal", "grazing", "backfacing", "bumped", "belowshading", "backgrazing"})
-    coat_glass_case.bugs[std::string("reciprocity/") + g] = kCoatTransmissionBug;
-  for (const char* g : {"backfacing", "backgrazing"}) coat_glass_case.bugs[std::string("reference/") + g] = kCoatTransmissionBug;
   MaterialCase smooth_thin = delta_case("smooth_thin_glass", gltf(white, 0.0, 0.0, 1.0, true), one);
   MaterialCase plastic = gltf_case("plastic_r03", gltf(orange, 0.0, 0.3), kNarrow);
   MaterialCase smooth_plastic_case = gltf_case("smooth_plastic", smooth_plastic, {});
@@ -1353,14 +1334,9 @@ TEST_P(BsdfDelta, RoughGlassApproachesSmooth) {
   check_continuity(*r, seed_on(GetParam(), 5), false);
 }
 
-// BUG: the smooth thin sheet reflects R' = 2R / (1 + R) (inter-reflections inside the
-// sheet, bsdf_dielectric_sample_smooth) but the rough one reflects R (bsdf_dielectric_eval
-// and _sample), so a sheet's reflectance drops from 0.077 to 0.04 at normal incidence as its
-// roughness crosses GGX_DELTA_ALPHA. Fix: for thin sheets use r = 2 r / (1 + r) in the
-// rough sampling and evaluation too (both, so that they stay consistent). Remove the skip
-// once fixed.
+// A thin sheet's reflectance, 2R / (1 + R) with inter-reflections, does not jump as its
+// roughness crosses GGX_DELTA_ALPHA (rough and smooth sheets agree)
 TEST_P(BsdfDelta, RoughThinSheetApproachesSmooth) {
-  GTEST_SKIP() << kRoughThinSheetBug;
   DELTA_RIG_OR_SKIP(r);
   check_continuity(*r, seed_on(GetParam(), 5), true);
 }
