@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <algorithm>
-#include <map>
 #include <random>
 
 #include "bvh_builder.hpp"
+#include "gltf_builder.hpp"
 #include "test_support.hpp"
 
 namespace candela::test {
@@ -73,31 +73,10 @@ Tri make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
 
 // Closed icosphere with shared vertices: every edge belongs to two triangles
 std::vector<Tri> icosphere(int subdivisions, glm::vec3 center, float radius) {
-  const float p = 1.6180339887f;
-  std::vector<glm::vec3> v = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
-                              {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
-  std::vector<glm::ivec3> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (auto& x : v) x = glm::normalize(x);
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<int, int>, int> mid;
-    auto midpoint = [&](int a, int b) {
-      auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back(glm::normalize(v[a] + v[b]));
-      return mid[key] = int(v.size()) - 1;
-    };
-    std::vector<glm::ivec3> nf;
-    for (auto t : f) {
-      int a = midpoint(t.x, t.y), b = midpoint(t.y, t.z), c = midpoint(t.z, t.x);
-      nf.insert(nf.end(), {{t.x, a, c}, {t.y, b, a}, {t.z, c, b}, {a, b, c}});
-    }
-    f = nf;
-  }
+  GltfBuilder::Primitive p = sphere_primitive(center, radius, subdivisions, 0);
   std::vector<Tri> out;
-  for (auto t : f) out.push_back(make_tri(center + radius * v[t.x], center + radius * v[t.y], center + radius * v[t.z]));
+  for (size_t i = 0; i + 2 < p.indices.size(); i += 3)
+    out.push_back(make_tri(p.positions[p.indices[i]], p.positions[p.indices[i + 1]], p.positions[p.indices[i + 2]]));
   return out;
 }
 
