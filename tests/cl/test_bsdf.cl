@@ -30,6 +30,16 @@ SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo, uint m
   return s;
 }
 
+// bsdf_sample of b from wo with (uc, u.x, u.y) drawn in that order from rng_init(i, 0, seed)
+bool test_bsdf_sample_i(const Bsdf* b, float3 wo, uint i, uint seed, BsdfSample* bs) {
+  Rng rng = rng_init(i, 0u, seed);
+  float uc = rng_next(&rng);
+  float2 u;
+  u.x = rng_next(&rng);
+  u.y = rng_next(&rng);
+  return bsdf_sample(b, wo, uc, u, bs);
+}
+
 // Sample i of bsdf_sample with (uc, u.x, u.y) drawn in that order from rng_init(i, 0, seed).
 // out[3i..3i+2]: (wi, pdf), (f, eta), (bsdf_eval, bsdf_pdf) at the sampled wi, all zero
 // when sampling fails; info[i]: (returned, BSDF_DELTA set, BSDF_REFLECTION set, flags valid:
@@ -41,13 +51,8 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
   SceneData sc = test_bsdf_scene(materials);
   SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz, 0u);
   Bsdf b = bsdf_at(&sc, &s);
-  Rng rng = rng_init(i, 0u, seed);
-  float uc = rng_next(&rng);
-  float2 u;
-  u.x = rng_next(&rng);
-  u.y = rng_next(&rng);
   BsdfSample bs;
-  bool ok = bsdf_sample(&b, wo.xyz, uc, u, &bs);
+  bool ok = test_bsdf_sample_i(&b, wo.xyz, i, seed, &bs);
   if (!ok) {
     out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = (float4)(0.0f);
     info[i] = (uint4)(0u);
@@ -87,14 +92,9 @@ __kernel void test_bsdf_albedo(__global const Material* materials, float4 ng, fl
   float3 wo = wos[c % n_wo].xyz;
   SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo, c / n_wo);
   Bsdf b = bsdf_at(&sc, &s);
-  Rng rng = rng_init(i, 0u, seed);
-  float uc = rng_next(&rng);
-  float2 u;
-  u.x = rng_next(&rng);
-  u.y = rng_next(&rng);
   BsdfSample bs;
   out[i] = (float4)(0.0f);
-  if (!bsdf_sample(&b, wo, uc, u, &bs)) return;
+  if (!test_bsdf_sample_i(&b, wo, i, seed, &bs)) return;
   float w = fabs(dot(bs.wi, b.frame.n)) / bs.pdf * bs.eta * bs.eta;
   out[i] = (float4)(bs.f * w, 1.0f);
 }

@@ -69,13 +69,8 @@ __kernel void test_energy_sample(__global const Material* materials, __global co
                                  uint with_table, float4 wo, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo.xyz);
-  Rng rng = rng_init(i, 0u, seed);
-  float uc = rng_next(&rng);
-  float2 u;
-  u.x = rng_next(&rng);
-  u.y = rng_next(&rng);
   BsdfSample bs;
-  if (!bsdf_sample(&b, wo.xyz, uc, u, &bs)) {
+  if (!test_bsdf_sample_i(&b, wo.xyz, i, seed, &bs)) {
     out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = (float4)(0.0f);
     return;
   }
@@ -92,13 +87,8 @@ __kernel void test_energy_albedo(__global const Material* materials, __global co
                                  uint with_table, float4 wo, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo.xyz);
-  Rng rng = rng_init(i, 0u, seed);
-  float uc = rng_next(&rng);
-  float2 u;
-  u.x = rng_next(&rng);
-  u.y = rng_next(&rng);
   BsdfSample bs;
-  bool ok = bsdf_sample(&b, wo.xyz, uc, u, &bs);
+  bool ok = test_bsdf_sample_i(&b, wo.xyz, i, seed, &bs);
   out[i] = ok ? (float4)(bs.f * fabs(bs.wi.z) / bs.pdf, 0.0f) : (float4)(0.0f);
 }
 
