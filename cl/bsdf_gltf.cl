@@ -1,16 +1,27 @@
 // glTF metallic-roughness BSDF (glTF 2.0 Appendix B, KHR_materials_* extensions) in the
 // local frame, as a mixture of components:
 //   coat:    clearcoat * F_c * GGX(coat roughness), F_c = Schlick(0.04, 1); it attenuates
-//            everything below by (1 - clearcoat * F_c)
+//            reflections below by (1 - A_c(mu_o)) (1 - A_c(mu_i)) and transmissions by
+//            1 - A_c at the outside direction's angle, A_c = the coat's albedo
 //   metal:   metallic * Schlick(base color, 1) * GGX
-//   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + (1 - max F_d) * base / pi],
+//   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + W(mu_o, mu_i) * base / pi],
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
 //   glass:   (1 - metallic) * transmission * dielectric(ior), base-tinted transmission,
 //            thin-walled or refracting (bsdf_dielectric.cl, exact Fresnel)
 //   ms:      with the GGX albedo table, the multiple scattering of the metal and plastic
 //            GGX lobes (energy.cl, Kulla & Conty 2017), each coloured by its Schlick
-//            term's average; the plastic's diffuse weighting stays 1 - max F_d (energy-
-//            correct layering is not attempted). Neither the coat nor the glass has one.
+//            term's average. Neither the coat nor the glass has one.
+// Layering (albedo scaling, Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017): what lies
+// below a layer gets the light the layer does not reflect. With A(mu) the layer's
+// directional albedo (the largest channel), the diffuse base is weighted by
+//   W = (1 - A(mu_o)) (1 - A(mu_i)) / (1 - A_avg),  A_avg = 2 integral of A mu dmu,
+// which is reciprocal and returns exactly 1 - A(mu_o) of a white base: a white plastic
+// reflects 1 at every angle. A comes from the GGX albedo table (E, E5 and the multiple-
+// scattering term); without the table (no compensation) A = Schlick's F(mu), exact only for
+// smooth layers, and the division is left out so that no rough layer can create energy.
+// The coat's attenuation has no division either: a base that is not Lambertian (plastic's
+// own specular peak) would gain energy from it; a white Lambert base under a clear coat
+// reflects about 93 % instead of 1 (its light trapped under the coat is not returned).
 // Sampling picks a component with a probability from its estimated weight at wo (the
 // lecture's combined BSDF); eval and pdf sum every non-delta component, so sampling and
 // evaluation describe the same mixture.
@@ -31,6 +42,60 @@ GgxEnergy gltf_energy(const Bsdf* b, float cos_o) {
   return energy_ggx(specular ? b->ggx_albedo : 0, b->ggx, cos_o);
 }
 
+// A dielectric GGX layer with Schlick's Fresnel term (f0, f90) above something else
+typedef struct {
+  GgxEnergy e;  // its table lookup (table 0: a delta lobe, or no compensation)
+  float3 f0;
+  float f90;
+  float3 f_ms;  // colour of its multiple-scattering term; 0 without one
+  float a_o;  // its albedo A(mu_o), largest channel
+  float a_avg;  // 2 integral of A mu dmu, largest channel
+  bool normalized;  // weight what lies below by W / (1 - a_avg)
+} GltfLayer;
+
+// A(mu) = f0 E(mu) + (f90 - f0) E5(mu) + (1 - E(mu)) F_ms, largest channel; a delta lobe
+// (or one without table) has E = 1 and E5 = (1 - mu)^5, so A = Schlick's F(mu)
+float gltf_layer_albedo(const GltfLayer* l, float mu) {
+  float e = 1.0f, e5 = schlick_weight(mu);
+  if (l->e.table) {
+    e = energy_lookup(&l->e, 0, mu);
+    e5 = energy_lookup(&l->e, 1, mu);
+  }
+  return max_component(l->f0 * e + (l->f90 - l->f0) * e5 + (1.0f - e) * l->f_ms);
+}
+
+GltfLayer gltf_layer(GgxEnergy e, float3 f0, float f90, float3 f_ms, float cos_o, bool normalized) {
+  GltfLayer l;
+  l.e = e;
+  l.f0 = f0;
+  l.f90 = f90;
+  l.f_ms = e.table ? f_ms : (float3)(0.0f);
+  l.a_o = gltf_layer_albedo(&l, cos_o);
+  float3 avg = e.table ? f0 * e.e_avg + (f90 - f0) * e.e5_avg + (1.0f - e.e_avg) * l.f_ms
+                       : energy_schlick_average(f0, (float3)(f90));
+  l.a_avg = max_component(avg);
+  l.normalized = normalized && l.a_avg < 1.0f;
+  return l;
+}
+
+// The plastic's specular layer over its diffuse base, normalized where the table is bound
+GltfLayer gltf_spec_layer(const Bsdf* b, const GgxEnergy* e, float cos_o) {
+  float3 f_ms = energy_ms_fresnel(e, energy_schlick_average(b->spec_f0, (float3)(b->spec_f90)));
+  return gltf_layer(*e, b->spec_f0, b->spec_f90, f_ms, cos_o, b->ggx_albedo != 0);
+}
+
+// The clearcoat: Schlick(0.04, 1) weighted by the coat factor, never normalized
+GltfLayer gltf_coat_layer(const Bsdf* b, float cos_o) {
+  GgxEnergy e = energy_ggx(b->coat > 0.0f ? b->ggx_albedo : 0, b->coat_ggx, cos_o);
+  return gltf_layer(e, (float3)(0.04f * b->coat), b->coat, (float3)(0.0f), cos_o, false);
+}
+
+// W(mu_o, mu_i) of what lies below the layer, both directions above
+float gltf_below(const GltfLayer* l, float cos_i) {
+  float w = (1.0f - l->a_o) * (1.0f - gltf_layer_albedo(l, cos_i));
+  return fmax(l->normalized ? w / (1.0f - l->a_avg) : w, 0.0f);
+}
+
 // Colour of the multiple-scattering lobe: each lobe's weight times its F_ms
 float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
   float m = b->metallic, t = b->transmission;
@@ -39,16 +104,17 @@ float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
   return m * metal + (1.0f - m) * (1.0f - t) * spec;
 }
 
-GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e) {
+GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e, const GltfLayer* spec,
+                     const GltfLayer* coat) {
   float m = b->metallic, t = b->transmission;
-  float fc = b->coat * (0.04f + 0.96f * schlick_weight(cos_o));
+  float fc = coat->a_o;
   float fs = luminance(fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_o));
   float rest = 1.0f - fc;
   GltfLobes w;
   w.coat = fc;
   w.metal = rest * m * e->e_o;
   w.spec = rest * (1.0f - m) * (1.0f - t) * fs * e->e_o;
-  w.diffuse = rest * (1.0f - m) * (1.0f - t) * (1.0f - fs) * luminance(b->base_color);
+  w.diffuse = rest * (1.0f - m) * (1.0f - t) * (1.0f - spec->a_o) * luminance(b->base_color);
   w.ms = e->table ? rest * energy_ms_albedo(e) * luminance(gltf_ms_fresnel(b, e)) : 0.0f;
   w.glass = rest * (1.0f - m) * t;
   float sum = w.coat + w.metal + w.spec + w.diffuse + w.ms + w.glass;
@@ -62,7 +128,7 @@ GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e) {
   return w;
 }
 
-// Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor
+// Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor, at the coat lobe's wo.h
 float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->coat * (0.04f + 0.96f * schlick_weight(cos_i)); }
 
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample
@@ -70,17 +136,18 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
   if (wo.z <= 0.0f) return (float3)(0.0f);
   GgxEnergy e = gltf_energy(b, wo.z);
-  GltfLobes w = gltf_lobes(b, wo.z, &e);
+  GltfLayer spec = gltf_spec_layer(b, &e, wo.z), coat = gltf_coat_layer(b, wo.z);
+  GltfLobes w = gltf_lobes(b, wo.z, &e, &spec, &coat);
   float m = b->metallic, t = b->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
-  float cos_h = wo.z;  // wo.h of reflections; the coat's attenuation uses it
+  float cos_h = wo.z;  // wo.h of reflections
   float d = 0.0f, p = 0.0f;
   if (wi.z > 0.0f) {
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
     bool glossy = m > 0.0f || b->spec_f90 > 0.0f || b->coat > 0.0f;
     if (glossy) d = ggx_reflection_eval(b->ggx, wo, wi, &p, &cos_h);
     float3 fd = glossy ? fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_h) : (float3)(0.0f);
-    under = (1.0f - m) * (1.0f - t) * (1.0f - max_component(fd)) * b->base_color * INV_PI_F;
+    under = (1.0f - m) * (1.0f - t) * gltf_below(&spec, wi.z) * b->base_color * INV_PI_F;
     *pdf += w.diffuse * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(b->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
@@ -96,9 +163,9 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
     under += (1.0f - m) * t * bsdf_dielectric_eval(b->ggx, b->eta, b->thin, b->base_color, wo, wi, &glass_p);
     *pdf += w.glass * glass_p;
   }
-  // Transmitted light crosses the coat once, at the angle of the direction outside
-  if (wi.z < 0.0f) cos_h = b->entering ? wo.z : -wi.z;
-  float3 f = (1.0f - gltf_coat_fresnel(b, cos_h)) * under;
+  // Reflected light crosses the coat twice; transmitted light once, at the angle of the
+  // direction outside
+  float3 f = under * (wi.z > 0.0f ? gltf_below(&coat, wi.z) : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -wi.z));
   if (wi.z > 0.0f && b->coat > 0.0f && !ggx_is_delta(b->coat_ggx)) {
     float coat_p, coat_h;
     float coat_d = ggx_reflection_eval(b->coat_ggx, wo, wi, &coat_p, &coat_h);
@@ -121,7 +188,8 @@ bool gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
 bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
   GgxEnergy e = gltf_energy(b, wo.z);
-  GltfLobes w = gltf_lobes(b, wo.z, &e);
+  GltfLayer spec = gltf_spec_layer(b, &e, wo.z), coat = gltf_coat_layer(b, wo.z);
+  GltfLobes w = gltf_lobes(b, wo.z, &e, &spec, &coat);
   float m = b->metallic, t = b->transmission;
   // Component by uc (coat, metal, spec, diffuse, ms, glass); uc is then rescaled to [0, 1)
   // within the component for reuse
@@ -131,7 +199,7 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
   while (c < 5 && uc >= cdf[c]) ++c;
   float lo = c == 0 ? 0.0f : cdf[c - 1], width = (c == 5 ? 1.0f : cdf[c]) - lo;
   float uc2 = width > 0.0f ? clamp((uc - lo) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
-  float coat_att = 1.0f - gltf_coat_fresnel(b, wo.z);
+  float coat_att = gltf_below(&coat, wo.z);  // a mirror reflection's, twice through the coat
   if (c == 0) {
     if (ggx_is_delta(b->coat_ggx)) return gltf_mirror(wo, (float3)(gltf_coat_fresnel(b, wo.z)), w.coat, bs);
     if (!ggx_reflection_sample(b->coat_ggx, wo, u, &bs->wi)) return false;
@@ -147,7 +215,7 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
   } else {
     if (!bsdf_dielectric_sample(b->ggx, b->eta, b->thin, b->base_color, wo, uc2, u, bs)) return false;
     if (bs->flags & BSDF_DELTA) {
-      float att = bs->wi.z > 0.0f || b->entering ? coat_att : 1.0f - gltf_coat_fresnel(b, -bs->wi.z);
+      float att = bs->wi.z > 0.0f ? coat_att : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -bs->wi.z);
       bs->f *= att * (1.0f - m) * t;
       bs->pdf *= w.glass;
       return bs->pdf > 0.0f;

@@ -48,10 +48,13 @@
 #define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
 #define TEXTURE_NEAREST 0x40000u  // nearest-texel lookup (glTF magFilter NEAREST), else bilinear
 
-// GGX albedo table (cl/energy.cl): E at GGX_ALBEDO_N x GGX_ALBEDO_N nodes (y, roughness),
-// y fastest (y: energy.cl's coordinate for mu), then E_avg at GGX_ALBEDO_N roughnesses
+// GGX albedo table (cl/energy.cl): two halves of GGX_ALBEDO_HALF floats, E (F = 1) then E5
+// (Fresnel weight (1 - wo.h)^5, for Schlick's term); each holds the albedo at
+// GGX_ALBEDO_N x GGX_ALBEDO_N nodes (y, roughness), y fastest (y: energy.cl's coordinate
+// for mu), then its hemispherical average at GGX_ALBEDO_N roughnesses
 #define GGX_ALBEDO_N 32
-#define GGX_ALBEDO_SIZE (GGX_ALBEDO_N * (GGX_ALBEDO_N + 1))
+#define GGX_ALBEDO_HALF (GGX_ALBEDO_N * (GGX_ALBEDO_N + 1))
+#define GGX_ALBEDO_SIZE (2 * GGX_ALBEDO_HALF)
 #define GGX_ALBEDO_QUADRATURE 64  // quadrature points per side of each entry
 
 #define NO_TEXTURE (-1)

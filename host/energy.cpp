@@ -21,7 +21,7 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   albedo.setArg(1, cl_uint(GGX_ALBEDO_QUADRATURE));
   average.setArg(0, *buffer);
   queue.enqueueNDRangeKernel(albedo, cl::NullRange, cl::NDRange(GGX_ALBEDO_N, GGX_ALBEDO_N));
-  queue.enqueueNDRangeKernel(average, cl::NullRange, cl::NDRange(GGX_ALBEDO_N));
+  queue.enqueueNDRangeKernel(average, cl::NullRange, cl::NDRange(GGX_ALBEDO_N, 2));
   std::vector<float> table(GGX_ALBEDO_SIZE);
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
   for (float e : table)

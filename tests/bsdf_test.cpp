@@ -173,12 +173,18 @@ struct GltfReference {
     f0 = glm::min(r * r * glm::dvec3(m.specular_color[0], m.specular_color[1], m.specular_color[2]), 1.0) * f90;
   }
   double coat_fresnel(double c) const { return coat * (0.04 + 0.96 * schlick_weight(c)); }
+  // Without the albedo table a layer's albedo is its Schlick term at mu; what lies below
+  // gets (1 - A(mu_o)) (1 - A(mu_i)) of reflected light, 1 - A(mu outside) of transmitted
+  double spec_albedo(double mu) const { return max_component(schlick(f0, glm::dvec3(f90), mu)); }
+  double below_spec(double mu_o, double mu_i) const { return (1.0 - spec_albedo(mu_o)) * (1.0 - spec_albedo(mu_i)); }
+  double below_coat(double mu_o, double mu_i) const { return (1.0 - coat_fresnel(mu_o)) * (1.0 - coat_fresnel(mu_i)); }
 
   // Component probabilities: coat, metal, specular, diffuse, glass
   std::array<double, 5> lobes(double cos_o) const {
     double m = metallic, t = transmission, fc = coat_fresnel(cos_o), fs = luminance(schlick(f0, glm::dvec3(f90), cos_o));
     std::array<double, 5> w = {fc, (1 - fc) * m, (1 - fc) * (1 - m) * (1 - t) * fs,
-                               (1 - fc) * (1 - m) * (1 - t) * (1 - fs) * luminance(base), (1 - fc) * (1 - m) * t};
+                               (1 - fc) * (1 - m) * (1 - t) * (1 - spec_albedo(cos_o)) * luminance(base),
+                               (1 - fc) * (1 - m) * t};
     double sum = w[0] + w[1] + w[2] + w[3] + w[4];
     for (double& x : w) x = sum > 0.0 ? x / sum : 0.0;
     return w;
@@ -201,7 +207,7 @@ struct GltfReference {
     auto [spec, spec_pdf] = ggx.delta() ? std::pair{0.0, 0.0} : ggx.reflection(wo, wi);
     bool glossy = m > 0.0 || f90 > 0.0 || coat > 0.0;
     glm::dvec3 fd = glossy ? schlick(f0, glm::dvec3(f90), c) : glm::dvec3(0.0);
-    glm::dvec3 under = (1 - m) * (1 - t) * (1.0 - max_component(fd)) * base / kPi;
+    glm::dvec3 under = (1 - m) * (1 - t) * below_spec(wo.z, wi.z) * base / kPi;
     double pdf = w[3] * wi.z / kPi;
     if (glossy) {
       under += (m * schlick(base, glm::dvec3(1.0), c) + (1 - m) * (1 - t) * fd) * spec;
@@ -212,7 +218,7 @@ struct GltfReference {
       under += (1 - m) * t * fr * spec;
       pdf += w[4] * fr * spec_pdf;
     }
-    glm::dvec3 f = (1.0 - coat_fresnel(c)) * under;
+    glm::dvec3 f = below_coat(wo.z, wi.z) * under;
     if (coat > 0.0 && !coat_ggx.delta()) {
       auto [cf, cpdf] = coat_ggx.reflection(wo, wi);
       f += coat_fresnel(c) * cf;
@@ -316,19 +322,6 @@ MaterialCase delta_case(std::string name, dev::Material m, std::function<std::op
 }
 
 
-// Energy created at grazing incidence (white base at 85 degrees: albedo up to 1.6 for plastic,
-// 1.4 for a smooth coat over metal, 1.8 for both): see BsdfEnergy
-const std::string kPlasticEnergyBug =
-    "BUG: glTF plastic creates energy at grazing incidence: the Lambert term is scaled by 1 - F_d(wo.h) "
-    "(glTF Appendix B's fresnel_mix with VdotH) while the specular lobe reflects F_d at near-grazing wo.h; "
-    "fix: scale it by (1 - max F_d(wo.z)) (1 - max F_d(wi.z)) (reciprocal, bounded by 1 - F_d(wo.z)), "
-    "or by 1 - E_spec as energy compensation does (Kelemen & Szirmay-Kalos 2001)";
-const std::string kCoatEnergyBug =
-    "BUG: the clearcoat creates energy at grazing incidence: the layers below are attenuated by "
-    "1 - F_c(wo.h) of each pair's half vector while the coat reflects F_c at wo; KHR_materials_clearcoat's "
-    "fresnel_coat uses V.Nc: fix: attenuate by 1 - F_c(wo.z) (the spec), or (1 - F_c(wo.z)) (1 - F_c(wi.z)) "
-    "for reciprocity";
-
 std::vector<MaterialCase> make_materials() {
   const glm::dvec3 orange(0.8, 0.5, 0.2), brass(0.95, 0.64, 0.54), white(1.0);
   dev::Material metal_aniso = gltf(brass, 1.0, 0.4);
@@ -359,8 +352,6 @@ std::vector<MaterialCase> make_materials() {
   MaterialCase smooth_plastic_case = gltf_case("smooth_plastic", smooth_plastic, {});
   MaterialCase coat_case = gltf_case("coat_plastic", coat, kNarrow);
   MaterialCase smooth_coat_case = gltf_case("smooth_coat_metal", smooth_coat, kGlossy);
-  plastic.bugs["albedo/grazing"] = smooth_plastic_case.bugs["albedo/grazing"] = kPlasticEnergyBug;
-  coat_case.bugs["albedo/grazing"] = smooth_coat_case.bugs["albedo/grazing"] = kCoatEnergyBug;
   return {
       diffuse(orange),
       conductor_case("conductor_r02", gold(0.2), kNarrow),
@@ -1368,18 +1359,18 @@ std::vector<EnergyLobe> energy_lobes() {
   return {
       {"conductor_gold", [](double r) { return gold(r); }, false, ""},
       {"metal_white", [=](double r) { return gltf(white, 1.0, r); }, false, ""},
-      {"plastic_white", [=](double r) { return gltf(white, 0.0, r); }, false, kPlasticEnergyBug},
+      {"plastic_white", [=](double r) { return gltf(white, 0.0, r); }, false, ""},
       {"glass_outside", [=](double r) { return gltf(white, 0.0, r, 1.0); }, false, ""},
       {"glass_inside", [=](double r) { return gltf(white, 0.0, r, 1.0); }, true, ""},
       {"thin_glass", [=](double r) { return gltf(white, 0.0, r, 1.0, true); }, false, ""},
-      {"coat_plastic_white", coat, false, kCoatEnergyBug},
+      {"coat_plastic_white", coat, false, ""},
       {"smooth_coat_metal_white", [=](double r) {
          dev::Material m = coat(r);
          m.metallic = 1.0f;
          m.clearcoat_roughness = 0.0f;
          return m;
-       }, false, kCoatEnergyBug},
-      {"mixture_white", [=](double r) { return gltf(white, 0.5, r, 0.5); }, false, kPlasticEnergyBug},
+       }, false, ""},
+      {"mixture_white", [=](double r) { return gltf(white, 0.5, r, 0.5); }, false, ""},
   };
 }
 

@@ -58,6 +58,10 @@ const std::vector<FurnaceCase>& furnace_cases() {
   static const std::vector<FurnaceCase> cases = {
       {"white_lambert", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}}, 1e-6},
       {"smooth_glass", glass(0.0, true), 1e-5},
+      // glTF plastic (ior 1.5): the diffuse base gets exactly what the specular layer does not
+      // reflect (cl/bsdf_gltf.cl's layering), within the albedo table's accuracy
+      {"white_plastic_r05", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}}, 3e-3},
+      {"white_smooth_plastic", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}}}, 1e-4},
       {"smooth_thin_glass", glass(0.0, false), 1e-5},
       // Rough dielectrics lose what single scattering misses (about 0.7% here, mostly at
       // the silhouette); their lobes have no multiple-scattering compensation yet

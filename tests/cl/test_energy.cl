@@ -2,24 +2,26 @@
 // quadrature off the nodes, an independent Monte Carlo estimate of the GGX albedo, and
 // bsdf_sample / bsdf_eval of material 0 with or without the table.
 
-// (E(mu), E_avg) for queries (mu, glTF roughness) of an isotropic lobe
+// (E(mu), E_avg, E5(mu), E5_avg) for queries (mu, glTF roughness) of an isotropic lobe
 __kernel void test_energy_lookup(__global const float* table, __global const float2* queries,
-                                 __global float2* out) {
+                                 __global float4* out) {
   uint i = get_global_id(0);
   GgxEnergy e = energy_ggx(table, ggx_from_roughness(queries[i].y, 0.0f), queries[i].x);
-  out[i] = (float2)(e.e_o, e.e_avg);
+  out[i] = (float4)(e.e_o, e.e_avg, e.e5_o, e.e5_avg);
 }
 
 // E(mu) by the table's quadrature with n x n points, at any (mu, roughness)
 __kernel void test_energy_quadrature(__global const float2* queries, uint n, __global float* out) {
   uint i = get_global_id(0);
-  out[i] = energy_ggx_albedo_quadrature(ggx_from_roughness(queries[i].y, 0.0f), queries[i].x, n);
+  out[i] = energy_ggx_albedo_quadrature(ggx_from_roughness(queries[i].y, 0.0f), queries[i].x, n).x;
 }
 
-// Monte Carlo weights f cos_i / pdf of E(mu) with F = 1 from half vectors distributed as
-// D(h) cos theta_h (Walter et al. 2007), not the visible normals the table integrates over:
-// work-item i draws n of them and writes their sum and sum of squares
-__kernel void test_energy_albedo_mc(float mu, float roughness, uint seed, uint n, __global float2* out) {
+// Monte Carlo weights f cos_i / pdf of E(mu) with F = 1 (fresnel5 = 0) or of E5(mu) with
+// F = (1 - wo.h)^5 (fresnel5 = 1) from half vectors distributed as D(h) cos theta_h (Walter
+// et al. 2007), not the visible normals the table integrates over: work-item i draws n of
+// them and writes their sum and sum of squares
+__kernel void test_energy_albedo_mc(float mu, float roughness, uint fresnel5, uint seed, uint n,
+                                    __global float2* out) {
   uint i = get_global_id(0);
   Rng rng = rng_init(i, 0u, seed);
   Ggx g = ggx_from_roughness(roughness, 0.0f);
@@ -36,6 +38,7 @@ __kernel void test_energy_albedo_mc(float mu, float roughness, uint seed, uint n
     float pdf, cos_oh;
     float f = ggx_reflection_eval(g, wo, wi, &pdf, &cos_oh);
     float w = f * wi.z / (ggx_d(g, h) * cos_h / (4.0f * cos_oh));
+    if (fresnel5) w *= pown(1.0f - cos_oh, 5);
     sums += (float2)(w, w * w);
   }
   out[i] = sums;
