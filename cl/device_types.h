@@ -130,10 +130,18 @@ typedef struct {
   float rgba[4];
 } TexelF;
 
+// One bin of the light-selection alias table, 8 bytes (sample_discrete_alias in
+// sampling.cl): a uniform 32-bit x picks bin b = floor(x n / 2^32); the low 32 bits of
+// x n then keep b when below `threshold`, else select `alias`.
+typedef struct {
+  unsigned int threshold;
+  unsigned int alias;
+} AliasBin;
+
 // A light, 64 bytes: a type, its selection probability, and the type's parameters.
-// Light i is selected when a uniform 32-bit integer x satisfies
-// threshold[i-1] <= x < threshold[i] (threshold[n-1] = 2^32 is not stored); `pmf` is
-// exactly that probability, so the estimator divides by what the kernel realizes.
+// Lights are selected through the alias table (light_alias, one bin per light, O(1));
+// `pmf` is exactly the probability it realizes, counted over all 2^32 integers, so the
+// estimator divides by what the kernel does.
 //   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
 //                      radiance comes from the primitive's material.
 //   LIGHT_ENVIRONMENT: radiance = constant radiance.
@@ -198,7 +206,7 @@ typedef struct {
   X(TexelF, texelsf)         \
   X(float, srgb_to_linear)   \
   X(Light, lights)           \
-  X(unsigned int, light_thresholds) \
+  X(AliasBin, light_alias)  \
   X(float, ggx_albedo)
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
@@ -219,6 +227,7 @@ typedef struct {
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
   SIZE(TexelF, 16)                                                                          \
+  SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
   SIZE(Camera, 64) FIELD(Camera, forward, 16) FIELD(Camera, right, 32) FIELD(Camera, up, 48) \

@@ -1,5 +1,5 @@
 // Light sampling from a context (a surface point, or a point in a medium), through one
-// light-selection table with probabilities proportional to power. Directions and pdfs
+// light-selection alias table with probabilities proportional to power. Directions and pdfs
 // are measured from ctx.p; a finite light's shadow ray ends at `target`, just off the
 // light's surface on ctx.p's side.
 
@@ -108,12 +108,12 @@ float lights_pdf_triangle(const SceneData* sc, __global const Light* light,
   return lights_triangle_solid_angle_pdf(ctx->p, ctx->p + t * wi, n, light->params[0]);
 }
 
-// Picks a light by x_select (power-proportional table) and samples a direction toward it
+// Picks a light by x_select (power-proportional alias table) and samples a direction toward it
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u,
                    LightSample* ls) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
-  __global const Light* light = &sc->lights[sample_discrete_thresholds(sc->light_thresholds, n, x_select)];
+  __global const Light* light = &sc->lights[sample_discrete_alias(sc->light_alias, n, x_select)];
   bool ok;
   ls->is_delta = false;
   switch (light->type) {

@@ -32,16 +32,11 @@ float2 sample_triangle(float u, float v) {
   return (float2)(t, 1.0f - s - t);
 }
 
-// Index i with threshold[i-1] <= x < threshold[i] for a uniform 32-bit x; the last
-// threshold (2^32) is implicit, so `threshold` holds n - 1 increasing values.
-uint sample_discrete_thresholds(__global const uint* threshold, uint n, uint x) {
-  uint lo = 0u, hi = n - 1u;
-  while (lo < hi) {
-    uint mid = (lo + hi) / 2u;
-    if (x < threshold[mid])
-      hi = mid;
-    else
-      lo = mid + 1u;
-  }
-  return lo;
+// Index chosen by the alias table `bins` (n bins) for a uniform 32-bit x: the high 32 bits
+// of x n pick a bin, the low 32 bits decide between the bin and its alias. O(1), and each
+// x maps to one index, so the host counts the exact probabilities (scene_compiler.cpp).
+uint sample_discrete_alias(__global const AliasBin* bins, uint n, uint x) {
+  uint bin = mul_hi(x, n);
+  AliasBin b = bins[bin];
+  return x * n < b.threshold ? bin : b.alias;
 }

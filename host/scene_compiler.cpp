@@ -159,7 +159,7 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     power.push_back(light_power(l, *b, 1.0, radius));
   }
   std::vector<double> pmf;
-  b->light_thresholds = selection_thresholds(power, &pmf);
+  b->light_alias = alias_table(power, &pmf);
   for (size_t i = 0; i < b->lights.size(); ++i) b->lights[i].pmf = float(pmf[i]);
   return environment;
 }
@@ -200,8 +200,7 @@ double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, do
   }
 }
 
-std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
-                                           std::vector<double>* pmf) {
+std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf) {
   const uint64_t range = uint64_t(1) << 32;
   size_t n = weights.size();
   pmf->assign(n, 0.0);
@@ -209,21 +208,44 @@ std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
   if (n > (uint64_t(1) << 31)) throw Error("too many lights for the light table");
   double total = 0.0;
   for (double w : weights) total += w;
-  std::vector<uint32_t> thresholds;
-  uint64_t prev = 0;
-  double cum = 0.0;
-  for (size_t i = 0; i + 1 < n; ++i) {
-    cum += weights[i];
-    uint64_t t = uint64_t(std::llround(cum / total * double(range)));
-    // At least one integer per light, and room for every light after this one
-    t = std::max(t, prev + 1);
-    t = std::min(t, range - (n - 1 - i));
-    thresholds.push_back(uint32_t(t));
-    (*pmf)[i] = double(t - prev) / double(range);
-    prev = t;
+  // Vose's construction: bins below their share borrow the rest from one above it
+  std::vector<double> q(n), keep(n, 1.0);
+  std::vector<uint32_t> alias(n);
+  std::vector<size_t> small, large;
+  for (size_t i = 0; i < n; ++i) {
+    q[i] = weights[i] / total * double(n);
+    alias[i] = uint32_t(i);
+    (q[i] < 1.0 ? small : large).push_back(i);
   }
-  (*pmf)[n - 1] = double(range - prev) / double(range);
-  return thresholds;
+  while (!small.empty() && !large.empty()) {
+    size_t s = small.back(), l = large.back();
+    small.pop_back();
+    keep[s] = q[s];
+    alias[s] = uint32_t(l);
+    q[l] -= 1.0 - q[s];
+    if (q[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  // Bin i holds the integers x in [ceil(i 2^32 / n), ceil((i + 1) 2^32 / n)); the low
+  // words x n - i 2^32 of those are r_i, r_i + n, r_i + 2n, ... Count exactly how many
+  // stay below the threshold: those select i, the others its alias.
+  std::vector<dev::AliasBin> bins(n);
+  std::vector<uint64_t> count(n, 0);
+  auto bin_start = [&](uint64_t i) { return (i * range + n - 1) / n; };  // no overflow: i < 2^31
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t start = bin_start(i), size = bin_start(i + 1) - start, r = start * n - i * range;
+    uint64_t t = uint64_t(std::llround(keep[i] * double(range)));
+    t = std::min<uint64_t>(t, range - 1);
+    if (t <= r) t = r + 1;  // every light keeps at least one integer of its own
+    uint64_t stay = std::min<uint64_t>(size, (t - r + n - 1) / n);
+    bins[i] = {uint32_t(t), alias[i]};
+    count[i] += stay;
+    count[alias[i]] += size - stay;
+  }
+  for (size_t i = 0; i < n; ++i) (*pmf)[i] = double(count[i]) / double(range);
+  return bins;
 }
 
 CompiledScene compile_scene(const Scene& scene) {

@@ -22,11 +22,10 @@ struct CompiledScene {
 
 CompiledScene compile_scene(const Scene& scene);
 
-// Thresholds for selecting index i with probability ~ weights[i] (all > 0) from a
-// uniform 32-bit integer (lights.cl); the exact probabilities realized go to *pmf.
-// Each index gets at least one of the 2^32 integers.
-std::vector<uint32_t> selection_thresholds(const std::vector<double>& weights,
-                                           std::vector<double>* pmf);
+// Alias table (Walker 1977, Vose 1991) for selecting index i with probability ~ weights[i]
+// (all > 0) from a uniform 32-bit integer (sample_discrete_alias in sampling.cl); the exact
+// probabilities it realizes go to *pmf. Each index gets at least one of the 2^32 integers.
+std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf);
 
 // Emitted power of a light (luminance-weighted, for light selection). `emission_scale`
 // is the mean luminance of a triangle light's emissive texture (1 without one);

@@ -163,42 +163,60 @@ TEST_F(SamplingTest, RngIsUniform) {
   EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
-// Light selection realizes exactly the pmf the estimator divides by, even for lights
-// whose power is far below 2^-24 of the total
+// Light selection through the alias table realizes exactly the pmf the estimator divides
+// by, even for lights whose power is far below 2^-24 of the total: the chosen indices of
+// random integers pass a chi-square test, and an even sweep over the 32-bit range picks
+// each light as often as its pmf says
 TEST_F(SamplingTest, LightSelectionMatchesItsPmf) {
-  std::vector<double> weights = {1e-12, 3.0, 0.5, 1e-9, 7.0, 2.0, 1e-3, 0.25, 4.0, 1e-15};
-  std::vector<double> pmf;
-  std::vector<uint32_t> thresholds = selection_thresholds(weights, &pmf);
-  ASSERT_EQ(thresholds.size(), weights.size() - 1);
-  double total = 0.0, wsum = 0.0;
-  for (double w : weights) wsum += w;
-  for (size_t i = 0; i < pmf.size(); ++i) {
-    EXPECT_GE(pmf[i], 0x1.0p-32) << "light " << i << " can never be picked";
-    if (weights[i] / wsum > 1e-6) {
-      EXPECT_NEAR(pmf[i], weights[i] / wsum, 1e-9);
+  for (const std::vector<double>& weights :
+       {std::vector<double>{1e-12, 3.0, 0.5, 1e-9, 7.0, 2.0, 1e-3, 0.25, 4.0, 1e-15}, std::vector<double>{1.0},
+        std::vector<double>{2.0, 2.0, 2.0}, std::vector<double>{1.0, 1e-20, 5.0, 0.3, 0.3, 9.0, 1e-7}}) {
+    std::vector<double> pmf;
+    std::vector<dev::AliasBin> bins = alias_table(weights, &pmf);
+    ASSERT_EQ(bins.size(), weights.size());
+    double total = 0.0, wsum = 0.0;
+    for (double w : weights) wsum += w;
+    for (size_t i = 0; i < pmf.size(); ++i) {
+      EXPECT_GE(pmf[i], 0x1.0p-32) << "light " << i << " can never be picked";
+      if (weights[i] / wsum > 1e-6) {
+        EXPECT_NEAR(pmf[i], weights[i] / wsum, 1e-9);
+      }
+      total += pmf[i];
     }
-    total += pmf[i];
-  }
-  EXPECT_DOUBLE_EQ(total, 1.0);
+    EXPECT_DOUBLE_EQ(total, 1.0);
 
-  cl::Buffer tb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, thresholds.size() * 4, thresholds.data());
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_uint));
-  cl::Kernel k(rig_->program, "test_light_select");
-  k.setArg(0, tb);
-  k.setArg(1, cl_uint(weights.size()));
-  k.setArg(2, cl_uint(17));
-  k.setArg(3, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
-  std::vector<cl_uint> picks(kSamples);
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_uint), picks.data());
-  std::vector<double> observed(weights.size(), 0.0), expected(weights.size());
-  for (cl_uint p : picks) {
-    ASSERT_LT(p, weights.size());
-    observed[p] += 1.0;
+    cl::Buffer tb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bins.size() * sizeof(dev::AliasBin),
+                  bins.data());
+    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_uint));
+    auto select = [&](cl_uint mode, cl_uint stride) {
+      cl::Kernel k(rig_->program, "test_light_select");
+      k.setArg(0, tb);
+      k.setArg(1, cl_uint(weights.size()));
+      k.setArg(2, cl_uint(17));
+      k.setArg(3, mode);
+      k.setArg(4, stride);
+      k.setArg(5, out);
+      rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
+      std::vector<cl_uint> picks(kSamples);
+      rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_uint), picks.data());
+      std::vector<double> observed(weights.size(), 0.0);
+      for (cl_uint p : picks) {
+        EXPECT_LT(p, weights.size());
+        if (p < weights.size()) observed[p] += 1.0;
+      }
+      return observed;
+    };
+    std::vector<double> observed = select(0, 0), expected(weights.size());
+    for (size_t i = 0; i < weights.size(); ++i) expected[i] = pmf[i] * kSamples;
+    ChiSquare r = chi_square_test(observed, expected);
+    EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+    // x = i * 2^12 over i < 2^20 visits every 4096th integer: the counts are the pmf's
+    // within the sweep's granularity (one integer in 4096 per bin boundary)
+    ASSERT_EQ(kSamples, size_t(1) << 20);
+    std::vector<double> swept = select(1, 1u << 12);
+    for (size_t i = 0; i < weights.size(); ++i)
+      EXPECT_NEAR(swept[i], pmf[i] * kSamples, 2.0 * weights.size() + 1.0) << "light " << i;
   }
-  for (size_t i = 0; i < weights.size(); ++i) expected[i] = pmf[i] * kSamples;
-  ChiSquare r = chi_square_test(observed, expected);
-  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 // The test itself must be able to fail: a wrong pdf is rejected

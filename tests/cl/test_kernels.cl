@@ -75,10 +75,11 @@ __kernel void test_trace_brute(__global const BvhTriangle* tris, uint num_tris,
   out[i] = result;
 }
 
-// Light-table selection: the index chosen for each of many uniform 32-bit integers
-__kernel void test_light_select(__global const uint* thresholds, uint n, uint seed,
+// Light selection by the alias table: the index chosen for each of many uniform 32-bit
+// integers, from the random stream (mode 0) or x = i * stride (mode 1, an even sweep)
+__kernel void test_light_select(__global const AliasBin* bins, uint n, uint seed, uint mode, uint stride,
                                 __global uint* out) {
   uint i = get_global_id(0);
   Rng rng = rng_init(i, 0u, seed);
-  out[i] = sample_discrete_thresholds(thresholds, n, rng_next_uint(&rng));
+  out[i] = sample_discrete_alias(bins, n, mode ? i * stride : rng_next_uint(&rng));
 }

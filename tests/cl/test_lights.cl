@@ -37,7 +37,7 @@ __kernel void test_lights_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const
   ls.is_delta = ls.at_infinity = false;
   bool ok = lights_sample(&sc, &ctx, x_select, u, &ls);
   // The light lights_sample picked, by the same table lookup
-  uint index = sample_discrete_thresholds(sc.light_thresholds, params->num_lights, x_select);
+  uint index = sample_discrete_alias(sc.light_alias, params->num_lights, x_select);
   __global const Light* light = &sc.lights[index];
   uint flags = ok ? TL_OK | (ls.at_infinity ? TL_AT_INFINITY : 0u) | (ls.is_delta ? TL_DELTA : 0u) : 0u;
   float pdf_eval = 0.0f;

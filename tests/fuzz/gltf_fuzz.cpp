@@ -46,8 +46,8 @@ void check_compiled(const candela::CompiledScene& c) {
     require(t.width > 0 && t.height > 0, "texture size");
     require(size_t(t.offset) + size_t(t.width) * t.height <= texels, "texture texels");
   }
-  require(b.lights.empty() ? b.light_thresholds.empty() : b.light_thresholds.size() + 1 == b.lights.size(),
-          "light thresholds");
+  require(b.light_alias.size() == (b.lights.empty() ? 0 : b.lights.size()), "light alias table");
+  for (const auto& bin : b.light_alias) require(bin.alias < b.lights.size(), "light alias");
   double pmf = 0.0;
   for (const auto& l : b.lights) {
     require(l.type != LIGHT_TRIANGLE || l.index < b.prims.size(), "light primitive index");
