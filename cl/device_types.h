@@ -34,6 +34,9 @@
 // Light types (lights.cl)
 #define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
 #define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away (constant for now)
+#define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
+#define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
+#define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
 
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
@@ -145,6 +148,15 @@ typedef struct {
 //   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
 //                      radiance comes from the primitive's material.
 //   LIGHT_ENVIRONMENT: radiance = constant radiance.
+//   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
+//                      radiance[3] = range (0: infinite), params[0..2] = position.
+//   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,
+//                      params[6] = angle scale 1 / max(0.001, cos(inner) - cos(outer)),
+//                      params[7] = angle offset -cos(outer) x scale; the intensity toward
+//                      a direction at cosine c to the axis is scaled by
+//                      clamp(c x scale + offset, 0, 1)^2 (KHR_lights_punctual).
+//   LIGHT_DIRECTIONAL: radiance = colour x intensity (irradiance at normal incidence),
+//                      params[3..5] = unit direction the light travels.
 typedef struct {
   unsigned int type;  // LIGHT_*
   float pmf;

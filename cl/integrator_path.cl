@@ -4,7 +4,8 @@
 // Strategies (no MIS, each light path counted exactly once):
 //   STRATEGY_NEE:  emission counted on camera rays and after delta lobes; all other light
 //                  arrives through shadow rays to sampled lights (skipped at delta lobes)
-//   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it
+//   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
+//                  punctual lights, which no ray can hit, contribute nothing)
 
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {

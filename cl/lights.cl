@@ -108,6 +108,56 @@ float lights_pdf_triangle(const SceneData* sc, __global const Light* light,
   return lights_triangle_solid_angle_pdf(ctx->p, ctx->p + t * wi, n, light->params[0]);
 }
 
+// Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries
+// the irradiance arriving normal to wi as `radiance` with pdf 1 (times the selection
+// pmf), so path_direct_light's f * radiance * cos / pdf is the reflected radiance, and no
+// BSDF-sampled ray can hit one (lights_pdf = 0).
+
+// The extension's recommended window for a finite `range`: 1 - (d / range)^4, clamped to
+// [0, 1], on top of the inverse square; exactly 0 at and beyond the range. range 0: none.
+float lights_range_window(float range, float dist) {
+  if (!(range > 0.0f)) return 1.0f;
+  float x = dist / range;
+  x *= x;
+  return clamp(1.0f - x * x, 0.0f, 1.0f);
+}
+
+// The extension's spot cone profile at cosine `cos_axis` from the axis: t^2 with t
+// interpolating the cosine linearly from cos(outer) (t = 0) to cos(inner) (t = 1)
+float lights_spot_falloff(__global const Light* light, float cos_axis) {
+  float t = clamp(cos_axis * light->params[6] + light->params[7], 0.0f, 1.0f);
+  return t * t;
+}
+
+// Point and spot lights: intensity I gives irradiance I / d^2 at ctx.p; the shadow ray
+// ends at the light's position
+bool lights_sample_point(__global const Light* light, const LightSampleContext* ctx, LightSample* ls) {
+  float3 pos = load3(light->params);
+  float3 d = pos - ctx->p;
+  float dist2 = dot(d, d);
+  if (!(dist2 > 0.0f)) return false;
+  float dist = sqrt(dist2);
+  ls->wi = d / dist;
+  float scale = lights_range_window(light->radiance[3], dist) / dist2;
+  if (light->type == LIGHT_SPOT) scale *= lights_spot_falloff(light, -dot(ls->wi, load3(light->params + 3)));
+  ls->radiance = load3(light->radiance) * scale;
+  ls->pdf = 1.0f;
+  ls->is_delta = true;
+  ls->at_infinity = false;
+  ls->target = pos;
+  return scale > 0.0f && isfinite(scale);
+}
+
+// Directional light: irradiance E at normal incidence from the one direction it comes from
+bool lights_sample_directional(__global const Light* light, LightSample* ls) {
+  ls->wi = -load3(light->params + 3);
+  ls->radiance = load3(light->radiance);
+  ls->pdf = 1.0f;
+  ls->is_delta = true;
+  ls->at_infinity = true;
+  return true;
+}
+
 // Picks a light by x_select (power-proportional alias table) and samples a direction toward it
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u,
                    LightSample* ls) {
@@ -122,6 +172,13 @@ bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_se
       break;
     case LIGHT_ENVIRONMENT:
       ok = lights_sample_environment(sc, ctx, u, ls);
+      break;
+    case LIGHT_POINT:
+    case LIGHT_SPOT:
+      ok = lights_sample_point(light, ctx, ls);
+      break;
+    case LIGHT_DIRECTIONAL:
+      ok = lights_sample_directional(light, ls);
       break;
     default:
       ok = false;
@@ -138,6 +195,10 @@ float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index,
       return light->pmf * lights_pdf_triangle(sc, light, ctx, wi);
     case LIGHT_ENVIRONMENT:
       return light->pmf * lights_pdf_environment(ctx, wi);
+    case LIGHT_POINT:
+    case LIGHT_SPOT:
+    case LIGHT_DIRECTIONAL:
+      return 0.0f;  // a delta in direction: no sampled direction finds it
     default:
       return 0.0f;
   }

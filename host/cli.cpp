@@ -144,8 +144,12 @@ Scene load_scene(const RenderArgs& a) {
   }
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  if (!scene.has_emission())
-    std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
+  if (!scene.has_light())
+    std::fprintf(stderr, "warning: the scene has no light: no emissive material, no punctual light and a black background; the image will be black\n");
+  // No BSDF-sampled ray can hit a point, spot or directional light
+  if (size_t n = scene.punctual_light_count(); n > 0 && parse_strategy(a.strategy) == Strategy::Bsdf)
+    std::fprintf(stderr, "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee\n", n,
+                 n == 1 ? "" : "s", n == 1 ? "s" : "");
   if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
   return scene;
 }

@@ -10,8 +10,10 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <string_view>
 
 #include "error.hpp"
 
@@ -22,7 +24,7 @@ namespace {
 const std::set<std::string> kSupportedExtensions = {
     "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization",
     "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
-    "KHR_materials_volume", "KHR_materials_clearcoat", "KHR_materials_anisotropy"};
+    "KHR_materials_volume", "KHR_materials_clearcoat", "KHR_materials_anisotropy", "KHR_lights_punctual"};
 
 // Measured conductors as RGB complex indices of refraction (eta + i k at about 650, 550
 // and 450 nm), selectable by name in a material's extras.candela.conductor
@@ -227,6 +229,44 @@ void read_texture_transform(const tinygltf::Value& ext, TextureSlot* ref) {
   ref->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
                              glm::vec3(ox, oy, 1.0f));
   if (ext.Has("texCoord")) ref->texcoord = int(number_or(ext, "texCoord", -1, ref->texcoord));
+}
+
+// A KHR_lights_punctual light's own properties, checked against what the extension says
+// they must be (an Error) or should be (a warning); the node reader places it
+PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, Warnings* warn) {
+  const std::string what = "KHR_lights_punctual light " + std::to_string(index);
+  PunctualLightDesc l;
+  if (gl.type == "point") l.type = PunctualType::Point;
+  else if (gl.type == "spot") l.type = PunctualType::Spot;
+  else if (gl.type == "directional") l.type = PunctualType::Directional;
+  else throw Error(what + " has type '" + gl.type + "'; it must be point, spot or directional");
+  if (!gl.color.empty()) {
+    if (gl.color.size() != 3) throw Error(what + ": color must hold 3 numbers");
+    for (int c = 0; c < 3; ++c) {
+      l.color[c] = float(gl.color[size_t(c)]);
+      if (!(l.color[c] >= 0.0f && std::isfinite(l.color[c]))) throw Error(what + ": color must be finite and non-negative");
+    }
+    if (l.color.x > 1.0f || l.color.y > 1.0f || l.color.z > 1.0f)
+      warn->add(what + ": color components above 1 are outside the extension's range; used as given");
+  }
+  l.intensity = float(gl.intensity);
+  if (!(l.intensity >= 0.0f && std::isfinite(l.intensity))) throw Error(what + ": intensity must be finite and non-negative");
+  // tinygltf reads an absent range as 0: both mean infinite
+  l.range = float(gl.range);
+  if (!(l.range >= 0.0f && std::isfinite(l.range))) throw Error(what + ": range must be greater than 0");
+  if (l.type == PunctualType::Directional && l.range > 0.0f) {
+    warn->add(what + ": range applies only to point and spot lights; it is ignored on a directional light");
+    l.range = 0.0f;
+  }
+  if (l.type == PunctualType::Spot) {
+    l.inner_cone = float(gl.spot.innerConeAngle);
+    l.outer_cone = float(gl.spot.outerConeAngle);
+    const double half_pi = 1.57079632679489662;
+    if (!(gl.spot.innerConeAngle >= 0.0 && gl.spot.innerConeAngle < gl.spot.outerConeAngle &&
+          gl.spot.outerConeAngle <= half_pi + 1e-9))
+      throw Error(what + ": spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2");
+  }
+  return l;
 }
 
 // Materials and the textures they use
@@ -688,9 +728,31 @@ class NodeReader {
         warn_.add("morph targets are not supported yet: base geometry is rendered");
     }
     if (node.camera >= 0 && !scene_->camera) read_camera(node.camera, world);
-    if (node.extensions.count("KHR_lights_punctual"))
-      warn_.add("KHR_lights_punctual lights are not supported yet and are ignored");
+    if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
+      read_light(index, ext->second, world);
     for (int child : node.children) visit(child, world);
+  }
+
+  // The node's KHR_lights_punctual light at the node's world origin, pointing along its
+  // world -Z axis
+  void read_light(int node_index, const tinygltf::Value& ext, const glm::mat4& world) {
+    const std::string where = "glTF node " + std::to_string(node_index);
+    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber())
+      throw Error(where + ": KHR_lights_punctual has no light index");
+    double index = ext.Get("light").GetNumberAsDouble();
+    if (!(index >= 0.0 && index < double(model_.lights.size()) && index == std::floor(index)))
+      throw Error(where + " refers to a missing KHR_lights_punctual light");
+    PunctualLightDesc l = read_punctual_light(model_.lights[size_t(index)], size_t(index), &warn_);
+    l.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
+    if (!(std::isfinite(l.position.x) && std::isfinite(l.position.y) && std::isfinite(l.position.z))) throw Error(where + ": the light's position is not finite");
+    if (l.type != PunctualType::Point) {
+      glm::vec3 dir = glm::vec3(world * glm::vec4(0, 0, -1, 0));
+      float len = glm::length(dir);
+      if (!(len > 0.0f && std::isfinite(len)))
+        throw Error(where + ": the light has no direction (its node transform is degenerate or not finite)");
+      l.direction = dir / len;
+    }
+    scene_->punctual_lights.push_back(l);
   }
 
   void read_camera(int index, const glm::mat4& world) {
@@ -835,7 +897,57 @@ size_t json_depth(const char* p, size_t n, size_t limit) {
   }
   return deepest;
 }
-constexpr size_t kMaxJsonDepth = 64;  // glTF itself needs under 10
+constexpr size_t kMaxJsonDepth = 64;
+
+void append_u32le(std::string* out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out->push_back(char((v >> (8 * i)) & 0xffu));
+}
+
+// KHR_lights_punctual lets a spot light leave out its `spot` object (the cone then takes
+// its defaults), but tinygltf 2.7 rejects the file. Gives each such light an empty one:
+// *out gets the patched file (JSON text, or GLB with its JSON chunk replaced) and the
+// result is true; false, and no copy, when the JSON needs nothing (or does not parse:
+// tinygltf then reports it).
+bool add_missing_spot_objects(const std::string& data, size_t json_begin, size_t json_size, bool binary,
+                              std::string* out) {
+  if (binary && json_begin != 20) return false;  // too short for a GLB: tinygltf reports it
+  std::string_view text(data.data() + json_begin, json_size);
+  if (text.find("KHR_lights_punctual") == std::string_view::npos) return false;
+  nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return false;
+  auto ext = j.find("extensions");
+  if (ext == j.end() || !ext->is_object()) return false;
+  auto khr = ext->find("KHR_lights_punctual");
+  if (khr == ext->end() || !khr->is_object()) return false;
+  auto lights = khr->find("lights");
+  if (lights == khr->end() || !lights->is_array()) return false;
+  bool changed = false;
+  for (nlohmann::json& l : *lights) {
+    if (!l.is_object() || l.contains("spot")) continue;
+    auto type = l.find("type");
+    if (type != l.end() && type->is_string() && type->get<std::string>() == "spot") {
+      l["spot"] = nlohmann::json::object();
+      changed = true;
+    }
+  }
+  if (!changed) return false;
+  std::string patched = j.dump();
+  if (!binary) {
+    *out = std::move(patched);
+    return true;
+  }
+  // GLB: header, the new JSON chunk (padded with spaces to 4 bytes), the chunks after it
+  while (patched.size() % 4) patched.push_back(' ');
+  std::string rest = data.substr(json_begin + json_size);
+  if (12 + 8 + patched.size() + rest.size() > UINT32_MAX) return false;
+  out->assign(data, 0, 8);  // magic and version
+  append_u32le(out, uint32_t(12 + 8 + patched.size() + rest.size()));
+  append_u32le(out, uint32_t(patched.size()));
+  out->append(data, 16, 4);  // chunk type JSON
+  *out += patched;
+  *out += rest;
+  return true;
+}  // glTF itself needs under 10
 
 // Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
 // External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
@@ -866,10 +978,12 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   }
   if (json_depth(data.data() + json_begin, json_size, kMaxJsonDepth) > kMaxJsonDepth)
     throw Error("cannot load glTF scene " + name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+  std::string patched;  // the file with defaults tinygltf needs written in, if any
+  const std::string& bytes = add_missing_spot_objects(data, json_begin, json_size, binary, &patched) ? patched : data;
   bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, &warn,
-                                               reinterpret_cast<const unsigned char*>(data.data()),
-                                               unsigned(data.size()), base_dir)
-                   : gltf.LoadASCIIFromString(&model, &err, &warn, data.data(), unsigned(data.size()), base_dir);
+                                               reinterpret_cast<const unsigned char*>(bytes.data()),
+                                               unsigned(bytes.size()), base_dir)
+                   : gltf.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base_dir);
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     throw Error("cannot load glTF scene " + name + ": " + (err.empty() ? "malformed file" : err));

@@ -63,8 +63,16 @@ SceneFeatures Scene::features() const {
   return f;
 }
 
-bool Scene::has_emission() const {
+size_t Scene::punctual_light_count() const {
+  size_t n = 0;
+  for (const PunctualLightDesc& l : punctual_lights)
+    n += dev::luminance_rgb(l.color.x, l.color.y, l.color.z) * l.intensity > 0.0f;
+  return n;
+}
+
+bool Scene::has_light() const {
   if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) return true;
+  if (punctual_light_count() > 0) return true;
   for (const auto& mesh : meshes) {
     const MaterialDesc& m = materials.at(mesh.material);
     bool factor = m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;

@@ -72,6 +72,20 @@ struct MeshDesc {
   size_t triangles() const { return indices.size() / 3; }
 };
 
+// A KHR_lights_punctual light placed in the world. Photometric values are taken one to one
+// as radiometric ones (no 683 lm/W): intensity in candela is radiant intensity (W/sr),
+// illuminance in lux is irradiance; colour (linear RGB) multiplies the intensity.
+enum class PunctualType { Point, Spot, Directional };
+struct PunctualLightDesc {
+  PunctualType type = PunctualType::Point;
+  glm::vec3 position{0.0f};  // point, spot: the node's world origin
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot, directional: the node's world -Z, unit
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;  // point, spot: candela (W/sr); directional: lux (W/m^2)
+  float range = 0.0f;  // point, spot: 0 = infinite
+  float inner_cone = 0.0f, outer_cone = 0.7853982f;  // spot, radians
+};
+
 struct CameraDesc {
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, -1.0f};
@@ -111,12 +125,14 @@ struct Scene {
   std::vector<TextureDesc> textures;
   std::optional<CameraDesc> camera;
   glm::vec3 background{0.0f};  // constant environment radiance
+  std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
   std::vector<std::string> warnings;  // each unsupported feature named once
 
   size_t triangles() const;
   Bounds bounds() const;
   SceneFeatures features() const;
-  bool has_emission() const;  // some triangle or the background emits
+  bool has_light() const;  // some triangle, the background or a punctual light emits
+  size_t punctual_light_count() const;  // punctual lights that emit (colour x intensity > 0)
 };
 
 // Unit normal of triangle (a, b, c) by its counter-clockwise winding; *area gets its area

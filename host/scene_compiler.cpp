@@ -124,7 +124,36 @@ glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {
   return glm::vec3(b.positions[3 * size_t(v)], b.positions[3 * size_t(v) + 1], b.positions[3 * size_t(v) + 2]);
 }
 
-// Every emissive triangle and the environment, with the selection table
+// The device record of a punctual light (the parameter table in cl/device_types.h)
+dev::Light punctual_light(const PunctualLightDesc& p) {
+  dev::Light l{};
+  l.type = p.type == PunctualType::Point ? LIGHT_POINT : p.type == PunctualType::Spot ? LIGHT_SPOT : LIGHT_DIRECTIONAL;
+  for (int c = 0; c < 3; ++c) {
+    l.radiance[c] = p.color[c] * p.intensity;
+    l.params[c] = p.position[c];
+    l.params[3 + c] = p.direction[c];
+  }
+  l.radiance[3] = p.type == PunctualType::Directional ? 0.0f : p.range;
+  if (p.type == PunctualType::Spot) {
+    // KHR_lights_punctual's reference form: t = cos * scale + offset
+    double cos_outer = std::cos(double(p.outer_cone));
+    double scale = 1.0 / std::max(0.001, std::cos(double(p.inner_cone)) - cos_outer);
+    l.params[6] = float(scale);
+    l.params[7] = float(-cos_outer * scale);
+  }
+  return l;
+}
+
+// Solid-angle integral of the spot profile clamp(c * scale + offset, 0, 1)^2 over the
+// sphere, c = cos(angle to the axis): with s = 1 / scale and c0 = -offset / scale (the
+// outer cosine), t = (c - c0) / s rises from 0 at c0 to 1 at c0 + s and stays 1 up to c = 1
+double spot_solid_angle(double scale, double offset) {
+  double s = 1.0 / scale, c0 = -offset / scale;
+  double t_max = std::min(1.0, (1.0 - c0) / s);
+  return 2.0 * kPi * (s * t_max * t_max * t_max / 3.0 + std::max(0.0, 1.0 - c0 - s));
+}
+
+// Every emissive triangle, punctual light and the environment, with the selection table
 int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   std::vector<double> texture_mean(scene.textures.size(), -1.0);  // computed on first use
   std::vector<double> power;
@@ -146,6 +175,15 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     l.params[0] = float(area);
     double w = light_power(l, *b, scale, radius);
     if (!(w > 0.0)) continue;  // includes emissive textures that are black throughout
+    b->lights.push_back(l);
+    power.push_back(w);
+  }
+  for (const PunctualLightDesc& p : scene.punctual_lights) {
+    dev::Light l = punctual_light(p);
+    double w = light_power(l, *b, 1.0, radius);
+    if (!std::isfinite(w) || !std::isfinite(l.radiance[0] + l.radiance[1] + l.radiance[2]))
+      throw Error("a punctual light's colour x intensity overflows single precision");
+    if (!(w > 0.0)) continue;  // black or of zero intensity
     b->lights.push_back(l);
     power.push_back(w);
   }
@@ -175,6 +213,9 @@ void check_extent(const Scene& scene, const CameraDesc& camera) {
     throw Error("the scene extends beyond +-1e15 units, too far for single-precision rendering");
   if (scene.camera && !within_range(camera.position))  // one framing the scene lies within a few radii
     throw Error("the camera lies beyond +-1e15 units, too far for single-precision rendering");
+  for (const PunctualLightDesc& l : scene.punctual_lights)
+    if (!within_range(l.position))
+      throw Error("a punctual light lies beyond +-1e15 units, too far for single-precision rendering");
   float forward = glm::length(camera.forward);
   if (!(forward > 0.0f && std::isfinite(forward)))
     throw Error("the camera has no viewing direction (its node transform is degenerate or not finite)");
@@ -194,6 +235,18 @@ double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, do
     case LIGHT_ENVIRONMENT:
       // A constant environment's power through the scene's bounding sphere
       return 4.0 * kPi * kPi * scene_radius * scene_radius *
+             dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+    case LIGHT_POINT:
+    case LIGHT_SPOT: {
+      // Radiant intensity I over the sphere, or over the spot's profile. A finite range
+      // is left out: the power is then an upper bound, which only costs variance.
+      double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+      double solid_angle = light.type == LIGHT_POINT ? 4.0 * kPi : spot_solid_angle(light.params[6], light.params[7]);
+      return lum * solid_angle;
+    }
+    case LIGHT_DIRECTIONAL:
+      // Irradiance E through the disc the scene's bounding sphere shows the light
+      return kPi * scene_radius * scene_radius *
              dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
     default:
       throw Error("light_power: unknown light type " + std::to_string(light.type));

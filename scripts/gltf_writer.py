@@ -8,6 +8,7 @@ Used by scripts/make_scenes.py.
 
 import base64
 import json
+import math
 import os
 import struct
 import zlib
@@ -159,6 +160,31 @@ class GltfWriter:
         if root:
             self.doc["scenes"][0]["nodes"].append(index)
         return index
+
+    def punctual_light(self, name, light_type, color=(1.0, 1.0, 1.0),
+                       intensity=1.0, light_range=None, inner_cone=0.0,
+                       outer_cone=math.pi / 4.0):
+        """A KHR_lights_punctual light ("point", "spot" or "directional"),
+        placed by light_node; returns its index.  Intensity is in candela for
+        point and spot lights and in lux for directional ones."""
+        self._use("KHR_lights_punctual")
+        light = {"name": name, "type": light_type, "color": list(color),
+                 "intensity": intensity}
+        if light_range is not None:
+            light["range"] = light_range
+        if light_type == "spot":
+            light["spot"] = {"innerConeAngle": inner_cone,
+                             "outerConeAngle": outer_cone}
+        ext = self.doc.setdefault("extensions", {})
+        lights = ext.setdefault("KHR_lights_punctual", {}).setdefault("lights", [])
+        lights.append(light)
+        return len(lights) - 1
+
+    def light_node(self, name, light, **fields):
+        """A node carrying punctual light `light`: it sits at the node's
+        origin and points down the node's -Z axis."""
+        return self.node(name, extensions={"KHR_lights_punctual": {"light": light}},
+                         **fields)
 
     def set_background(self, rgb):
         """candela's scene background radiance (scene extras)."""

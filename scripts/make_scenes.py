@@ -7,6 +7,8 @@ Outputs (deterministic, byte-identical on every run):
   scenes/cornell-box/cornell-box.gltf   Cornell Box (published measured data)
   scenes/furnace/closed-sphere.gltf     emissive+diffuse sphere seen from inside
   scenes/furnace/white-objects.gltf     albedo-1 objects under a white background
+  scenes/materials/materials.gltf       grid of material spheres under an area light
+  scenes/lights/punctual.gltf           point, spot and directional lights (KHR_lights_punctual)
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices
@@ -544,6 +546,48 @@ def quat_from_basis(x, y, z):
     return q
 
 
+def look_at_rotation(eye, target, up=(0.0, 1.0, 0.0)):
+    """Node rotation whose -Z axis points from eye to target, +Y toward up."""
+    z = normalize(sub(eye, target))
+    x = normalize(cross(up, z))
+    return quat_from_basis(x, cross(z, x), z)
+
+
+# ---------------------------------------------------------------------------
+# Punctual lights
+
+def make_punctual(path):
+    """A floor, a sphere and a cube under a warm point light, a blue spot
+    light on the cube and a dim directional light from the upper left."""
+    g = GltfWriter(GENERATOR)
+    grey = g.material("grey", (0.6, 0.6, 0.6, 1.0))
+    white = g.material("white", (0.8, 0.8, 0.8, 1.0))
+    red = g.material("red", (0.7, 0.15, 0.1, 1.0))
+    s = 4.0
+    floor = [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)]
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(
+        orient_quad(floor, (0.0, 1.0, 0.0)))), grey))
+    g.node("sphere", mesh=g.mesh("sphere", *flat_mesh(icosphere(3, radius=0.5)), red),
+           translation=[-0.8, 0.5, 0.0])
+    half = math.radians(25.0) / 2.0
+    g.node("cube", mesh=g.mesh("cube", *flat_mesh(cube(0.7)), white),
+           translation=[0.9, 0.35, 0.3],
+           rotation=[0.0, math.sin(half), 0.0, math.cos(half)])
+    point = g.punctual_light("warm point", "point", (1.0, 0.8, 0.6), 6.0)
+    g.light_node("point", point, translation=[-1.6, 1.6, 1.2])
+    spot = g.punctual_light("blue spot", "spot", (0.5, 0.7, 1.0), 30.0,
+                            light_range=6.0, inner_cone=0.2, outer_cone=0.35)
+    spot_at = [1.4, 3.2, 1.2]
+    g.light_node("spot", spot, translation=spot_at,
+                 rotation=look_at_rotation(tuple(spot_at), (0.9, 0.35, 0.3)))
+    sun = g.punctual_light("sun", "directional", (1.0, 1.0, 0.95), 0.6)
+    g.light_node("sun", sun, rotation=look_at_rotation((-2.0, 3.0, 1.0), (0.0, 0.0, 0.0)))
+    eye = (0.0, 2.2, 4.8)
+    g.node("camera", camera=g.camera("camera", 0.7, 1.5), translation=list(eye),
+           rotation=look_at_rotation(eye, (0.0, 0.4, 0.0)))
+    g.write(path)
+
+
 # ---------------------------------------------------------------------------
 
 SCENES = [
@@ -551,6 +595,7 @@ SCENES = [
     ("scenes/furnace/closed-sphere.gltf", make_closed_sphere),
     ("scenes/furnace/white-objects.gltf", make_white_objects),
     ("scenes/materials/materials.gltf", make_materials),
+    ("scenes/lights/punctual.gltf", make_punctual),
 ]
 
 

@@ -49,6 +49,24 @@ expect_error "bad background" "three comma-separated numbers" -- "$bin" render "
 mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights.cl"
 expect_error "kernel build failure shows the log" "cl/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
 
+# Punctual lights: counted in the summary and the stats; one warning under --strategy bsdf
+punctual=$root/scenes/lights/punctual.gltf
+if "$bin" render "$punctual" -o "$tmp/p.png" --spp 1 --width 16 --height 16 --device pocl \
+    --stats "$tmp/p.json" >"$tmp/out" 2>"$tmp/err" && grep -q "^scene: .* 3 lights" "$tmp/err" &&
+    ! grep -q "punctual light" "$tmp/err" &&
+    python3 -c "import json; assert json.load(open('$tmp/p.json'))['lights'] == 3" 2>/dev/null; then
+  pass "punctual lights count as lights"
+else
+  fail "punctual lights count as lights"; cat "$tmp/err"
+fi
+if "$bin" render "$punctual" -o "$tmp/p.png" --spp 1 --width 16 --height 16 --device pocl \
+    --strategy bsdf >"$tmp/out" 2>"$tmp/err" &&
+    [ "$(grep -c "the scene's 3 punctual lights contribute nothing under --strategy bsdf; use nee" "$tmp/err")" -eq 1 ]; then
+  pass "--strategy bsdf warns about punctual lights"
+else
+  fail "--strategy bsdf warns about punctual lights"; cat "$tmp/err"
+fi
+
 # --device rusticl finds Mesa's CPU device without RUSTICL_ENABLE in the environment
 if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
   if env -u RUSTICL_ENABLE "$bin" render "$scene" -o "$tmp/r.png" --spp 1 --width 16 --height 16 \
