@@ -118,6 +118,14 @@ uint bsdf_flags(const Bsdf* b) {
   }
 }
 
+// Alpha (sqrt(ax ay)) of the widest microfacet lobe a non-diffuse BSDF has: how sharp its
+// sharpest-but-not-delta reflection is, for the auto strategy (integrator_path.cl)
+float bsdf_widest_alpha(const Bsdf* b) {
+  float a = sqrt(b->ggx.ax * b->ggx.ay);
+  if (b->type == MATERIAL_GLTF && b->coat > 0.0f) a = fmax(a, sqrt(b->coat_ggx.ax * b->coat_ggx.ay));
+  return a;
+}
+
 // The geometric side test: wi lies on wo's side of the surface
 bool bsdf_is_reflection(const Bsdf* b, float3 wi) { return dot(wi, b->ng) > 0.0f; }
 

@@ -41,6 +41,7 @@
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
 #define STRATEGY_BSDF 1u
+#define STRATEGY_AUTO 2u  // per vertex: nee at rough or diffuse BSDFs, bsdf at near-specular ones
 
 // Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
 // colour encoding, texel storage and filter

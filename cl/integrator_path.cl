@@ -7,13 +7,19 @@
 //   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
 //                  punctual lights, which no ray can hit, contribute nothing)
 
+// Near-specular threshold of STRATEGY_AUTO (alpha = glTF roughness^2): below it BSDF
+// sampling has the lower error on area and environment lights (measured on
+// scenes/lights/veach.gltf, see README "Strategies")
+#define AUTO_BSDF_ALPHA 0.04f
+
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
   Ray ray;
   float3 beta;  // throughput
   float3 radiance;  // light gathered so far
   uint depth;  // scattering events so far
-  bool specular_bounce;  // the last scattering was a delta lobe: count emission next
+  bool specular_bounce;  // emission the ray finds counts: the camera ray, a delta lobe's
+                         // ray, or one from a vertex that took no light sample
   float eta_scale;  // product of eta^2 over transmissions, so roulette sees radiance scale
   int medium;  // medium the ray travels in, NO_MEDIUM = vacuum (for the volumes issue)
 } PathState;
@@ -24,19 +30,22 @@ PathState path_start(Ray ray) {
   ps.beta = (float3)(1.0f);
   ps.radiance = (float3)(0.0f);
   ps.depth = 0u;
-  ps.specular_bounce = false;
+  ps.specular_bounce = true;  // the camera sees emitters directly
   ps.eta_scale = 1.0f;
   ps.medium = NO_MEDIUM;
   return ps;
 }
 
-// Next-event estimate of light arriving at ctx and scattered by bsdf toward wo
+// Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
+// `delta_only`, of the delta lights alone (the others then count when a sampled ray finds
+// them: a sample of another light contributes nothing here)
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
-                         float3 wo, Rng* rng) {
+                         float3 wo, bool delta_only, Rng* rng) {
   uint x_select = rng_next_uint(rng);
   float2 u = (float2)(rng_next(rng), rng_next(rng));
   LightSample ls;
   if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
+  if (delta_only && !ls.is_delta) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
   float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
@@ -71,11 +80,11 @@ bool path_survives_roulette(PathState* ps, uint rr_depth, Rng* rng) {
 // Radiance along one camera ray
 float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
   __global const RenderParams* params = sc->params;
-  const bool nee = params->strategy == STRATEGY_NEE;
+  const uint strategy = params->strategy;
   PathState ps = path_start(camera_ray);
   for (;; ++ps.depth) {
     Hit hit = scene_intersect(sc, ps.ray, INFINITY);
-    bool counts_emission = ps.depth == 0u || ps.specular_bounce || !nee;
+    bool counts_emission = ps.specular_bounce;
     if (hit.prim < 0) {
       if (counts_emission) ps.radiance += ps.beta * lights_environment_radiance(sc, ps.ray.dir);
       break;
@@ -89,9 +98,13 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     Bsdf bsdf = bsdf_at(sc, &s);
     uint flags = bsdf_flags(&bsdf);
     // Light sampling, except at lobes that are all delta (no light sample can find them)
-    if (nee && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u) {
+    // and where the strategy leaves area and environment lights to the sampled ray
+    bool samples_lights = strategy != STRATEGY_BSDF && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u;
+    bool near_specular = strategy == STRATEGY_AUTO && (flags & BSDF_DIFFUSE) == 0u &&
+                         bsdf_widest_alpha(&bsdf) <= AUTO_BSDF_ALPHA;
+    if (samples_lights) {
       LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
-      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, rng);
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, near_specular, rng);
     }
 
     // Continue the path by sampling the BSDF
@@ -100,7 +113,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     BsdfSample bs;
     if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
     ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
-    ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u;
+    ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u || !samples_lights || near_specular;
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
     ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);

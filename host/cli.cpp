@@ -131,7 +131,8 @@ void apply_camera_options(const RenderArgs& a, Scene* scene) {
 Strategy parse_strategy(const std::string& name) {
   if (name == "nee") return Strategy::Nee;
   if (name == "bsdf") return Strategy::Bsdf;
-  throw Error("--strategy must be nee or bsdf, not '" + name + "'");
+  if (name == "auto") return Strategy::Auto;
+  throw Error("--strategy must be nee, bsdf or auto, not '" + name + "'");
 }
 
 // The scene with the command line's overrides, its warnings printed
@@ -244,7 +245,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU");
   render->add_option("--seed", a.seed, "Random seed (default 0)");
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
-  render->add_option("--strategy", a.strategy, "nee (next-event estimation, default) or bsdf (BSDF sampling only)");
+  render->add_option("--strategy", a.strategy, "nee (next-event estimation, default), bsdf (BSDF sampling only) or auto (per vertex: bsdf at near-specular surfaces, nee elsewhere)");
   render->add_flag("--no-energy-compensation", a.no_energy_compensation,
                    "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
   render->add_option("--background", a.background, "Constant background radiance R,G,B (overrides the scene's)");
