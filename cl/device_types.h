@@ -43,6 +43,16 @@
 #define STRATEGY_BSDF 1u
 #define STRATEGY_AUTO 2u  // per vertex: nee at rough or diffuse BSDFs, bsdf at near-specular ones
 
+// Camera projections (camera.cl)
+#define CAMERA_PERSPECTIVE 0u  // pinhole, or a thin lens when lens_radius > 0
+#define CAMERA_ORTHOGRAPHIC 1u  // parallel rays along forward
+
+// Pixel filters (filter.cl), importance-sampled: film samples are offset from the pixel
+// centre with the filter's density, so each pixel stays an unweighted mean
+#define FILTER_BOX 0u  // uniform over the pixel (|dx|, |dy| < 1/2)
+#define FILTER_TENT 1u  // separable tent of radius 1 pixel
+#define FILTER_GAUSSIAN 2u  // isotropic Gaussian, sigma 1/2 pixel, not truncated
+
 // Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
 // colour encoding, texel storage and filter
 #define WRAP_REPEAT 0u
@@ -167,19 +177,26 @@ typedef struct {
   float params[8];  // per-type parameters, see above
 } Light;
 
-// Pinhole camera, 64 bytes: ray direction = forward + (2x-1) right + (1-2y) up.
+// Camera, 64 bytes. Pixel (x, y) in [-1, 1]^2 (x right, y up) maps to
+//   CAMERA_PERSPECTIVE:  direction forward + x right + y up from origin, with right and
+//                        up scaled by tan(xfov/2) and tan(yfov/2). A thin lens
+//                        (lens_radius > 0) starts the ray at a uniform point of the lens
+//                        disk around origin and aims it at the point where the pinhole ray
+//                        crosses the focus plane, focus_distance along forward.
+//   CAMERA_ORTHOGRAPHIC: direction forward from origin + x right + y up, with right and
+//                        up scaled by the half-width and half-height of the view (xmag, ymag).
 typedef struct {
   float origin[3];
+  unsigned int type;  // CAMERA_*
+  float forward[3];  // unit
+  float lens_radius;  // thin-lens aperture radius in scene units; 0 = pinhole
+  float right[3];
+  float focus_distance;  // thin lens: distance of the sharp plane along forward
+  float up[3];
   float pad0;
-  float forward[3];
-  float pad1;
-  float right[3];  // scaled by tan(xfov/2)
-  float pad2;
-  float up[3];  // scaled by tan(yfov/2)
-  float pad3;
 } Camera;
 
-// Everything one launch needs besides buffers, 116 bytes.
+// Everything one launch needs besides buffers, 120 bytes.
 typedef struct {
   Camera camera;
   unsigned int width;
@@ -195,6 +212,7 @@ typedef struct {
   unsigned int pixel_begin;  // first pixel of this launch (row-major)
   unsigned int pixel_end;  // one past the last pixel of this launch
   unsigned int energy_compensation;  // 1: multiple-scattering compensation of GGX lobes (energy.cl)
+  unsigned int filter;  // FILTER_*: the density of film sample offsets (filter.cl)
 } RenderParams;
 
 // Every scene buffer, in kernel-argument order: X(element type, name). This one list
@@ -243,10 +261,12 @@ typedef struct {
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
-  SIZE(Camera, 64) FIELD(Camera, forward, 16) FIELD(Camera, right, 32) FIELD(Camera, up, 48) \
-  SIZE(RenderParams, 116) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
+  SIZE(Camera, 64) FIELD(Camera, type, 12) FIELD(Camera, forward, 16)                      \
+  FIELD(Camera, lens_radius, 28) FIELD(Camera, right, 32) FIELD(Camera, focus_distance, 44) \
+  FIELD(Camera, up, 48) FIELD(Camera, pad0, 60)                                             \
+  SIZE(RenderParams, 120) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
   FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \
   FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)                 \
-  FIELD(RenderParams, energy_compensation, 112)
+  FIELD(RenderParams, energy_compensation, 112) FIELD(RenderParams, filter, 116)
 
 #endif  // CANDELA_DEVICE_TYPES_H

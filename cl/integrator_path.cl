@@ -1,5 +1,5 @@
 // Megakernel path tracer: one work-item per pixel traces `sample_count` whole paths, each
-// from a box-filtered (uniformly jittered) point of its pixel, and folds them into the
+// from a point drawn with the pixel filter's density (filter.cl), and folds them into the
 // film with Welford's running mean and squared deviations.
 // Strategies (no MIS, each light path counted exactly once):
 //   STRATEGY_NEE:  emission counted on camera rays and after delta lobes; all other light
@@ -136,7 +136,10 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
     float jx = rng_next(&rng), jy = rng_next(&rng);
-    Ray ray = camera_ray(params, (float)px + jx, (float)py + jy);
+    float2 film = filter_sample(params->filter, jx, jy);
+    float2 lens = (float2)(0.0f);
+    if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(&rng), rng_next(&rng));
+    Ray ray = camera_ray(params, (float)px + film.x, (float)py + film.y, lens);
     float3 l = path_trace(&sc, ray, &rng);
     if (!all_finite(l)) {
       m2.w += 1.0f;

@@ -40,3 +40,22 @@ uint sample_discrete_alias(__global const AliasBin* bins, uint n, uint x) {
   AliasBin b = bins[bin];
   return x * n < b.threshold ? bin : b.alias;
 }
+
+// Uniform point on the unit disk by Shirley and Chiu's concentric mapping (1997, A
+// Low Distortion Map Between Disk and Square): the square [-1, 1]^2 is cut into four
+// triangles by its diagonals, and each square ring of half-width r maps to the circle of
+// radius r, keeping the area fractions. The pdf is 1 / pi.
+float2 sample_concentric_disk(float u, float v) {
+  float a = 2.0f * u - 1.0f, b = 2.0f * v - 1.0f;
+  if (a == 0.0f && b == 0.0f) return (float2)(0.0f);
+  float r, phi;
+  if (fabs(a) > fabs(b)) {
+    r = a;
+    phi = (0.25f * PI_F) * (b / a);
+  } else {
+    r = b;
+    phi = 0.5f * PI_F - (0.25f * PI_F) * (a / b);
+  }
+  float cos_phi, sin_phi = sincos(phi, &cos_phi);
+  return (float2)(r * cos_phi, r * sin_phi);
+}

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <unistd.h>
 
@@ -42,7 +43,9 @@ struct RenderArgs {
   std::string stats;
   float exposure = 0.0f;
   std::string look_from, look_at, up;
-  float fov = 0.0f;
+  std::optional<float> fov;  // degrees
+  std::optional<float> aperture, focus_distance;
+  std::string filter = "box";
   bool quiet = false;
 };
 
@@ -111,21 +114,47 @@ void resolve_size(const RenderArgs& a, const Scene& scene, int* w, int* h) {
 }
 
 void apply_camera_options(const RenderArgs& a, Scene* scene) {
-  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov != 0;
+  if (a.fov && !(*a.fov > 0 && *a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees (exclusive)");
+  if (a.aperture && !(*a.aperture >= 0 && std::isfinite(*a.aperture)))
+    throw Error("--aperture must be a non-negative radius in scene units");
+  if (a.focus_distance && !(*a.focus_distance > 0 && std::isfinite(*a.focus_distance)))
+    throw Error("--focus-distance must be a positive distance in scene units");
+  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov || a.aperture ||
+             a.focus_distance;
   if (!any) return;
-  CameraDesc cam = resolve_camera(*scene);
+  CameraDesc cam = scene->camera ? *scene->camera : framing_camera(*scene);
   if (!a.look_from.empty()) cam.position = parse_vec3(a.look_from, "--look-from");
+  std::optional<float> look_at_distance;
   if (!a.look_at.empty()) {
     glm::vec3 target = parse_vec3(a.look_at, "--look-at");
     if (glm::length(target - cam.position) <= 0) throw Error("--look-at must differ from the camera position");
     cam.forward = glm::normalize(target - cam.position);
+    look_at_distance = glm::length(target - cam.position);
   }
   if (!a.up.empty()) cam.up = parse_vec3(a.up, "--up");
-  if (a.fov != 0) {
-    if (!(a.fov > 0 && a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees");
-    cam.yfov = a.fov * 3.14159265f / 180.0f;
+  if (a.fov) {  // a field of view makes the camera perspective
+    cam.projection = Projection::Perspective;
+    cam.yfov = *a.fov * 3.14159265f / 180.0f;
   }
+  if (a.aperture) {
+    if (*a.aperture > 0 && cam.projection == Projection::Orthographic)
+      throw Error("--aperture needs a perspective camera: the scene camera is orthographic (add --fov to replace it)");
+    cam.aperture_radius = *a.aperture;
+  }
+  // Focus: --focus-distance, else the look-at point, else the scene camera's extras,
+  // else (resolve_camera) the bounds' centre along the view axis
+  if (a.focus_distance)
+    cam.focus_distance = *a.focus_distance;
+  else if (look_at_distance)
+    cam.focus_distance = look_at_distance;
   scene->camera = cam;
+}
+
+PixelFilter parse_filter(const std::string& name) {
+  if (name == "box") return PixelFilter::Box;
+  if (name == "tent") return PixelFilter::Tent;
+  if (name == "gaussian") return PixelFilter::Gaussian;
+  throw Error("--filter must be box, tent or gaussian, not '" + name + "'");
 }
 
 Strategy parse_strategy(const std::string& name) {
@@ -172,6 +201,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"height", settings.height},
                       {"strategy", a.strategy},
                       {"energy_compensation", settings.energy_compensation},
+                      {"filter", a.filter},
                       {"max_depth", a.max_depth},
                       {"seed", a.seed},
                       {"interrupted", r.interrupted},
@@ -183,6 +213,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
 int run_render(const RenderArgs& a) {
   RenderSettings settings;
   settings.strategy = parse_strategy(a.strategy);
+  settings.filter = parse_filter(a.filter);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
   Scene scene = load_scene(a);
@@ -217,7 +248,7 @@ int run_render(const RenderArgs& a) {
       {"device", device.description()},        {"seed", std::to_string(a.seed)},
       {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
       {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene},
-      {"energy_compensation", settings.energy_compensation ? "on" : "off"}};
+      {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
@@ -254,7 +285,13 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
-  render->add_option("--fov", a.fov, "Vertical field of view in degrees");
+  render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)");
+  render->add_option("--aperture", a.aperture,
+                     "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)");
+  render->add_option("--focus-distance", a.focus_distance,
+                     "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
+                     "camera's extras, else the scene bounds' centre)");
+  render->add_option("--filter", a.filter, "Pixel filter: box (default), tent (radius 1 pixel) or gaussian (sigma 0.5 pixel)");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
   return render;
 }

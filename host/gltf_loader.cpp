@@ -755,21 +755,56 @@ class NodeReader {
     scene_->punctual_lights.push_back(l);
   }
 
+  // The first camera met, perspective or orthographic; znear and zfar are ignored (rays
+  // start at the camera and are never clipped)
   void read_camera(int index, const glm::mat4& world) {
     if (index >= (int)model_.cameras.size()) throw Error("glTF camera " + std::to_string(index) + " does not exist");
     const tinygltf::Camera& c = model_.cameras[size_t(index)];
-    if (c.type != "perspective") {
-      warn_.add("camera type '" + c.type + "' is not supported yet; it is skipped");
+    CameraDesc cam;
+    if (c.type == "perspective") {
+      cam.yfov = float(c.perspective.yfov);
+      cam.aspect = float(c.perspective.aspectRatio);
+      if (!(cam.yfov > 0.0f && cam.yfov < 3.14159f)) throw Error("glTF camera has an invalid yfov");
+    } else if (c.type == "orthographic") {
+      cam.projection = Projection::Orthographic;
+      // The spec forbids zero and advises against negative magnifications: take |mag|
+      double xmag = std::fabs(c.orthographic.xmag), ymag = std::fabs(c.orthographic.ymag);
+      if (!(xmag > 0.0 && ymag > 0.0 && xmag < 1e15 && ymag < 1e15))
+        throw Error("glTF orthographic camera needs finite, non-zero xmag and ymag");
+      cam.ymag = float(ymag);
+      cam.aspect = float(xmag / ymag);
+    } else {
+      warn_.add("camera type '" + c.type + "' is not supported; it is skipped");
       return;
     }
-    CameraDesc cam;
     cam.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
     cam.forward = glm::normalize(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
     cam.up = glm::normalize(glm::vec3(world * glm::vec4(0, 1, 0, 0)));
-    cam.yfov = float(c.perspective.yfov);
-    cam.aspect = float(c.perspective.aspectRatio);
-    if (!(cam.yfov > 0.0f && cam.yfov < 3.14159f)) throw Error("glTF camera has an invalid yfov");
+    read_camera_extras(c.extras, &cam);
     scene_->camera = cam;
+  }
+
+  // Thin lens: cameras[i].extras.candela = {"aperture_radius": R, "focus_distance": D}
+  void read_camera_extras(const tinygltf::Value& extras, CameraDesc* cam) {
+    if (!extras.IsObject() || !extras.Has("candela")) return;
+    const tinygltf::Value& c = extras.Get("candela");
+    auto number = [&](const char* key) -> std::optional<double> {
+      if (!c.Has(key)) return std::nullopt;
+      const tinygltf::Value& v = c.Get(key);
+      if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+        throw Error(std::string("camera extras candela.") + key + " must be a finite number");
+      return v.GetNumberAsDouble();
+    };
+    if (auto r = number("aperture_radius")) {
+      if (*r < 0.0) throw Error("camera extras candela.aperture_radius must not be negative");
+      if (*r > 0.0 && cam->projection == Projection::Orthographic)
+        throw Error("camera extras candela.aperture_radius: an orthographic camera has no lens (depth of field needs a perspective camera)");
+      cam->aperture_radius = float(*r);
+    }
+    if (auto d = number("focus_distance")) {
+      if (!(*d > 0.0)) throw Error("camera extras candela.focus_distance must be positive");
+      cam->focus_distance = float(*d);
+    }
   }
 
   const tinygltf::Model& model_;

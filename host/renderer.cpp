@@ -96,6 +96,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.num_lights = uint32_t(scene.buffers.lights.size());
   params_host_.environment_light = scene.environment_light;
   params_host_.energy_compensation = settings.energy_compensation ? 1u : 0u;
+  params_host_.filter = uint32_t(settings.filter);
 
   size_t pixels = size_t(settings.width) * settings.height;
   chunk_ = std::min(pixels, std::max<size_t>(local_size_, 4096));

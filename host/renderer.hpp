@@ -20,6 +20,9 @@ namespace candela {
 
 enum class Strategy : uint32_t { Nee = STRATEGY_NEE, Bsdf = STRATEGY_BSDF, Auto = STRATEGY_AUTO };
 
+// Pixel filter, importance-sampled by the kernel (cl/filter.cl)
+enum class PixelFilter : uint32_t { Box = FILTER_BOX, Tent = FILTER_TENT, Gaussian = FILTER_GAUSSIAN };
+
 // The film's per-pixel sample count is a float: exact up to 2^24
 constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
 
@@ -30,6 +33,7 @@ struct RenderSettings {
   uint32_t rr_depth = 3;  // Russian roulette after this many bounces
   Strategy strategy = Strategy::Nee;
   bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/energy.cl)
+  PixelFilter filter = PixelFilter::Box;
   double launch_seconds = 0.2;  // target duration of one launch
 };
 

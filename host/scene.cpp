@@ -1,6 +1,9 @@
 #include "scene.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include "error.hpp"
 
 namespace candela {
 
@@ -90,8 +93,7 @@ glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm
   return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
 }
 
-CameraDesc resolve_camera(const Scene& scene) {
-  if (scene.camera) return *scene.camera;
+CameraDesc framing_camera(const Scene& scene) {
   // Look at the bounds from +z, far enough to see the whole bounding sphere
   Bounds b = scene.bounds();
   CameraDesc cam;
@@ -99,6 +101,22 @@ CameraDesc resolve_camera(const Scene& scene) {
   float dist = r / std::sin(0.5f * cam.yfov) * 1.05f;
   cam.position = b.center() + glm::vec3(0.0f, 0.0f, dist);
   cam.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+  return cam;
+}
+
+CameraDesc resolve_camera(const Scene& scene) {
+  CameraDesc cam = scene.camera ? *scene.camera : framing_camera(scene);
+  if (!(cam.aperture_radius >= 0.0f) || !std::isfinite(cam.aperture_radius))
+    throw Error("the camera's aperture radius must be finite and non-negative");
+  if (cam.aperture_radius > 0.0f && cam.projection == Projection::Orthographic)
+    throw Error("an orthographic camera has no lens: depth of field (an aperture) needs a perspective camera");
+  if (!cam.focus_distance) {
+    Bounds b = scene.bounds();
+    float along = b.empty() ? 0.0f : glm::dot(b.center() - cam.position, glm::normalize(cam.forward));
+    cam.focus_distance = along > 0.0f ? along : std::max(b.empty() ? 1.0f : b.radius(), 1e-3f);
+  }
+  if (!(*cam.focus_distance > 0.0f) || !std::isfinite(*cam.focus_distance))
+    throw Error("the camera's focus distance must be finite and positive");
   return cam;
 }
 
@@ -115,14 +133,19 @@ dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
   }
   r = glm::normalize(r);
   glm::vec3 u = glm::cross(r, f);
-  float tan_y = std::tan(0.5f * cam.yfov);
-  float tan_x = tan_y * float(width) / float(height);
+  // Half-extents of the image at depth 1 (perspective) or in scene units (orthographic)
+  bool ortho = cam.projection == Projection::Orthographic;
+  float half_y = ortho ? cam.ymag : std::tan(0.5f * cam.yfov);
+  float half_x = half_y * float(width) / float(height);
   dev::Camera c{};
+  c.type = ortho ? CAMERA_ORTHOGRAPHIC : CAMERA_PERSPECTIVE;
+  c.lens_radius = ortho ? 0.0f : cam.aperture_radius;
+  c.focus_distance = cam.focus_distance.value_or(1.0f);
   for (int i = 0; i < 3; ++i) {
     c.origin[i] = cam.position[i];
     c.forward[i] = f[i];
-    c.right[i] = r[i] * tan_x;
-    c.up[i] = u[i] * tan_y;
+    c.right[i] = r[i] * half_x;
+    c.up[i] = u[i] * half_y;
   }
   return c;
 }

@@ -86,12 +86,20 @@ struct PunctualLightDesc {
   float inner_cone = 0.0f, outer_cone = 0.7853982f;  // spot, radians
 };
 
+enum class Projection { Perspective, Orthographic };
+
 struct CameraDesc {
+  Projection projection = Projection::Perspective;
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, -1.0f};
   glm::vec3 up{0.0f, 1.0f, 0.0f};
-  float yfov = 0.7853982f;  // radians
-  float aspect = 0.0f;  // width / height; 0 = not given
+  float yfov = 0.7853982f;  // perspective: vertical field of view, radians
+  float ymag = 1.0f;  // orthographic: half-height of the view in scene units
+  float aspect = 0.0f;  // width / height (glTF aspectRatio, or xmag / ymag); 0 = not given
+  // Thin lens (perspective only), in scene units: aperture radius (0 = pinhole) and the
+  // distance of the sharp plane along the view axis; unset = resolve_camera's default
+  float aperture_radius = 0.0f;
+  std::optional<float> focus_distance;
 };
 
 struct Bounds {
@@ -140,8 +148,16 @@ struct Scene {
 glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                                double* area);
 
-// Camera for an image of width x height: the scene's, else one framing the bounds
+// A perspective camera looking at the scene's bounds from +z, far enough to see them all
+CameraDesc framing_camera(const Scene& scene);
+// The camera to render with: the scene's, else framing_camera. An unset focus distance
+// becomes the distance from the camera to the bounds' centre along the view axis (when
+// that centre is not in front of the camera: the bounds' radius). Throws Error for an
+// invalid camera (negative aperture, non-positive focus distance, a lens on an
+// orthographic camera).
 CameraDesc resolve_camera(const Scene& scene);
+// Device record for an image of width x height. The vertical extent (yfov or ymag) is
+// kept and the horizontal one follows from width / height.
 dev::Camera make_device_camera(const CameraDesc& cam, int width, int height);
 
 }  // namespace candela

@@ -46,6 +46,20 @@ expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OC
 expect_error "bad output extension" "must end in .exr or .png" -- "$bin" render "$scene" -o "$tmp/x.jpg" --device pocl
 expect_error "bad strategy" "strategy must be nee or bsdf" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
 expect_error "bad background" "three comma-separated numbers" -- "$bin" render "$scene" -o "$tmp/x.png" --background 1,2 --device pocl
+expect_error "zero field of view" "fov must be between 0 and 180" -- "$bin" render "$scene" -o "$tmp/x.png" --fov 0 --device pocl
+expect_error "field of view of 180" "fov must be between 0 and 180" -- "$bin" render "$scene" -o "$tmp/x.png" --fov 180 --device pocl
+expect_error "negative aperture" "aperture must be a non-negative radius" -- "$bin" render "$scene" -o "$tmp/x.png" --aperture -0.1 --device pocl
+expect_error "zero focus distance" "focus-distance must be a positive distance" -- "$bin" render "$scene" -o "$tmp/x.png" --focus-distance 0 --device pocl
+expect_error "negative focus distance" "focus-distance must be a positive distance" -- "$bin" render "$scene" -o "$tmp/x.png" --focus-distance -1 --device pocl
+expect_error "unknown filter" "filter must be box, tent or gaussian" -- "$bin" render "$scene" -o "$tmp/x.png" --filter lanczos --device pocl
+# The Cornell box seen by an orthographic camera 0.4 wide and 0.3 high
+python3 - "$scene" "$tmp/ortho.gltf" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+j["cameras"][0] = {"type": "orthographic", "orthographic": {"xmag": 0.4, "ymag": 0.3, "znear": 0.01, "zfar": 100}}
+json.dump(j, open(sys.argv[2], "w"))
+PY
+expect_error "aperture on an orthographic camera" "aperture needs a perspective camera" -- "$bin" render "$tmp/ortho.gltf" -o "$tmp/x.png" --aperture 0.01 --device pocl
 mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights.cl"
 expect_error "kernel build failure shows the log" "cl/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
 
@@ -112,6 +126,26 @@ if "$bin" render "$scene" -o "$tmp/nec.exr" --spp 1 --width 16 --height 16 --dev
   pass "--no-energy-compensation recorded"
 else
   fail "--no-energy-compensation recorded"; cat "$tmp/err"
+fi
+
+# An orthographic camera: --width alone takes the height from xmag / ymag (0.4 / 0.3)
+if "$bin" render "$tmp/ortho.gltf" -o "$tmp/ortho.png" --spp 1 --width 40 --device pocl --stats "$tmp/ortho.json" -q \
+    >/dev/null 2>"$tmp/err" &&
+  python3 -c "import json; s = json.load(open('$tmp/ortho.json')); assert (s['width'], s['height']) == (40, 30), s"; then
+  pass "orthographic camera sets the aspect"
+else
+  fail "orthographic camera sets the aspect"; cat "$tmp/err"
+fi
+grep -q "camera" "$tmp/err" && { fail "orthographic camera warns"; cat "$tmp/err"; } || pass "orthographic camera without warning"
+
+# Thin lens and filters render, and the filter is recorded
+if "$bin" render "$scene" -o "$tmp/dof.exr" --spp 2 --width 16 --height 16 --device pocl --aperture 0.02 \
+    --focus-distance 1.2 --filter gaussian --stats "$tmp/dof.json" -q >/dev/null 2>"$tmp/err" &&
+  python3 -c "import json; assert json.load(open('$tmp/dof.json'))['filter'] == 'gaussian'" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/dof.exr" | grep -q 'candela:filter: "gaussian"'; }; then
+  pass "thin lens with a Gaussian filter renders"
+else
+  fail "thin lens with a Gaussian filter renders"; cat "$tmp/err"
 fi
 
 # Ctrl-C during a long render writes what was rendered and exits 130
