@@ -64,7 +64,11 @@ SceneFeatures Scene::features() const {
 }
 
 bool Scene::has_emission() const {
-  if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) return true;
+  if (environment) {
+    if (environment->strength > 0.0f && environment->image.mean_luminance() > 0.0) return true;
+  } else if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) {
+    return true;
+  }
   for (const auto& mesh : meshes) {
     const MaterialDesc& m = materials.at(mesh.material);
     bool factor = m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;

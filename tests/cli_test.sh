@@ -49,6 +49,45 @@ expect_error "bad background" "three comma-separated numbers" -- "$bin" render "
 mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights.cl"
 expect_error "kernel build failure shows the log" "cl/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
 
+# Environment maps: a missing or unreadable map is one error line
+expect_error "missing environment map" "environment map not found" -- "$bin" render "$scene" -o "$tmp/x.png" --env "$tmp/nope.hdr" --device pocl
+echo "not an image" >"$tmp/bad.hdr"
+expect_error "unreadable environment map" "cannot read environment map" -- "$bin" render "$scene" -o "$tmp/x.png" --env "$tmp/bad.hdr" --device pocl
+sed 's/"file": "sky.hdr"/"file": "missing.hdr"/' "$root/scenes/lights/environment.gltf" >"$tmp/missing-map.gltf"
+expect_error "scene extras name a missing map" "environment map not found" -- "$bin" render "$tmp/missing-map.gltf" -o "$tmp/x.png" --device pocl
+if "$bin" render "$root/scenes/lights/environment.gltf" -o "$tmp/env.png" --spp 1 --width 16 --height 10 --device pocl -q \
+    --env-strength 0.5 --env-rotation 90 >"$tmp/out" 2>"$tmp/err" && [ -s "$tmp/env.png" ]; then
+  pass "environment scene renders"
+else
+  fail "environment scene renders"; cat "$tmp/err"
+fi
+
+# Default lighting: the Cornell box without its light gets the built-in sky, announced on
+# stderr; --no-default-light keeps it black (with a warning)
+python3 - "$scene" "$tmp/dark.gltf" <<'PY'
+import json, sys
+doc = json.load(open(sys.argv[1]))
+for m in doc["materials"]:
+    m.pop("emissiveFactor", None)
+    m.get("extensions", {}).pop("KHR_materials_emissive_strength", None)
+json.dump(doc, open(sys.argv[2], "w"))
+PY
+mean_of() { oiiotool --stats "$1" | sed -n 's/.*Stats Avg: \([0-9.e+-]*\).*/\1/p' | head -1; }
+if "$bin" render "$tmp/dark.gltf" -o "$tmp/sky.exr" --spp 2 --width 16 --height 16 --device pocl -q >/dev/null 2>"$tmp/err" &&
+  grep -q "note: the scene has no light; lighting it with the built-in sky (--no-default-light keeps it black)" "$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) > 0.05" "$(mean_of "$tmp/sky.exr")"; }; then
+  pass "a scene without light gets the built-in sky"
+else
+  fail "a scene without light gets the built-in sky"; cat "$tmp/err"
+fi
+if "$bin" render "$tmp/dark.gltf" -o "$tmp/black.exr" --spp 2 --width 16 --height 16 --device pocl -q --no-default-light \
+    >/dev/null 2>"$tmp/err" && grep -q "the image will be black" "$tmp/err" && ! grep -q "built-in sky" "$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) == 0" "$(mean_of "$tmp/black.exr")"; }; then
+  pass "--no-default-light keeps it black"
+else
+  fail "--no-default-light keeps it black"; cat "$tmp/err"
+fi
+
 # --device rusticl finds Mesa's CPU device without RUSTICL_ENABLE in the environment
 if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
   if env -u RUSTICL_ENABLE "$bin" render "$scene" -o "$tmp/r.png" --spp 1 --width 16 --height 16 \
