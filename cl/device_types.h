@@ -33,7 +33,7 @@
 
 // Light types (lights.cl)
 #define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
-#define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away (constant for now)
+#define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away: constant or a map
 #define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
 #define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
 #define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
@@ -158,7 +158,11 @@ typedef struct {
 // estimator divides by what the kernel does.
 //   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
 //                      radiance comes from the primitive's material.
-//   LIGHT_ENVIRONMENT: radiance = constant radiance.
+//   LIGHT_ENVIRONMENT: without a map (params[0] = NO_TEXTURE): radiance = constant radiance.
+//                      With an equirectangular map (cl/environment.cl): params[0] = its
+//                      TextureInfo index (an integer stored as float), params[1] = strength
+//                      (radiance = strength x texel), params[2] = rotation about +Y in
+//                      radians; its sampling distribution is the env_distribution buffer.
 //   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
 //                      radiance[3] = range (0: infinite), params[0..2] = position.
 //   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,
@@ -219,7 +223,8 @@ typedef struct {
 // generates the kernel's parameters and SceneData (cl/scene_data.cl) and the host's
 // SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
 // Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
-// vertex; an array the scene does not need holds one dummy element. ggx_albedo is no part
+// vertex; an array the scene does not need holds one dummy element. env_distribution holds
+// the environment map's sampling CDFs (cl/environment.cl), one dummy without a map. ggx_albedo is no part
 // of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
 #define CD_SCENE_BUFFERS(X)  \
   X(BvhNode, bvh_nodes)      \
@@ -238,6 +243,7 @@ typedef struct {
   X(float, srgb_to_linear)   \
   X(Light, lights)           \
   X(AliasBin, light_alias)  \
+  X(float, env_distribution) \
   X(float, ggx_albedo)
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and

@@ -28,11 +28,18 @@ LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) 
   return ctx;
 }
 
-// Environment light: radiance arriving along -dir from infinitely far away
-float3 lights_environment_radiance(const SceneData* sc, float3 dir) {
+// Environment light: a constant, or an equirectangular map (cl/environment.cl)
+__global const Light* lights_environment(const SceneData* sc) {
   int i = sc->params->environment_light;
-  if (i == NO_LIGHT) return (float3)(0.0f);
-  return load3(sc->lights[i].radiance);
+  return i == NO_LIGHT ? 0 : &sc->lights[i];
+}
+
+// Radiance arriving along -dir from infinitely far away
+float3 lights_environment_radiance(const SceneData* sc, float3 dir) {
+  __global const Light* env = lights_environment(sc);
+  if (!env) return (float3)(0.0f);
+  if (environment_map(env) != NO_TEXTURE) return environment_radiance(sc, env, dir);
+  return load3(env->radiance);
 }
 
 // Reflection-only surfaces see the environment over the hemisphere of n (sampled by the
@@ -41,20 +48,30 @@ bool lights_environment_hemisphere(const LightSampleContext* ctx) {
   return !ctx->transmits && dot(ctx->n, ctx->n) > 0.0f;
 }
 
-float lights_pdf_environment(const LightSampleContext* ctx, float3 wi) {
+// A map is importance-sampled over the whole sphere, whatever the context
+float lights_pdf_environment(const SceneData* sc, const LightSampleContext* ctx, float3 wi) {
+  __global const Light* env = lights_environment(sc);
+  if (env && environment_map(env) != NO_TEXTURE) return environment_pdf(sc, env, wi);
   if (lights_environment_hemisphere(ctx)) return sample_cosine_hemisphere_pdf(dot(wi, ctx->n));
   return sample_uniform_sphere_pdf();
 }
 
 bool lights_sample_environment(const SceneData* sc, const LightSampleContext* ctx, float2 u,
                                LightSample* ls) {
+  __global const Light* env = lights_environment(sc);
+  if (env && environment_map(env) != NO_TEXTURE) {
+    ls->wi = environment_sample(sc, env, u, &ls->pdf);
+    ls->radiance = environment_radiance(sc, env, ls->wi);
+    ls->at_infinity = true;
+    return ls->pdf > 0.0f;
+  }
   if (lights_environment_hemisphere(ctx)) {
     Frame f = frame_from_z(ctx->n);
     ls->wi = frame_from_local(&f, sample_cosine_hemisphere(u.x, u.y));
   } else {
     ls->wi = sample_uniform_sphere(u.x, u.y);
   }
-  ls->pdf = lights_pdf_environment(ctx, ls->wi);
+  ls->pdf = lights_pdf_environment(sc, ctx, ls->wi);
   ls->radiance = lights_environment_radiance(sc, ls->wi);
   ls->at_infinity = true;
   return ls->pdf > 0.0f;
@@ -194,7 +211,7 @@ float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index,
     case LIGHT_TRIANGLE:
       return light->pmf * lights_pdf_triangle(sc, light, ctx, wi);
     case LIGHT_ENVIRONMENT:
-      return light->pmf * lights_pdf_environment(ctx, wi);
+      return light->pmf * lights_pdf_environment(sc, ctx, wi);
     case LIGHT_POINT:
     case LIGHT_SPOT:
     case LIGHT_DIRECTIONAL:

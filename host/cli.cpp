@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "device.hpp"
+#include "environment.hpp"
 #include "error.hpp"
 #include "gltf_loader.hpp"
 #include "kernel_sources.hpp"
@@ -40,6 +41,9 @@ struct RenderArgs {
   std::string strategy = "nee";
   bool no_energy_compensation = false;
   std::string background;
+  std::string env;
+  std::optional<float> env_strength, env_rotation;
+  bool no_default_light = false;
   std::string stats;
   float exposure = 0.0f;
   std::string look_from, look_at, up;
@@ -171,14 +175,34 @@ Scene load_scene(const RenderArgs& a) {
     scene.background = parse_vec3(a.background, "--background");
     if (scene.background.x < 0 || scene.background.y < 0 || scene.background.z < 0)
       throw Error("--background must not be negative");
+    scene.environment.reset();  // the constant replaces the scene's map too
   }
+  if (!a.env.empty()) scene.environment = load_environment(a.env, 1.0f, 0.0f);
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  if (!scene.has_light())
-    std::fprintf(stderr, "warning: the scene has no light: no emissive material, no punctual light and a black background; the image will be black\n");
+  // Default lighting: a scene without any light (and without a map) gets the built-in sky
+  if (!scene.has_light() && !scene.environment) {
+    if (a.no_default_light) {
+      std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
+    } else {
+      std::fprintf(stderr, "%s\n", kBuiltinSkyNote);
+      scene.environment = builtin_sky();
+    }
+  }
+  if (scene.environment) {
+    if (a.env_strength) scene.environment->strength = *a.env_strength;
+    if (a.env_rotation) scene.environment->rotation = *a.env_rotation;
+    if (!(scene.environment->strength >= 0.0f) || !std::isfinite(scene.environment->strength))
+      throw Error("--env-strength must be finite and non-negative");
+    if (!std::isfinite(scene.environment->rotation)) throw Error("--env-rotation must be finite");
+    if (!scene.has_light())
+      std::fprintf(stderr, "warning: the scene has no light: the environment map is black; the image will be black\n");
+  } else if (a.env_strength || a.env_rotation) {
+    std::fprintf(stderr, "warning: --env-strength and --env-rotation apply to an environment map; the scene has none\n");
+  }
   // No BSDF-sampled ray can hit a point, spot or directional light
   if (size_t n = scene.punctual_light_count(); n > 0 && parse_strategy(a.strategy) == Strategy::Bsdf)
-    std::fprintf(stderr, "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee\n", n,
+    std::fprintf(stderr, "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee or auto\n", n,
                  n == 1 ? "" : "s", n == 1 ? "s" : "");
   if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
   return scene;
@@ -279,7 +303,14 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--strategy", a.strategy, "nee (next-event estimation, default), bsdf (BSDF sampling only) or auto (per vertex: bsdf at near-specular surfaces, nee elsewhere)");
   render->add_flag("--no-energy-compensation", a.no_energy_compensation,
                    "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
-  render->add_option("--background", a.background, "Constant background radiance R,G,B (overrides the scene's)");
+  auto* background_opt =
+      render->add_option("--background", a.background, "Constant background radiance R,G,B (replaces the scene's background and environment map)");
+  render->add_option("--env", a.env, "Equirectangular environment map (.hdr, .exr, .png, .jpg), replacing the scene's")
+      ->excludes(background_opt);
+  render->add_option("--env-strength", a.env_strength, "Environment map strength, a radiance scale (default 1, or the scene's)");
+  render->add_option("--env-rotation", a.env_rotation, "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)");
+  render->add_flag("--no-default-light", a.no_default_light,
+                   "Keep a scene without any light black instead of lighting it with the built-in sky");
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
   render->add_option("--exposure", a.exposure, "PNG exposure in stops (default 0)");
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");

@@ -15,6 +15,7 @@
 #include <set>
 #include <string_view>
 
+#include "environment.hpp"
 #include "error.hpp"
 
 namespace candela {
@@ -699,6 +700,7 @@ class NodeReader {
   void read_scene_extras(const tinygltf::Value& extras) {
     if (!extras.Has("candela")) return;
     const tinygltf::Value& c = extras.Get("candela");
+    if (c.Has("environment")) read_environment_extras(c.Get("environment"));
     if (!c.Has("background")) return;
     const tinygltf::Value& bg = c.Get("background");
     if (!bg.IsArray() || bg.ArrayLen() != 3)
@@ -709,6 +711,28 @@ class NodeReader {
       if (!(scene_->background[i] >= 0.0f) || !std::isfinite(scene_->background[i]))
         throw Error("scene extras candela.background must be finite and non-negative");
     }
+  }
+
+  // extras.candela.environment = {"file": "sky.hdr", "strength": 1, "rotation": 0}: the
+  // file name (relative to the glTF file) goes to EnvironmentDesc::source; load_gltf_bytes
+  // reads the image
+  void read_environment_extras(const tinygltf::Value& env) {
+    const char* what = "scene extras candela.environment";
+    if (!env.IsObject() || !env.Has("file") || !env.Get("file").IsString())
+      throw Error(std::string(what) + " must be an object with a \"file\" string");
+    EnvironmentDesc e;
+    e.source = env.Get("file").Get<std::string>();
+    auto number = [&](const char* key, float fallback) {
+      if (!env.Has(key)) return fallback;
+      const tinygltf::Value& v = env.Get(key);
+      double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+      if (!std::isfinite(x) || std::fabs(x) > 1e30) throw Error(std::string(what) + "." + key + " must be a finite number");
+      return float(x);
+    };
+    e.strength = number("strength", 1.0f);
+    e.rotation = number("rotation", 0.0f);
+    if (e.strength < 0.0f) throw Error(std::string(what) + ".strength must not be negative");
+    scene_->environment = e;
   }
 
   void visit(int index, const glm::mat4& parent) {
@@ -1033,6 +1057,17 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   MaterialReader(model, image_errors, &scene, &warnings).read_all();
   NodeReader(model, &scene, &warnings).read_scene();
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
+  if (scene.environment) {
+    // The environment map's file, beside the glTF file; none is read from memory alone
+    EnvironmentDesc& env = *scene.environment;
+    if (base_dir.empty()) {
+      warnings.add("the environment map " + env.source + " is not loaded: the scene was read without a folder");
+      scene.environment.reset();
+    } else {
+      std::string path = (std::filesystem::path(base_dir) / env.source).string();
+      scene.environment = load_environment(path, env.strength, env.rotation);
+    }
+  }
   return scene;
 }
 

@@ -74,7 +74,11 @@ size_t Scene::punctual_light_count() const {
 }
 
 bool Scene::has_light() const {
-  if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) return true;
+  if (environment) {
+    if (environment->strength > 0.0f && environment->image.mean_luminance() > 0.0) return true;
+  } else if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) {
+    return true;
+  }
   if (punctual_light_count() > 0) return true;
   for (const auto& mesh : meshes) {
     const MaterialDesc& m = materials.at(mesh.material);

@@ -60,6 +60,15 @@ struct TextureDesc {
   double mean_luminance() const;
 };
 
+// An equirectangular environment map (cl/environment.cl documents the mapping): a
+// LIGHT_ENVIRONMENT with a texture, replacing the constant background
+struct EnvironmentDesc {
+  TextureDesc image;  // float RGBA texels (alpha 1), linear, row 0 looks up (+Y)
+  float strength = 1.0f;  // radiance = strength x texel
+  float rotation = 0.0f;  // degrees about +Y, counter-clockwise seen from above
+  std::string source;  // the file it came from, or "built-in sky"
+};
+
 // One glTF primitive placed in the world: vertex arrays (world space) and triangles
 struct MeshDesc {
   std::vector<glm::vec3> positions;
@@ -134,12 +143,13 @@ struct Scene {
   std::optional<CameraDesc> camera;
   glm::vec3 background{0.0f};  // constant environment radiance
   std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
+  std::optional<EnvironmentDesc> environment;  // a map; when present, background is not used
   std::vector<std::string> warnings;  // each unsupported feature named once
 
   size_t triangles() const;
   Bounds bounds() const;
   SceneFeatures features() const;
-  bool has_light() const;  // some triangle, the background or a punctual light emits
+  bool has_light() const;  // some triangle, the background or map, or a punctual light emits
   size_t punctual_light_count() const;  // punctual lights that emit (colour x intensity > 0)
 };
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bvh_builder.hpp"
+#include "environment.hpp"
 #include "error.hpp"
 
 namespace candela {
@@ -153,6 +154,33 @@ double spot_solid_angle(double scale, double offset) {
   return 2.0 * kPi * (s * t_max * t_max * t_max / 3.0 + std::max(0.0, 1.0 - c0 - s));
 }
 
+// An environment map as a LIGHT_ENVIRONMENT: its texels appended to the float texel
+// array as one more texture, its sampling CDFs as env_distribution (cl/environment.cl).
+// *power_scale gets its mean radiance luminance, strength included.
+dev::Light compile_environment_map(const EnvironmentDesc& env, dev::SceneBuffers* b, double* power_scale) {
+  const TextureDesc& t = env.image;
+  if (t.width <= 0 || t.height <= 0 || t.rgbaf.size() != t.texels() * 4)
+    throw Error("the environment map " + env.source + " has no float texels");
+  if (b->texelsf.size() + t.texels() > size_t(UINT32_MAX) || b->textures.size() >= (size_t(1) << 24))
+    throw Error("the scene's textures hold more than 2^32 texels");
+  dev::TextureInfo info{};
+  info.offset = uint32_t(b->texelsf.size());
+  info.width = uint32_t(t.width);
+  info.height = uint32_t(t.height);
+  info.flags = WRAP_REPEAT | (WRAP_CLAMP << 8) | TEXTURE_FLOAT | TEXTURE_NEAREST;
+  for (size_t i = 0; i < t.texels(); ++i)
+    b->texelsf.push_back({{t.rgbaf[4 * i], t.rgbaf[4 * i + 1], t.rgbaf[4 * i + 2], 1.0f}});
+  dev::Light l{};
+  l.type = LIGHT_ENVIRONMENT;
+  l.params[0] = float(b->textures.size());  // exact: fewer than 2^24 textures
+  l.params[1] = env.strength;
+  l.params[2] = float(double(env.rotation) * kPi / 180.0);
+  b->textures.push_back(info);
+  b->env_distribution = environment_distribution(t);
+  *power_scale = environment_mean_luminance(t) * env.strength;
+  return l;
+}
+
 // Every emissive triangle, punctual light and the environment, with the selection table
 int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   std::vector<double> texture_mean(scene.textures.size(), -1.0);  // computed on first use
@@ -188,9 +216,18 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     power.push_back(w);
   }
   int environment = NO_LIGHT;
-  if (dev::luminance_rgb(scene.background.x, scene.background.y, scene.background.z) > 0.0f) {
+  if (scene.environment) {
+    double power_scale = 0.0;
+    dev::Light l = compile_environment_map(*scene.environment, b, &power_scale);
+    if (power_scale > 0.0) {
+      environment = int(b->lights.size());
+      b->lights.push_back(l);
+      power.push_back(light_power(l, *b, power_scale, radius));
+    }
+  } else if (dev::luminance_rgb(scene.background.x, scene.background.y, scene.background.z) > 0.0f) {
     dev::Light l{};
     l.type = LIGHT_ENVIRONMENT;
+    l.params[0] = float(NO_TEXTURE);  // constant radiance
     for (int c = 0; c < 3; ++c) l.radiance[c] = scene.background[c];
     environment = int(b->lights.size());
     b->lights.push_back(l);
@@ -232,10 +269,13 @@ double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, do
       double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
       return kPi * lum * light.params[0] * ((m.flags & MATERIAL_DOUBLE_SIDED) ? 2.0 : 1.0);
     }
-    case LIGHT_ENVIRONMENT:
-      // A constant environment's power through the scene's bounding sphere
-      return 4.0 * kPi * kPi * scene_radius * scene_radius *
-             dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+    case LIGHT_ENVIRONMENT: {
+      // A constant environment's power through the scene's bounding sphere; a map's
+      // (params[0] a texture) with its mean radiance luminance, passed as emission_scale
+      bool map = int(light.params[0]) != NO_TEXTURE;
+      double lum = map ? emission_scale : dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+      return 4.0 * kPi * kPi * scene_radius * scene_radius * lum;
+    }
     case LIGHT_POINT:
     case LIGHT_SPOT: {
       // Radiant intensity I over the sphere, or over the spot's profile. A finite range

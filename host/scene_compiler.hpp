@@ -28,7 +28,8 @@ CompiledScene compile_scene(const Scene& scene);
 std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf);
 
 // Emitted power of a light (luminance-weighted, for light selection). `emission_scale`
-// is the mean luminance of a triangle light's emissive texture (1 without one);
+// is the mean luminance of a triangle light's emissive texture (1 without one), or an
+// environment map's mean radiance luminance (strength included);
 // `scene_radius` bounds the scene for environment lights.
 double light_power(const dev::Light& light, const dev::SceneBuffers& buffers,
                    double emission_scale, double scene_radius);

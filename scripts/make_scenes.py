@@ -9,6 +9,8 @@ Outputs (deterministic, byte-identical on every run):
   scenes/furnace/white-objects.gltf     albedo-1 objects under a white background
   scenes/materials/materials.gltf       grid of material spheres under an area light
   scenes/lights/punctual.gltf           point, spot and directional lights (KHR_lights_punctual)
+  scenes/lights/sky.hdr, tiny-sun.hdr   equirectangular maps (Radiance RGBE)
+  scenes/lights/environment.gltf        spheres on a floor lit by sky.hdr
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices
@@ -589,6 +591,156 @@ def make_punctual(path):
 
 
 # ---------------------------------------------------------------------------
+# Environment maps (Radiance RGBE .hdr) and the environment scene
+
+def write_hdr(path, width, height, texel):
+    """Radiance RGBE .hdr of texel(x, y) -> (r, g, b), row 0 at the top.
+
+    Scanlines use the run-length format's layout (each channel in literal runs of
+    at most 128 bytes, no compression), which every reader accepts."""
+    def rgbe(rgb):
+        v = max(rgb)
+        if v < 1e-32:
+            return (0, 0, 0, 0)
+        m, e = math.frexp(v)
+        f = m * 256.0 / v
+        return tuple(min(255, int(c * f)) for c in rgb) + (e + 128,)
+
+    out = bytearray(b"#?RADIANCE\n# %s\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n"
+                    % (GENERATOR.encode(), height, width))
+    for y in range(height):
+        pixels = [rgbe(texel(x, y)) for x in range(width)]
+        out += bytes((2, 2, width >> 8, width & 255))
+        for ch in range(4):
+            channel = bytes(p[ch] for p in pixels)
+            for i in range(0, width, 128):
+                chunk = channel[i:i + 128]
+                out += bytes((len(chunk),)) + chunk
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "wb") as f:
+        f.write(out)
+
+
+def read_hdr(path):
+    """Read back a file of write_hdr: (width, height, rows of (r, g, b))."""
+    with open(path, "rb") as f:
+        data = f.read()
+    head, _, rest = data.partition(b"\n\n")
+    assert head.startswith(b"#?RADIANCE") and b"FORMAT=32-bit_rle_rgbe" in head
+    size, _, body = rest.partition(b"\n")
+    _, h, _, w = size.split()
+    w, h = int(w), int(h)
+    rows, i = [], 0
+    for _ in range(h):
+        assert tuple(body[i:i + 4]) == (2, 2, w >> 8, w & 255)
+        i += 4
+        channels = []
+        for _ in range(4):
+            ch = bytearray()
+            while len(ch) < w:
+                n = body[i]
+                assert 0 < n <= 128
+                ch += body[i + 1:i + 1 + n]
+                i += 1 + n
+            channels.append(ch)
+        rows.append([tuple(math.ldexp(channels[c][x] + 0.5, channels[3][x] - 136) if channels[3][x] else 0.0
+                           for c in range(3)) for x in range(w)])
+    assert i == len(body)
+    return w, h, rows
+
+
+def env_direction(u, v):
+    """Direction of map coordinates (u, v) at rotation 0 (cl/environment.cl): theta
+    from +Y down the rows, the image centre along -Z, u = 3/4 along +X."""
+    theta, phi = math.pi * v, 2.0 * math.pi * u
+    return (-math.sin(theta) * math.sin(phi), math.cos(theta), math.sin(theta) * math.cos(phi))
+
+
+SUN_UV = (0.1, (90.0 - 35.0) / 180.0)  # 35 degrees high, behind a camera looking down -Z, to its left
+
+
+def sky_texel(width, height):
+    """Sun and sky: a gradient from a bright horizon to a blue zenith, a darker ground,
+    and a sun disc of 2 degrees' radius and radiance about 1000."""
+    sun = env_direction(*SUN_UV)
+    cos_sun = math.cos(math.radians(2.0))
+
+    def texel(x, y):
+        d = env_direction((x + 0.5) / width, (y + 0.5) / height)
+        if dot(d, sun) > cos_sun:
+            return (1000.0, 950.0, 850.0)
+        if d[1] >= 0.0:
+            t = math.sqrt(d[1])
+            horizon, zenith = (1.2, 1.25, 1.3), (0.3, 0.5, 1.0)
+            return tuple(h + (z - h) * t for h, z in zip(horizon, zenith))
+        fade = math.exp(d[1] / 0.05)
+        return tuple(g + (1.2 - g) * fade for g in (0.25, 0.22, 0.18))
+    return texel
+
+
+def tiny_sun_texel(width, height):
+    """A dim uniform 0.02 with a sun of 2 x 2 texels of radiance 1000, 45 degrees high."""
+    sx, sy = int(SUN_UV[0] * width), height // 4 - 1
+
+    def texel(x, y):
+        return (1000.0,) * 3 if x in (sx, sx + 1) and y in (sy, sy + 1) else (0.02,) * 3
+    return texel
+
+
+def make_sky_map(path):
+    write_hdr(path, 256, 128, sky_texel(256, 128))
+
+
+def make_tiny_sun_map(path):
+    write_hdr(path, 128, 64, tiny_sun_texel(128, 64))
+
+
+def make_environment(path):
+    """Spheres of several materials on a floor, lit by sky.hdr through the scene extras."""
+    g = GltfWriter(GENERATOR)
+    spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
+
+    def pbr(base, metallic, roughness):
+        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
+                "roughnessFactor": roughness}
+    materials = [
+        g.pbr_material("white-diffuse", pbr((0.8, 0.8, 0.8), 0.0, 1.0), spec0),
+        g.pbr_material("gold", pbr((1, 1, 1), 1.0, 0.3), extras={"candela": {"conductor": "gold"}}),
+        g.pbr_material("glass", pbr((1, 1, 1), 0.0, 0.0),
+                       {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                        "KHR_materials_volume": {"thicknessFactor": 1.0}}),
+        g.pbr_material("red-plastic", pbr((0.8, 0.05, 0.05), 0.0, 0.2)),
+    ]
+    radius = 0.45
+    pos, nrm, uv, idx = uv_sphere(radius)
+    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
+              "TEXCOORD_0": g.vec_accessor(uv, 2)}
+    sphere_indices = g.index_accessor(idx)
+    for k, mat in enumerate(materials):
+        name = g.doc["materials"][mat]["name"]
+        mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
+        g.node(name, mesh=mesh, translation=[1.1 * k - 1.65, radius, 0.0])
+    floor_mat = g.pbr_material("floor", pbr((0.5, 0.5, 0.5), 0.0, 1.0), spec0)
+    s = 6.0
+    floor_pos = [f32v(p) for p in ((-s, 0, s), (s, 0, s), (s, 0, -s), (-s, 0, -s))]
+    g.node("floor", mesh=g.mesh("floor", floor_pos, [(0.0, 1.0, 0.0)] * 4, [0, 1, 2, 0, 2, 3], floor_mat))
+    eye, target = (0.0, 1.3, 4.2), (0.0, 0.4, 0.0)
+    f = normalize(sub(target, eye))
+    right = normalize(cross(f, (0.0, 1.0, 0.0)))
+    up = cross(right, f)
+    g.node("camera", camera=g.camera("camera", 0.6, 1.6), translation=list(eye),
+           rotation=quat_from_basis(right, up, scale(f, -1.0)))
+    g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
+                                                                "rotation": 0.0}}}
+    g.write(path)
+
+
+# ---------------------------------------------------------------------------
+
+MAPS = [
+    ("scenes/lights/sky.hdr", make_sky_map),
+    ("scenes/lights/tiny-sun.hdr", make_tiny_sun_map),
+]
 
 SCENES = [
     ("scenes/cornell-box/cornell-box.gltf", make_cornell_box),
@@ -596,10 +748,17 @@ SCENES = [
     ("scenes/furnace/white-objects.gltf", make_white_objects),
     ("scenes/materials/materials.gltf", make_materials),
     ("scenes/lights/punctual.gltf", make_punctual),
+    ("scenes/lights/environment.gltf", make_environment),
 ]
 
 
 def main():
+    for rel_path, make in MAPS:
+        path = os.path.join(REPO_ROOT, rel_path)
+        make(path)
+        w, h, rows = read_hdr(path)
+        peak = max(max(t) for row in rows for t in row)
+        print("wrote %s: %d x %d texels, peak radiance %.0f" % (rel_path, w, h, peak))
     for rel_path, make in SCENES:
         path = os.path.join(REPO_ROOT, rel_path)
         make(path)

@@ -44,7 +44,7 @@ mkdir -p "$tmp/no-vendors"
 expect_error "no OpenCL platform" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$scene" -o "$tmp/x.png"
 expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" devices
 expect_error "bad output extension" "must end in .exr or .png" -- "$bin" render "$scene" -o "$tmp/x.jpg" --device pocl
-expect_error "bad strategy" "strategy must be nee or bsdf" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
+expect_error "bad strategy" "strategy must be nee, bsdf or auto" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
 expect_error "bad background" "three comma-separated numbers" -- "$bin" render "$scene" -o "$tmp/x.png" --background 1,2 --device pocl
 expect_error "zero field of view" "fov must be between 0 and 180" -- "$bin" render "$scene" -o "$tmp/x.png" --fov 0 --device pocl
 expect_error "field of view of 180" "fov must be between 0 and 180" -- "$bin" render "$scene" -o "$tmp/x.png" --fov 180 --device pocl
@@ -75,10 +75,49 @@ else
 fi
 if "$bin" render "$punctual" -o "$tmp/p.png" --spp 1 --width 16 --height 16 --device pocl \
     --strategy bsdf >"$tmp/out" 2>"$tmp/err" &&
-    [ "$(grep -c "the scene's 3 punctual lights contribute nothing under --strategy bsdf; use nee" "$tmp/err")" -eq 1 ]; then
+    [ "$(grep -c "the scene's 3 punctual lights contribute nothing under --strategy bsdf; use nee or auto" "$tmp/err")" -eq 1 ]; then
   pass "--strategy bsdf warns about punctual lights"
 else
   fail "--strategy bsdf warns about punctual lights"; cat "$tmp/err"
+fi
+
+# Environment maps: a missing or unreadable map is one error line
+expect_error "missing environment map" "environment map not found" -- "$bin" render "$scene" -o "$tmp/x.png" --env "$tmp/nope.hdr" --device pocl
+echo "not an image" >"$tmp/bad.hdr"
+expect_error "unreadable environment map" "cannot read environment map" -- "$bin" render "$scene" -o "$tmp/x.png" --env "$tmp/bad.hdr" --device pocl
+sed 's/"file": "sky.hdr"/"file": "missing.hdr"/' "$root/scenes/lights/environment.gltf" >"$tmp/missing-map.gltf"
+expect_error "scene extras name a missing map" "environment map not found" -- "$bin" render "$tmp/missing-map.gltf" -o "$tmp/x.png" --device pocl
+if "$bin" render "$root/scenes/lights/environment.gltf" -o "$tmp/env.png" --spp 1 --width 16 --height 10 --device pocl -q \
+    --env-strength 0.5 --env-rotation 90 >"$tmp/out" 2>"$tmp/err" && [ -s "$tmp/env.png" ]; then
+  pass "environment scene renders"
+else
+  fail "environment scene renders"; cat "$tmp/err"
+fi
+
+# Default lighting: the Cornell box without its light gets the built-in sky, announced on
+# stderr; --no-default-light keeps it black (with a warning)
+python3 - "$scene" "$tmp/dark.gltf" <<'PY'
+import json, sys
+doc = json.load(open(sys.argv[1]))
+for m in doc["materials"]:
+    m.pop("emissiveFactor", None)
+    m.get("extensions", {}).pop("KHR_materials_emissive_strength", None)
+json.dump(doc, open(sys.argv[2], "w"))
+PY
+mean_of() { oiiotool --stats "$1" | sed -n 's/.*Stats Avg: \([0-9.e+-]*\).*/\1/p' | head -1; }
+if "$bin" render "$tmp/dark.gltf" -o "$tmp/sky.exr" --spp 2 --width 16 --height 16 --device pocl -q >/dev/null 2>"$tmp/err" &&
+  grep -q "note: the scene has no light; lighting it with the built-in sky (--no-default-light keeps it black)" "$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) > 0.05" "$(mean_of "$tmp/sky.exr")"; }; then
+  pass "a scene without light gets the built-in sky"
+else
+  fail "a scene without light gets the built-in sky"; cat "$tmp/err"
+fi
+if "$bin" render "$tmp/dark.gltf" -o "$tmp/black.exr" --spp 2 --width 16 --height 16 --device pocl -q --no-default-light \
+    >/dev/null 2>"$tmp/err" && grep -q "the image will be black" "$tmp/err" && ! grep -q "built-in sky" "$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) == 0" "$(mean_of "$tmp/black.exr")"; }; then
+  pass "--no-default-light keeps it black"
+else
+  fail "--no-default-light keeps it black"; cat "$tmp/err"
 fi
 
 # --device rusticl finds Mesa's CPU device without RUSTICL_ENABLE in the environment

@@ -1,0 +1,110 @@
+// Equirectangular environment maps: the lecture's L_i(w) = I[theta/pi h, phi/2pi w], and
+// their importance sampling by a piecewise-constant 2D distribution (pbrt's
+// marginal-over-rows, conditional-within-rows construction).
+//
+// Mapping (glTF is +Y up), for a direction d turned by -rotation about +Y:
+//   theta = angle from +Y,  v = theta / pi         (row 0, the top of the image, looks up)
+//   phi = atan2(-d.x, d.z) in [0, 2 pi),  u = phi / (2 pi)   (columns, left to right)
+// so the image centre (u = 1/2) is seen along -Z, u = 3/4 along +X, u = 1/4 along -X and
+// the left and right edges along +Z, as a viewer standing at the origin looking down -Z
+// sees the middle of the panorama, with the right half of the image to its right.
+// `rotation` (Light.params[2], radians) turns the map counter-clockwise seen from above
+// (right-handed about +Y): at 90 degrees the image centre is seen along -X.
+//
+// Filter: nearest texel. A direction's radiance is the texel its (u, v) falls in, times the
+// strength, and the sampling pdf is constant in (u, v) over each texel, in proportion to
+// that texel's luminance x sin(theta at the row centre). So the pdf is > 0 wherever the
+// radiance is > 0 (the host keeps every such texel's CDF step > 0 in float), and
+// radiance / pdf is exactly what the estimator needs.
+//
+// env_distribution layout for a w x h map: floats [0, h] are the marginal CDF over rows
+// (cdf[0] = 0, cdf[h] = total, not normalized), then row r's conditional CDF over its
+// columns at (h + 1) + r (w + 1), w + 1 floats each. A step of zero is a cell that is never
+// sampled (and has pdf 0). The solid-angle pdf is p(u, v) / (2 pi^2 sin theta), since
+// dw = sin(theta) dtheta dphi = 2 pi^2 sin(theta) du dv.
+
+// The light's map (a TextureInfo index), or NO_TEXTURE for a constant environment
+int environment_map(__global const Light* light) { return (int)light->params[0]; }
+
+// (u, v) of a unit direction: the mapping above
+float2 environment_uv(float3 dir, float rotation) {
+  float u = (atan2(-dir.x, dir.z) + rotation) * (0.5f * INV_PI_F);
+  u -= floor(u);
+  float v = acos(clamp(dir.y, -1.0f, 1.0f)) * INV_PI_F;
+  return (float2)(u, v);
+}
+
+// The unit direction of (u, v): the inverse of environment_uv
+float3 environment_direction(float2 uv, float rotation) {
+  float phi = 2.0f * PI_F * uv.x - rotation;
+  float cos_theta, sin_theta = sincos(PI_F * uv.y, &cos_theta);
+  float cos_phi, sin_phi = sincos(phi, &cos_phi);
+  return (float3)(-sin_theta * sin_phi, cos_theta, sin_theta * cos_phi);
+}
+
+// The texel (column, row) that (u, v) lies in
+int2 environment_texel(__global const TextureInfo* tex, float2 uv) {
+  int w = (int)tex->width, h = (int)tex->height;
+  return (int2)(clamp((int)(uv.x * (float)w), 0, w - 1), clamp((int)(uv.y * (float)h), 0, h - 1));
+}
+
+// Radiance arriving along -dir: strength x the nearest texel
+float3 environment_radiance(const SceneData* sc, __global const Light* light, float3 dir) {
+  __global const TextureInfo* tex = &sc->textures[environment_map(light)];
+  int2 t = environment_texel(tex, environment_uv(dir, light->params[2]));
+  return light->params[1] * texture_texel(sc, tex, t.x, t.y).xyz;
+}
+
+// Density in (u, v) of texel t: (marginal step / total) h x (conditional step / total) w
+float environment_pdf_uv(const SceneData* sc, __global const TextureInfo* tex, int2 t) {
+  int w = (int)tex->width, h = (int)tex->height;
+  __global const float* rows = sc->env_distribution;
+  __global const float* cols = rows + (h + 1) + t.y * (w + 1);
+  float p_row = (rows[t.y + 1] - rows[t.y]) / rows[h];
+  float p_col = (cols[t.x + 1] - cols[t.x]) / cols[w];
+  if (!(p_row > 0.0f && p_col > 0.0f)) return 0.0f;
+  return p_row * p_col * (float)w * (float)h;
+}
+
+// Solid-angle pdf with which environment_sample picks dir
+float environment_pdf(const SceneData* sc, __global const Light* light, float3 dir) {
+  __global const TextureInfo* tex = &sc->textures[environment_map(light)];
+  float sin_theta = sqrt(dir.x * dir.x + dir.z * dir.z);  // accurate near the poles
+  if (!(sin_theta > 0.0f)) return 0.0f;
+  int2 t = environment_texel(tex, environment_uv(dir, light->params[2]));
+  return environment_pdf_uv(sc, tex, t) / (2.0f * PI_F * PI_F * sin_theta);
+}
+
+// A coordinate in [0, 1) distributed by one CDF of n cells: the cell i with
+// cdf[i] <= x < cdf[i+1] for x = u cdf[n] (binary search), then uniform within it
+float environment_sample_cdf(__global const float* cdf, int n, float u, int* index) {
+  float total = cdf[n];
+  float x = fmin(u * total, nextafter(total, 0.0f));  // x < total: a cell of positive step
+  int lo = 0, hi = n - 1;  // the largest i with cdf[i] <= x
+  while (lo < hi) {
+    int mid = (lo + hi + 1) / 2;
+    if (cdf[mid] <= x)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  *index = lo;
+  float t = (x - cdf[lo]) / (cdf[lo + 1] - cdf[lo]);
+  return ((float)lo + clamp(t, 0.0f, 1.0f)) / (float)n;
+}
+
+// A direction distributed by the map's luminance x sin(theta): a row by the marginal CDF
+// (u.y), a column within it by the row's conditional CDF (u.x). *pdf is environment_pdf of
+// the returned direction (0 when it should not be used).
+float3 environment_sample(const SceneData* sc, __global const Light* light, float2 u, float* pdf) {
+  __global const TextureInfo* tex = &sc->textures[environment_map(light)];
+  int w = (int)tex->width, h = (int)tex->height;
+  int row, col;
+  float v = environment_sample_cdf(sc->env_distribution, h, u.y, &row);
+  float uu = environment_sample_cdf(sc->env_distribution + (h + 1) + row * (w + 1), w, u.x, &col);
+  float3 dir = environment_direction((float2)(uu, v), light->params[2]);
+  // Evaluated from the direction itself, so that sample and pdf agree exactly even where
+  // rounding puts dir across a texel edge
+  *pdf = environment_pdf(sc, light, dir);
+  return dir;
+}
