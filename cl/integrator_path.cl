@@ -10,7 +10,9 @@
 // Near-specular threshold of STRATEGY_AUTO (alpha = glTF roughness^2): below it BSDF
 // sampling has the lower error on area and environment lights (measured on
 // scenes/lights/veach.gltf, see README "Strategies")
-#define AUTO_BSDF_ALPHA 0.04f
+#ifndef AUTO_BSDF_ALPHA
+#define AUTO_BSDF_ALPHA 0.01f
+#endif
 
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {

@@ -11,6 +11,10 @@ Outputs (deterministic, byte-identical on every run):
   scenes/lights/punctual.gltf           point, spot and directional lights (KHR_lights_punctual)
   scenes/lights/sky.hdr, tiny-sun.hdr   equirectangular maps (Radiance RGBE)
   scenes/lights/environment.gltf        spheres on a floor lit by sky.hdr
+  scenes/lights/veach.gltf              glossy plates of four roughnesses under four
+                                        spherical lights of four sizes (Veach 1997)
+  scenes/lights/small-light.gltf        a small bright light over a diffuse floor
+  scenes/lights/large-light-glossy.gltf a large light over smooth-ish metal
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices
@@ -736,6 +740,91 @@ def make_environment(path):
 
 
 # ---------------------------------------------------------------------------
+# Light vs BSDF sampling: where each fails (the lecture's comparison pair, Veach's layout)
+
+def metal_pbr(g, name, roughness, base=(0.8, 0.8, 0.8)):
+    return g.pbr_material(name, {"baseColorFactor": list(base) + [1.0], "metallicFactor": 1.0,
+                                 "roughnessFactor": roughness})
+
+
+def plate_quad(centre, normal, half_width, half_depth):
+    """Corners of a plate spanning +-half_width along x, facing `normal`."""
+    x = (1.0, 0.0, 0.0)
+    t = normalize(cross(normal, x))  # in the plate, perpendicular to x
+    corners = []
+    for sx, st in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+        corners.append(f32v(add(centre, add(scale(x, sx * half_width), scale(t, st * half_depth)))))
+    return orient_quad(corners, normal)
+
+
+def look_camera(g, eye, target, yfov, aspect):
+    f = normalize(sub(target, eye))
+    right = normalize(cross(f, (0.0, 1.0, 0.0)))
+    g.node("camera", camera=g.camera("camera", yfov, aspect), translation=list(eye),
+           rotation=quat_from_basis(right, cross(right, f), scale(f, -1.0)))
+
+
+def make_veach(path):
+    """Veach's (1997, fig. 9.2) layout with numbers of our own: four metal plates of
+    glTF roughness 0.5, 0.3, 0.15, 0.05 (alpha 0.25 ... 0.0025), each tilted to reflect a
+    row of four spherical lights of radius 0.03, 0.1, 0.3, 0.9 and equal power
+    (radiance 2 (0.9 / r)^2) toward the camera, in front of a dark wall."""
+    g = GltfWriter(GENERATOR)
+    eye, light_row = (0.0, 2.0, 10.0), (0.0, 4.0, -3.5)
+    for k, (roughness, centre) in enumerate(zip((0.5, 0.3, 0.15, 0.05), (
+            (0.0, 0.0, 2.4), (0.0, 0.45, 1.3), (0.0, 0.95, 0.2), (0.0, 1.5, -0.9)))):
+        normal = normalize(add(normalize(sub(eye, centre)), normalize(sub(light_row, centre))))
+        mat = metal_pbr(g, "plate-r%.2f" % roughness, roughness)
+        g.node("plate%d" % k, mesh=g.mesh("plate%d" % k, *flat_mesh(quad_triangles(
+            plate_quad(centre, normal, 4.0, 0.45))), mat))
+    for k, radius in enumerate((0.03, 0.1, 0.3, 0.9)):
+        radiance = 2.0 * (0.9 / radius) ** 2
+        mat = g.material("light-r%.2f" % radius, (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0),
+                         strength=radiance, double_sided=False)
+        g.node("light%d" % k, mesh=g.mesh("light%d" % k, *flat_mesh(icosphere(3, radius=radius)), mat),
+               translation=[-3.0 + 2.0 * k, light_row[1], light_row[2]])
+    wall = g.material("wall", (0.15, 0.15, 0.15, 1.0))
+    w = [(-12.0, -4.0, -6.0), (12.0, -4.0, -6.0), (12.0, 10.0, -6.0), (-12.0, 10.0, -6.0)]
+    g.node("wall", mesh=g.mesh("wall", *flat_mesh(quad_triangles(orient_quad(
+        [f32v(p) for p in w], (0.0, 0.0, 1.0)))), wall))
+    look_camera(g, eye, (0.0, 0.9, 0.0), 0.55, 1.5)
+    g.write(path)
+
+
+def make_small_light(path):
+    """A diffuse floor under a small (radius 0.05) bright spherical light: light
+    sampling finds it every time, BSDF sampling rarely."""
+    g = GltfWriter(GENERATOR)
+    floor = g.material("floor", (0.5, 0.5, 0.5, 1.0))
+    s = 2.0
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
+        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    light = g.material("light", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), strength=400.0,
+                       double_sided=False)
+    g.node("light", mesh=g.mesh("light", *flat_mesh(icosphere(2, radius=0.05)), light),
+           translation=[0.0, 0.6, 0.0])
+    look_camera(g, (0.0, 2.2, 2.6), (0.0, 0.0, 0.0), 0.8, 1.5)
+    g.write(path)
+
+
+def make_large_light_glossy(path):
+    """A large area light (3 x 1.5, radiance 1) above a metal floor of glTF roughness
+    0.08 (alpha 0.0064), seen in reflection: BSDF sampling finds it, light sampling picks
+    points the narrow lobe hardly reflects."""
+    g = GltfWriter(GENERATOR)
+    metal = metal_pbr(g, "metal-r0.08", 0.08, (0.9, 0.9, 0.9))
+    s = 3.0
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
+        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), metal))
+    light = g.material("panel", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), double_sided=False)
+    p = [(-1.5, 1.5, -2.0), (1.5, 1.5, -2.0), (1.5, 1.5, -0.5), (-1.5, 1.5, -0.5)]
+    g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
+        [f32v(q) for q in p], (0.0, -1.0, 0.0)))), light))
+    look_camera(g, (0.0, 1.2, 3.5), (0.0, 0.0, -0.6), 0.7, 1.5)
+    g.write(path)
+
+
+# ---------------------------------------------------------------------------
 
 MAPS = [
     ("scenes/lights/sky.hdr", make_sky_map),
@@ -749,6 +838,9 @@ SCENES = [
     ("scenes/materials/materials.gltf", make_materials),
     ("scenes/lights/punctual.gltf", make_punctual),
     ("scenes/lights/environment.gltf", make_environment),
+    ("scenes/lights/veach.gltf", make_veach),
+    ("scenes/lights/small-light.gltf", make_small_light),
+    ("scenes/lights/large-light-glossy.gltf", make_large_light_glossy),
 ]
 
 
