@@ -38,7 +38,7 @@ struct RenderArgs {
   std::string device;
   uint32_t seed = 0;
   uint32_t max_depth = 16;
-  std::string strategy = "nee";
+  std::string strategy;  // empty: the scene's (extras candela.strategy), else nee
   bool no_energy_compensation = false;
   std::string background;
   std::string env;
@@ -168,9 +168,11 @@ Strategy parse_strategy(const std::string& name) {
   throw Error("--strategy must be nee, bsdf or auto, not '" + name + "'");
 }
 
-// The scene with the command line's overrides, its warnings printed
-Scene load_scene(const RenderArgs& a) {
+// The scene with the command line's overrides, its warnings printed; fills in the
+// strategy from the scene when the command line gives none
+Scene load_scene(RenderArgs& a) {
   Scene scene = load_gltf(a.scene);
+  if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "nee" : scene.strategy;
   if (!a.background.empty()) {
     scene.background = parse_vec3(a.background, "--background");
     if (scene.background.x < 0 || scene.background.y < 0 || scene.background.z < 0)
@@ -234,13 +236,14 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
   if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + a.stats);
 }
 
-int run_render(const RenderArgs& a) {
+int run_render(RenderArgs a) {
   RenderSettings settings;
-  settings.strategy = parse_strategy(a.strategy);
+  if (!a.strategy.empty()) parse_strategy(a.strategy);  // a bad name fails before loading
   settings.filter = parse_filter(a.filter);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
   Scene scene = load_scene(a);
+  settings.strategy = parse_strategy(a.strategy);
   resolve_size(a, scene, &settings.width, &settings.height);
   settings.seed = a.seed;
   settings.max_depth = a.max_depth;
@@ -300,7 +303,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU");
   render->add_option("--seed", a.seed, "Random seed (default 0)");
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
-  render->add_option("--strategy", a.strategy, "nee (next-event estimation, default), bsdf (BSDF sampling only) or auto (per vertex: bsdf at near-specular surfaces, nee elsewhere)");
+  render->add_option("--strategy", a.strategy, "nee (next-event estimation), bsdf (BSDF sampling only) or auto (per vertex: bsdf at near-specular surfaces, nee elsewhere); default: the scene's extras candela.strategy, else nee");
   render->add_flag("--no-energy-compensation", a.no_energy_compensation,
                    "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
   auto* background_opt =

@@ -701,6 +701,12 @@ class NodeReader {
     if (!extras.Has("candela")) return;
     const tinygltf::Value& c = extras.Get("candela");
     if (c.Has("environment")) read_environment_extras(c.Get("environment"));
+    if (c.Has("strategy")) {
+      const tinygltf::Value& st = c.Get("strategy");
+      if (!st.IsString() || (st.Get<std::string>() != "nee" && st.Get<std::string>() != "bsdf" && st.Get<std::string>() != "auto"))
+        throw Error("scene extras candela.strategy must be \"nee\", \"bsdf\" or \"auto\"");
+      scene_->strategy = st.Get<std::string>();
+    }
     if (!c.Has("background")) return;
     const tinygltf::Value& bg = c.Get("background");
     if (!bg.IsArray() || bg.ArrayLen() != 3)

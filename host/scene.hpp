@@ -141,6 +141,7 @@ struct Scene {
   std::vector<MaterialDesc> materials;
   std::vector<TextureDesc> textures;
   std::optional<CameraDesc> camera;
+  std::string strategy;  // scene extras candela.strategy (nee, bsdf, auto); empty: not given
   glm::vec3 background{0.0f};  // constant environment radiance
   std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
   std::optional<EnvironmentDesc> environment;  // a map; when present, background is not used

@@ -15,6 +15,7 @@ Outputs (deterministic, byte-identical on every run):
                                         spherical lights of four sizes (Veach 1997)
   scenes/lights/small-light.gltf        a small bright light over a diffuse floor
   scenes/lights/large-light-glossy.gltf a large light over smooth-ish metal
+  scenes/lights/many-lights.gltf        4096 small emissive quads over a floor
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices
@@ -788,6 +789,7 @@ def make_veach(path):
     g.node("wall", mesh=g.mesh("wall", *flat_mesh(quad_triangles(orient_quad(
         [f32v(p) for p in w], (0.0, 0.0, 1.0)))), wall))
     look_camera(g, eye, (0.0, 0.9, 0.0), 0.55, 1.5)
+    g.doc["scenes"][0]["extras"] = {"candela": {"strategy": "auto"}}  # the scene-side default
     g.write(path)
 
 
@@ -824,6 +826,43 @@ def make_large_light_glossy(path):
     g.write(path)
 
 
+def make_many_lights(path):
+    """4096 small emissive quads (8192 triangles, 8 colours) floating in a 64 x 64 grid
+    over a diffuse floor with a few spheres: light selection by power through the alias
+    table must not slow down per light."""
+    g = GltfWriter(GENERATOR)
+    floor = g.material("floor", (0.6, 0.6, 0.6, 1.0))
+    s = 4.0
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
+        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    ball = g.material("ball", (0.7, 0.7, 0.7, 1.0))
+    sphere = flat_mesh(icosphere(2, radius=0.5))
+    for k, x in enumerate((-1.5, 0.0, 1.5)):
+        g.node("ball%d" % k, mesh=g.mesh("ball%d" % k, *sphere, ball), translation=[x, 0.5, 0.0])
+    colours = [(1.0, 0.3, 0.2), (0.2, 1.0, 0.3), (0.3, 0.4, 1.0), (1.0, 0.9, 0.3),
+               (1.0, 0.4, 0.9), (0.3, 1.0, 1.0), (1.0, 1.0, 1.0), (1.0, 0.6, 0.2)]
+    quads = [[] for _ in colours]
+    state, n, h = 12345, 64, 0.02
+    for i in range(n):
+        for j in range(n):
+            state = (1103515245 * state + 12345) % (1 << 31)
+            x, z = -3.6 + 7.2 * (i + 0.5) / n, -3.6 + 7.2 * (j + 0.5) / n
+            y = 1.6 + 0.8 * ((state >> 8) % 1000) / 1000.0
+            quads[state % len(colours)].append(
+                [(x - h, y, z - h), (x - h, y, z + h), (x + h, y, z + h), (x + h, y, z - h)])
+    for c, (colour, group) in enumerate(zip(colours, quads)):
+        mat = g.material("emitter%d" % c, (0.0, 0.0, 0.0, 1.0), emissive=colour, strength=4.0)
+        positions, indices = [], []
+        for q in group:
+            base = len(positions)
+            positions += [f32v(p) for p in orient_quad(q, (0.0, -1.0, 0.0))]
+            indices += [base, base + 1, base + 2, base, base + 2, base + 3]
+        normals = [(0.0, -1.0, 0.0)] * len(positions)
+        g.node("emitters%d" % c, mesh=g.mesh("emitters%d" % c, positions, normals, indices, mat))
+    look_camera(g, (0.0, 3.0, 7.5), (0.0, 0.6, 0.0), 0.7, 1.5)
+    g.write(path)
+
+
 # ---------------------------------------------------------------------------
 
 MAPS = [
@@ -841,6 +880,7 @@ SCENES = [
     ("scenes/lights/veach.gltf", make_veach),
     ("scenes/lights/small-light.gltf", make_small_light),
     ("scenes/lights/large-light-glossy.gltf", make_large_light_glossy),
+    ("scenes/lights/many-lights.gltf", make_many_lights),
 ]
 
 

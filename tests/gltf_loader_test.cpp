@@ -116,6 +116,19 @@ TEST(GltfLoader, NodeHierarchyTransformsApply) {
   EXPECT_NEAR(s.background.x, 1.0f, 0.0f);
 }
 
+// scenes[i].extras.candela.strategy sets the default strategy; anything else is an error
+TEST(GltfLoader, SceneExtrasChooseTheStrategy) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  EXPECT_EQ(load_gltf(dir.write("none.gltf", j.dump())).strategy, "");
+  j["scenes"][0]["extras"]["candela"]["strategy"] = "auto";
+  EXPECT_EQ(load_gltf(dir.write("auto.gltf", j.dump())).strategy, "auto");
+  j["scenes"][0]["extras"]["candela"]["strategy"] = "mis";
+  EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
+  j["scenes"][0]["extras"]["candela"]["strategy"] = 1;
+  EXPECT_THROW(load_gltf(dir.write("bad2.gltf", j.dump())), Error);
+}
+
 TEST(GltfLoader, MirroringTransformKeepsFrontFacesFront) {
   TempDir dir;
   json j = quad_gltf().document();
