@@ -237,6 +237,13 @@ void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
                    "to the scene (to measure what specialization gains)");
 }
 
+// The compiled scene: for --generic, with every kernel feature on (and the vertex arrays
+// those features read)
+std::shared_ptr<const CompiledScene> compile_for_render(const RenderArgs& a, const Scene& scene) {
+  return std::make_shared<const CompiledScene>(a.generic ? compile_scene(scene, SceneFeatures::all())
+                                                         : compile_scene(scene));
+}
+
 // ---- end of --variance and --generic ----
 
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
@@ -278,11 +285,10 @@ int run_render(const RenderArgs& a) {
   settings.seed = a.seed;
   settings.max_depth = a.max_depth;
   settings.energy_compensation = !a.no_energy_compensation;
-  settings.generic_kernel = a.generic;
 
   DeviceEntry device = select_device(a.device);
   if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
-  Renderer renderer(device, scene, settings);
+  Renderer renderer(device, compile_for_render(a, scene), settings);
   if (!a.quiet)
     std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; kernel build %.2fs%s\n",
                  renderer.triangles(), renderer.lights(), renderer.bvh_build_seconds(),

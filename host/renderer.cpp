@@ -67,7 +67,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
-  std::string options = "-cl-std=CL1.2 " + (settings.generic_kernel ? SceneFeatures::all() : scene.features).build_options();
+  std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
   ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;

@@ -35,7 +35,6 @@ struct RenderSettings {
   bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/energy.cl)
   PixelFilter filter = PixelFilter::Box;
   double launch_seconds = 0.2;  // target duration of one launch
-  bool generic_kernel = false;  // every SceneFeatures flag on, not the scene's (--generic)
 };
 
 struct RenderProgress {

@@ -197,6 +197,16 @@ if "$bin" render "$scene" -o "$tmp/m.exr" --variance "$tmp/v.exr" --spp 4 --widt
 else
   fail "--variance writes the variance image (generic kernel)"; cat "$tmp/err"
 fi
+# The generic kernel renders the Cornell box (no optional feature) to the same image
+if command -v oiiotool >/dev/null; then
+  if "$bin" render "$scene" -o "$tmp/spec.exr" --spp 4 --width 16 --height 16 --device pocl -q >/dev/null 2>&1 &&
+    "$bin" render "$scene" -o "$tmp/gen.exr" --spp 4 --width 16 --height 16 --device pocl -q --generic >/dev/null 2>"$tmp/err" &&
+    ! grep -q "non-finite" "$tmp/err" && oiiotool "$tmp/spec.exr" "$tmp/gen.exr" --diff >/dev/null 2>&1; then
+    pass "--generic renders the same image"
+  else
+    fail "--generic renders the same image"; cat "$tmp/err"
+  fi
+fi
 expect_error "compare needs two devices" "at least two devices" -- "$bin" compare "$scene" --devices pocl --spp 4 --width 8
 expect_error "compare with an unknown device" "device 'quantum': no OpenCL device matches --device 'quantum'" -- "$bin" compare "$scene" --devices pocl,quantum --spp 4 --width 8 -q
 expect_error "compare with a missing scene" "scene file not found" -- "$bin" compare "$tmp/nope.gltf" --devices pocl,pocl
