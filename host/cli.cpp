@@ -18,6 +18,8 @@
 #include "gltf_loader.hpp"
 #include "kernel_sources.hpp"
 #include "renderer.hpp"
+#include "compare.hpp"
+#include "image_stats.hpp"
 
 namespace {
 
@@ -51,6 +53,8 @@ struct RenderArgs {
   std::optional<float> aperture, focus_distance;
   std::string filter = "box";
   bool quiet = false;
+  std::string variance;  // --variance: variance-of-the-mean image (host/image_stats.hpp)
+  bool generic = false;  // --generic: the kernel with every scene feature compiled in
 };
 
 glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
@@ -210,6 +214,40 @@ Scene load_scene(RenderArgs& a) {
   return scene;
 }
 
+// ---- Speed against accuracy: render's --variance and --generic (README) ----
+
+void check_variance_path(const RenderArgs& a) {
+  if (a.variance.empty()) return;
+  std::string ext = a.variance.size() >= 4 ? a.variance.substr(a.variance.size() - 4) : "";
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".exr") throw Error("--variance must name an .exr file (the variance is linear float data): " + a.variance);
+}
+
+// The variance of each pixel's mean beside the image, with the image's metadata
+void write_variance_output(const RenderArgs& a, const Film& film, const std::map<std::string, std::string>& meta) {
+  if (a.variance.empty()) return;
+  write_variance_image(a.variance, film, meta);
+  std::printf("wrote %s\n", a.variance.c_str());
+}
+
+void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
+  render->add_option("--variance", a->variance,
+                     "Also write the variance of each pixel's mean, M2 / (n (n - 1)) per channel, to this .exr "
+                     "(infinite where a pixel has fewer than 2 samples)");
+  render->add_flag("--generic", a->generic,
+                   "Build the generic kernel with every scene feature compiled in, instead of the one specialized "
+                   "to the scene (to measure what specialization gains)");
+}
+
+// The compiled scene: for --generic, with every kernel feature on (and the vertex arrays
+// those features read)
+std::shared_ptr<const CompiledScene> compile_for_render(const RenderArgs& a, const Scene& scene) {
+  return std::make_shared<const CompiledScene>(a.generic ? compile_scene(scene, SceneFeatures::all())
+                                                         : compile_scene(scene));
+}
+
+// ---- end of --variance and --generic ----
+
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
                  const RenderResult& r, double samples_per_second) {
   nlohmann::json j = {{"spp", r.spp},
@@ -231,7 +269,8 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"max_depth", a.max_depth},
                       {"seed", a.seed},
                       {"interrupted", r.interrupted},
-                      {"dropped_samples", r.film.dropped_samples()}};
+                      {"dropped_samples", r.film.dropped_samples()},
+                      {"generic_kernel", a.generic}};
   std::ofstream f(a.stats);
   if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + a.stats);
 }
@@ -242,6 +281,7 @@ int run_render(RenderArgs a) {
   settings.filter = parse_filter(a.filter);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
+  check_variance_path(a);
   Scene scene = load_scene(a);
   settings.strategy = parse_strategy(a.strategy);
   resolve_size(a, scene, &settings.width, &settings.height);
@@ -251,7 +291,7 @@ int run_render(RenderArgs a) {
 
   DeviceEntry device = select_device(a.device);
   if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
-  Renderer renderer(device, scene, settings);
+  Renderer renderer(device, compile_for_render(a, scene), settings);
   if (!a.quiet)
     std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; kernel build %.2fs%s\n",
                  renderer.triangles(), renderer.lights(), renderer.bvh_build_seconds(),
@@ -280,6 +320,7 @@ int run_render(RenderArgs a) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
   }
+  write_variance_output(a, r.film, meta);
   std::printf("%u spp in %.2fs: %.3f Msamples/s on %s%s\n", r.spp, r.seconds, samples_per_second * 1e-6,
               device.description().c_str(), r.interrupted ? " (interrupted)" : "");
   if (r.partial_pass)
@@ -327,8 +368,53 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
                      "camera's extras, else the scene bounds' centre)");
   render->add_option("--filter", a.filter, "Pixel filter: box (default), tent (radius 1 pixel) or gaussian (sigma 0.5 pixel)");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
+  add_accuracy_render_options(render, &a);
   return render;
 }
+
+// ---- `candela compare` (host/compare.cpp) ----
+
+struct CompareCli {
+  CompareArgs args;
+  std::string devices;
+};
+
+CLI::App* add_compare_command(CLI::App* app, CompareCli* c) {
+  CompareArgs& a = c->args;
+  auto* cmd = app->add_subcommand(
+      "compare",
+      "Render a scene on several devices and test whether each agrees with the first within the measured noise "
+      "(exit 0: consistent, 2: not); options it does not know are passed to every render");
+  cmd->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
+  cmd->add_option("--devices", c->devices, "Comma-separated device selectors, the first is the reference")->required();
+  cmd->add_option("--spp", a.spp, "Samples per pixel on every device (default 64)")->check(CLI::Range(2u, 1u << 24));
+  cmd->add_option("--width", a.width, "Image width (default 64)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--height", a.height, "Image height (default from the camera's aspect ratio)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--seed", a.seed, "Seed of the first device; device I renders seed + I (default 0)");
+  cmd->add_flag("--same-seed", a.same_seed,
+                "Render the same seed on every device (correlated noise: the z-test no longer applies)");
+  cmd->add_flag("!--no-determinism-check", a.determinism_check,
+                "Skip the extra render of the first device's seed on the other devices");
+  cmd->add_option("--device-args", a.device_args,
+                  "I:OPTIONS: extra render options for the device at position I, e.g. '1:--strategy bsdf' (repeatable)");
+  cmd->add_option("--json", a.json, "Also write the results as JSON to this file");
+  cmd->add_option("--keep", a.keep, "Keep each device's image and variance image in this directory");
+  cmd->add_flag("-q,--quiet", a.quiet, "No progress lines");
+  cmd->allow_extras();
+  return cmd;
+}
+
+int run_compare_command(CLI::App* cmd, CompareCli* c) {
+  std::stringstream ss(c->devices);
+  for (std::string sel; std::getline(ss, sel, ',');) {
+    if (sel.empty()) throw Error("--devices has an empty entry: '" + c->devices + "'");
+    c->args.devices.push_back(sel);
+  }
+  c->args.render_options = cmd->remaining();
+  return run_compare(c->args);
+}
+
+// ---- end of compare ----
 
 }  // namespace
 
@@ -345,6 +431,8 @@ int main(int argc, char** argv) {
 
   RenderArgs a;
   add_render_command(&app, &a);
+  CompareCli compare_cli;
+  auto* compare_cmd = add_compare_command(&app, &compare_cli);
 
   try {
     app.parse(argc, argv);
@@ -370,6 +458,7 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
+    if (*compare_cmd) return run_compare_command(compare_cmd, &compare_cli);
     return run_render(a);
   } catch (const Error& e) {
     std::fprintf(stderr, "candela: error: %s\n", e.what());

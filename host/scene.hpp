@@ -134,6 +134,8 @@ struct SceneFeatures {
   bool vertex_colors = false;  // some COLOR_0 is not white
   bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
   std::string build_options() const;
+  // Every flag on: the generic kernel, correct for any scene (--generic)
+  static SceneFeatures all() { return {true, true, true, true, true}; }
 };
 
 struct Scene {

@@ -341,10 +341,17 @@ std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::
   return bins;
 }
 
-CompiledScene compile_scene(const Scene& scene) {
+CompiledScene compile_scene(const Scene& scene) { return compile_scene(scene, scene.features()); }
+
+CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   auto start = Clock::now();
   CompiledScene c;
-  c.features = scene.features();
+  c.features = features;
+  const SceneFeatures needed = scene.features();
+  if ((needed.textures && !features.textures) || (needed.uvs && !features.uvs) ||
+      (needed.tangents && !features.tangents) || (needed.vertex_colors && !features.vertex_colors) ||
+      (needed.alpha && !features.alpha))
+    throw Error("compile_scene: the kernel features leave out some the scene needs");
   c.camera = resolve_camera(scene);
   check_extent(scene, c.camera);
   compile_geometry(scene, c.features, &c.buffers);

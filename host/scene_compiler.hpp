@@ -21,6 +21,10 @@ struct CompiledScene {
 };
 
 CompiledScene compile_scene(const Scene& scene);
+// With kernel features that include the scene's (e.g. SceneFeatures::all(), the generic
+// kernel of --generic): the optional vertex arrays of every feature on are filled, with
+// the defaults where a mesh has none. Throws Error when `features` lack one the scene needs.
+CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features);
 
 // Alias table (Walker 1977, Vose 1991) for selecting index i with probability ~ weights[i]
 // (all > 0) from a uniform 32-bit integer (sample_discrete_alias in sampling.cl); the exact

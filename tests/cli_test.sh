@@ -187,6 +187,64 @@ else
   fail "thin lens with a Gaussian filter renders"; cat "$tmp/err"
 fi
 
+# ---- Speed against accuracy: --variance, --generic, compare ----
+expect_error "variance must be EXR" "variance must name an .exr file" -- "$bin" render "$scene" -o "$tmp/x.exr" --variance "$tmp/v.png" --device pocl
+if "$bin" render "$scene" -o "$tmp/m.exr" --variance "$tmp/v.exr" --spp 4 --width 16 --height 16 --device pocl --generic \
+    --stats "$tmp/v.json" -q >"$tmp/out" 2>"$tmp/err" && grep -q "wrote $tmp/v.exr" "$tmp/out" &&
+  python3 -c "import json; assert json.load(open('$tmp/v.json'))['generic_kernel'] is True" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/v.exr" | grep -q 'candela:image: "variance_of_mean"'; }; then
+  pass "--variance writes the variance image (generic kernel)"
+else
+  fail "--variance writes the variance image (generic kernel)"; cat "$tmp/err"
+fi
+# The generic kernel renders the Cornell box (no optional feature) to the same image
+if command -v oiiotool >/dev/null; then
+  if "$bin" render "$scene" -o "$tmp/spec.exr" --spp 4 --width 16 --height 16 --device pocl -q >/dev/null 2>&1 &&
+    "$bin" render "$scene" -o "$tmp/gen.exr" --spp 4 --width 16 --height 16 --device pocl -q --generic >/dev/null 2>"$tmp/err" &&
+    ! grep -q "non-finite" "$tmp/err" && oiiotool "$tmp/spec.exr" "$tmp/gen.exr" --diff >/dev/null 2>&1; then
+    pass "--generic renders the same image"
+  else
+    fail "--generic renders the same image"; cat "$tmp/err"
+  fi
+fi
+expect_error "compare needs two devices" "at least two devices" -- "$bin" compare "$scene" --devices pocl --spp 4 --width 8
+expect_error "compare with an unknown device" "device 'quantum': no OpenCL device matches --device 'quantum'" -- "$bin" compare "$scene" --devices pocl,quantum --spp 4 --width 8 -q
+expect_error "compare with a missing scene" "scene file not found" -- "$bin" compare "$tmp/nope.gltf" --devices pocl,pocl
+# The same device, full transport against direct light only: NOT consistent, exit status 2
+"$bin" compare "$scene" --devices pocl,pocl --spp 8 --width 16 --device-args "0:--max-depth 8" --device-args "1:--max-depth 1" \
+  --json "$tmp/c2.json" -q >"$tmp/out" 2>"$tmp/err"
+rc=$?
+if [ $rc -eq 2 ] && grep -q "^verdict: NOT consistent" "$tmp/out" &&
+  python3 -c "import json; j = json.load(open('$tmp/c2.json')); assert not j['consistent'] and j['devices'][1]['against_first']['z_test']['mean_z2'] > 2, j"; then
+  pass "compare: max depth 8 against 1 is NOT consistent"
+else
+  fail "compare: max depth 8 against 1 is NOT consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
+fi
+# PoCL against rusticl: consistent; the same-seed determinism check is reported
+if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
+  "$bin" compare "$scene" --devices pocl,rusticl --spp 16 --width 24 --max-depth 8 --json "$tmp/c1.json" -q >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+  if [ $rc -eq 0 ] && grep -q "^verdict: statistically consistent" "$tmp/out" && grep -q "determinism, seed 0 on rusticl" "$tmp/out" &&
+    python3 - "$tmp/c1.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["consistent"] and j["spp"] == 16 and j["width"] == 24, j
+a, b = j["devices"]
+assert a["seed"] == 0 and b["seed"] == 1, j
+for d in (a, b):
+    assert d["kernel_build_cold_seconds"] > 0 and d["kernel_from_cache"] and d["samples_per_second"] > 0, d
+    assert d["render_options"] == [], d
+z = b["against_first"]["z_test"]
+assert z["consistent"] and z["values"] > 0 and 0.5 < z["mean_z2"] < 1.5, z
+assert "max_abs_diff" in b["same_seed"] and 0 <= b["same_seed"]["identical_fraction"] <= 1, b
+PY
+  then
+    pass "compare: pocl and rusticl are consistent"
+  else
+    fail "compare: pocl and rusticl are consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
+  fi
+fi
+
 # Ctrl-C during a long render writes what was rendered and exits 130
 "$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \
   --stats "$tmp/int.json" >"$tmp/int.out" 2>"$tmp/int.err" &

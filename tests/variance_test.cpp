@@ -1,0 +1,206 @@
+// The variance image (`candela render --variance`): written from the film's Welford M2,
+// zero where the radiance is constant, and in agreement with the spread of independent
+// renders across seeds; the z-test of `candela compare` on renders with known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <unistd.h>
+
+#include "error.hpp"
+
+#include "gltf_loader.hpp"
+#include "image_stats.hpp"
+#include "renderer.hpp"
+#include "test_support.hpp"
+
+namespace candela::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_file(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("candela-variance-test-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// The film written and read back as the renderer's outputs
+RgbImage as_image(const Film& film, const std::string& name) {
+  fs::path p = temp_file(name + ".exr");
+  write_image(p.string(), film, {});
+  return read_rgb_image(p.string());
+}
+RgbImage as_variance(const Film& film, const std::string& name) {
+  fs::path p = temp_file(name + "-variance.exr");
+  write_variance_image(p.string(), film, {{"seed", "7"}});
+  return read_rgb_image(p.string());
+}
+
+RenderResult render(const DeviceEntry& device, const Scene& scene, int size, uint32_t spp, uint32_t seed,
+                    uint32_t max_depth = 16) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.seed = seed;
+  s.max_depth = max_depth;
+  Renderer r(device, scene, s);
+  return r.render(0, spp);
+}
+
+// A camera facing a large emissive quad that fills its view: every sample of every pixel
+// sees the same radiance
+Scene emitter_wall(glm::vec3 radiance) {
+  Scene s;
+  MeshDesc m;
+  m.positions = {{-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  s.meshes.push_back(m);
+  MaterialDesc mat;
+  mat.type = MATERIAL_DIFFUSE;
+  mat.base_color = glm::vec4(0, 0, 0, 1);
+  mat.emission = radiance;
+  s.materials.push_back(mat);
+  CameraDesc cam;
+  cam.position = {0, 0, 1};
+  cam.forward = {0, 0, -1};
+  cam.yfov = 0.5f;
+  s.camera = cam;
+  return s;
+}
+
+TEST(VarianceImage, ZeroWhereTheRadianceIsConstant) {
+  DeviceEntry device = pocl_device();
+  glm::vec3 le(0.5f, 1.0f, 2.0f);
+  RenderResult r = render(device, emitter_wall(le), 8, 16, 3, 0);
+  RgbImage img = as_image(r.film, "wall");
+  RgbImage var = as_variance(r.film, "wall");
+  ASSERT_EQ(var.width, 8);
+  ASSERT_EQ(var.height, 8);
+  EXPECT_EQ(var.metadata["image"], "variance_of_mean");
+  EXPECT_EQ(var.metadata["seed"], "7");
+  for (size_t k = 0; k < img.rgb.size(); ++k) {
+    EXPECT_NEAR(img.rgb[k], le[k % 3], 1e-6f) << "value " << k;
+    EXPECT_EQ(var.rgb[k], 0.0f) << "value " << k;
+  }
+}
+
+TEST(VarianceImage, InfiniteWithOneSample) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderResult r = render(device, scene, 4, 1, 0);
+  RgbImage var = as_variance(r.film, "one");
+  for (float v : var.rgb) EXPECT_TRUE(std::isinf(v) && v > 0);
+}
+
+TEST(VarianceImage, IsTheFilmsM2OverNTimesNMinusOne) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderResult r = render(device, scene, 6, 5, 0);
+  RgbImage var = as_variance(r.film, "m2");
+  for (size_t i = 0; i < r.film.pixels(); ++i) {
+    double n = r.film.samples(i);
+    ASSERT_EQ(n, 5.0);
+    for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(var.rgb[3 * i + c], float(r.film.m2[4 * i + c] / (n * (n - 1))));
+  }
+}
+
+// Eight renders with different seeds: the spread of their means across seeds (the
+// empirical variance of the mean) against the variance images. Both estimate the same
+// per-pixel quantity without bias; the image means must agree within the standard error
+// of their difference, measured over pixels (independent: each pixel has its own random
+// numbers).
+// The scene: the closed furnace sphere (every pixel noisy, without the few pixels at the
+// edge of a visible light whose rare hits would dominate the sums).
+TEST(VarianceImage, AgreesWithTheSpreadAcrossSeeds) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("furnace/closed-sphere.gltf"));
+  const int size = 16, seeds = 8;
+  const uint32_t spp = 16;
+  std::vector<RgbImage> images, variances;
+  for (int s = 0; s < seeds; ++s) {
+    RenderResult r = render(device, scene, size, spp, 100 + s, 8);
+    images.push_back(as_image(r.film, "seed" + std::to_string(s)));
+    variances.push_back(as_variance(r.film, "seed" + std::to_string(s)));
+  }
+  size_t pixels = size_t(size) * size;
+  std::vector<double> diff;  // per pixel: empirical minus predicted, summed over channels
+  double empirical_sum = 0.0, predicted_sum = 0.0;
+  for (size_t i = 0; i < pixels; ++i) {
+    double d = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      size_t k = 3 * i + c;
+      double mean = 0.0, predicted = 0.0;
+      for (int s = 0; s < seeds; ++s) {
+        mean += images[s].rgb[k] / seeds;
+        predicted += variances[s].rgb[k] / seeds;
+      }
+      double empirical = 0.0;
+      for (int s = 0; s < seeds; ++s) empirical += std::pow(images[s].rgb[k] - mean, 2) / (seeds - 1);
+      empirical_sum += empirical;
+      predicted_sum += predicted;
+      d += empirical - predicted;
+    }
+    diff.push_back(d);
+  }
+  double mean_diff = 0.0, var_diff = 0.0;
+  for (double d : diff) mean_diff += d / pixels;
+  for (double d : diff) var_diff += (d - mean_diff) * (d - mean_diff) / (pixels - 1);
+  double se = std::sqrt(var_diff / pixels);
+  EXPECT_GT(predicted_sum, 0.0);
+  EXPECT_NEAR(mean_diff, 0.0, 4.0 * se) << "SE " << se << ", empirical " << empirical_sum / (3 * pixels) << " predicted "
+                                        << predicted_sum / (3 * pixels);
+  // And the ratio is near one (the test above has power: the SE is a fraction of the mean)
+  EXPECT_LT(4.0 * se, 0.25 * predicted_sum / pixels);
+}
+
+// The z-test between two independent renders: consistent for two seeds of the same render,
+// inconsistent when one of them leaves out indirect light
+TEST(CompareZTest, SameRenderDifferentSeedsIsConsistent) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderResult a = render(device, scene, 24, 32, 1, 8), b = render(device, scene, 24, 32, 2, 8);
+  ZTest t = z_test(as_image(a.film, "za"), as_variance(a.film, "za"), as_image(b.film, "zb"),
+                   as_variance(b.film, "zb"));
+  EXPECT_TRUE(t.consistent) << (t.reasons.empty() ? "" : t.reasons[0]);
+  EXPECT_GT(t.values, 24u * 24u);
+  EXPECT_NEAR(t.mean_z2, 1.0, 0.3);
+}
+
+TEST(CompareZTest, DirectLightingOnlyIsNotConsistent) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderResult a = render(device, scene, 24, 32, 1, 8), b = render(device, scene, 24, 32, 2, 1);
+  ZTest t = z_test(as_image(a.film, "da"), as_variance(a.film, "da"), as_image(b.film, "db"),
+                   as_variance(b.film, "db"));
+  EXPECT_FALSE(t.consistent);
+  EXPECT_GT(t.mean_z, 0.0);  // the full render is brighter
+}
+
+TEST(CompareZTest, SameSeedDifferenceOfIdenticalImagesIsZero) {
+  DeviceEntry device = pocl_device();
+  Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  RenderResult a = render(device, scene, 8, 4, 5), b = render(device, scene, 8, 4, 5);
+  SameSeedDiff d = same_seed_diff(as_image(a.film, "sa"), as_image(b.film, "sb"));
+  EXPECT_EQ(d.max_abs, 0.0);
+  EXPECT_EQ(d.identical_fraction, 1.0);
+}
+
+TEST(ImageError, RelMseMseAndMae) {
+  RgbImage ref, img;
+  ref.width = img.width = 2;
+  ref.height = img.height = 1;
+  ref.rgb = {0, 1, 2, 0.1f, 0.2f, 0.3f};
+  img.rgb = {0.1f, 1, 1, 0.1f, 0.2f, 0.5f};
+  ErrorMetrics m = image_error(img, ref);
+  double rel = (0.01 / 0.01 + 0 + 1 / 4.01 + 0 + 0 + 0.04 / (0.09 + 0.01)) / 6;
+  EXPECT_NEAR(m.rel_mse, rel, 1e-6);
+  EXPECT_NEAR(m.mse, (0.01 + 1 + 0.04) / 6, 1e-6);
+  EXPECT_NEAR(m.mae, (0.1 + 1 + 0.2) / 6, 1e-6);
+  RgbImage small;
+  small.width = small.height = 1;
+  small.rgb = {0, 0, 0};
+  EXPECT_THROW(image_error(small, ref), Error);
+}
+
+}  // namespace
+}  // namespace candela::test
