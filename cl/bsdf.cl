@@ -126,6 +126,37 @@ float bsdf_widest_alpha(const Bsdf* b) {
   return a;
 }
 
+// Shading normals (interpolated, normal-mapped) can tilt so far from the geometric normal
+// that, near silhouettes, wo lies below the shading hemisphere or reflects about the
+// shading normal to below the surface: no reflection lobe returns anything there, and the
+// surface shows black fringes. Where the mirror direction of wo about the shading normal
+// falls below q = min(0.9 wo.ng, 0.01) above the geometric plane, the shading normal is
+// replaced by the half vector of wo and the direction R' that keeps the mirror direction's
+// azimuth at height q (the idea of Cycles' ensure_valid_reflection). The frame's tangent
+// follows by Gram-Schmidt; the geometric side test still decides reflection and
+// transmission. Called by the integrator once it knows wo (the BSDF tests see the
+// unmodified frame).
+void bsdf_face_wo(Bsdf* b, float3 wo) {
+  float3 n = b->frame.n, ng = b->ng;
+  float cos_o = dot(wo, ng);
+  if (!(cos_o > 0.0f)) return;
+  float q = fmin(0.9f * cos_o, 0.01f);
+  float3 r = 2.0f * dot(wo, n) * n - wo;
+  if (dot(r, ng) >= q) return;
+  float3 rt = r - dot(r, ng) * ng;
+  float len = length(rt);
+  if (!(len > 1e-6f)) {
+    rt = dot(wo, ng) * ng - wo;  // the mirror image of wo's tangential part
+    len = length(rt);
+    if (!(len > 1e-6f)) return;
+  }
+  float3 r_valid = rt * (sqrt(1.0f - q * q) / len) + q * ng;
+  float3 n_new = normalize(wo + r_valid);
+  float handed = dot(cross(b->frame.n, b->frame.t), b->frame.b) >= 0.0f ? 1.0f : -1.0f;
+  b->frame = frame_from_z_x(n_new, b->frame.t);
+  b->frame.b *= handed;
+}
+
 // The geometric side test: wi lies on wo's side of the surface
 bool bsdf_is_reflection(const Bsdf* b, float3 wi) { return dot(wi, b->ng) > 0.0f; }
 

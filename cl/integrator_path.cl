@@ -98,6 +98,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 
     float3 wo = -ps.ray.dir;
     Bsdf bsdf = bsdf_at(sc, &s);
+    bsdf_face_wo(&bsdf, wo);  // no black fringes where shading normals tilt away from wo
     uint flags = bsdf_flags(&bsdf);
     // Light sampling, except at lobes that are all delta (no light sample can find them)
     // and where the strategy leaves area and environment lights to the sampled ray

@@ -66,6 +66,7 @@ int GltfBuilder::add_mesh(const std::vector<Primitive>& primitives) {
     json prim = {{"mode", p.mode}};
     json& attr = prim["attributes"];
     attr["POSITION"] = add_accessor(p.positions, FLOAT, "VEC3", {{"min", vec(lo)}, {"max", vec(hi)}});
+    if (!p.normals.empty()) attr["NORMAL"] = add_accessor(p.normals, FLOAT, "VEC3");
     if (!p.uvs.empty()) attr["TEXCOORD_0"] = add_accessor(p.uvs, FLOAT, "VEC2");
     if (!p.colors.empty()) attr["COLOR_0"] = add_accessor(p.colors, UNSIGNED_BYTE, "VEC4", {{"normalized", true}});
     if (!p.indices.empty()) prim["indices"] = add_accessor(p.indices, UNSIGNED_SHORT, "SCALAR");

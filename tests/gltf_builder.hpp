@@ -15,6 +15,7 @@ class GltfBuilder {
   // One primitive's vertex data; empty attributes (and indices) are left out
   struct Primitive {
     std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;     // NORMAL
     std::vector<glm::vec2> uvs;         // TEXCOORD_0
     std::vector<glm::u8vec4> colors;    // COLOR_0, normalized unsigned bytes
     std::vector<uint16_t> indices;
