@@ -2,6 +2,7 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -544,6 +545,7 @@ class MeshReader {
                        : uint32_t(model_.materials.size());  // the default material
       read_attributes(prim, world, &m);
       read_triangles(prim, world, &m);
+      if (m.tangents.empty()) generate_tangents(normal_texcoord(prim), &m);
       if (m.triangles() > 0) scene_->meshes.push_back(std::move(m));
     }
   }
@@ -621,6 +623,58 @@ class MeshReader {
         throw Error("glTF COLOR_0 values must lie in [0, 1] (integer colors must be normalized)");
     for (size_t v = 0; v < n; ++v)
       m->colors.push_back(glm::vec3(col[comps * v], col[comps * v + 1], col[comps * v + 2]));
+  }
+
+  // The TEXCOORD set of the primitive's normal texture, -1 without one
+  int normal_texcoord(const tinygltf::Primitive& prim) const {
+    if (prim.material < 0 || prim.material >= (int)model_.materials.size()) return -1;
+    const tinygltf::NormalTextureInfo& n = model_.materials[size_t(prim.material)].normalTexture;
+    return n.index >= 0 && (n.texCoord == 0 || n.texCoord == 1) ? n.texCoord : -1;
+  }
+
+  // Per-vertex tangents for a normal-mapped mesh without TANGENT, as the glTF specification
+  // asks (MikkTSpace-style, not bit-identical to it): each triangle's dp/du from the normal
+  // texture's coordinates, summed at its corners weighted by the corner angle, made
+  // orthogonal to the vertex normal; the bitangent sign w says whether cross(n, t) points
+  // toward decreasing v (+Y of the normal texture, glTF's convention) or away (mirrored
+  // UVs). Vertices without a usable tangent keep 0 (the kernel then uses dp/du).
+  void generate_tangents(int texcoord, MeshDesc* m) {
+    const std::vector<glm::vec2>& uv = texcoord == 1 ? m->uv1 : m->uv0;
+    if (texcoord < 0 || uv.size() != m->positions.size()) return;
+    size_t n = m->positions.size();
+    std::vector<glm::vec3> sum(n, glm::vec3(0.0f));
+    std::vector<float> handed(n, 0.0f);
+    for (size_t t = 0; t < m->triangles(); ++t) {
+      uint32_t idx[3] = {m->indices[3 * t], m->indices[3 * t + 1], m->indices[3 * t + 2]};
+      glm::vec3 e1 = m->positions[idx[1]] - m->positions[idx[0]], e2 = m->positions[idx[2]] - m->positions[idx[0]];
+      glm::vec2 d1 = uv[idx[1]] - uv[idx[0]], d2 = uv[idx[2]] - uv[idx[0]];
+      float det = d1.x * d2.y - d2.x * d1.y;
+      if (!(std::fabs(det) > 1e-20f)) continue;
+      glm::vec3 dpdu = (d2.y * e1 - d1.y * e2) / det, dpdv = (d1.x * e2 - d2.x * e1) / det;
+      float len = glm::length(dpdu);
+      if (!(len > 0.0f) || !std::isfinite(len)) continue;
+      dpdu /= len;
+      glm::vec3 face = glm::cross(e1, e2);
+      for (int k = 0; k < 3; ++k) {
+        glm::vec3 a = m->positions[idx[(k + 1) % 3]] - m->positions[idx[k]];
+        glm::vec3 b = m->positions[idx[(k + 2) % 3]] - m->positions[idx[k]];
+        float la = glm::length(a), lb = glm::length(b);
+        if (!(la > 0.0f && lb > 0.0f)) continue;
+        float angle = std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0f, 1.0f));
+        glm::vec3 nv = m->normals.empty() || glm::dot(m->normals[idx[k]], m->normals[idx[k]]) == 0.0f
+                           ? glm::normalize(face)
+                           : m->normals[idx[k]];
+        sum[idx[k]] += angle * dpdu;
+        handed[idx[k]] += angle * (glm::dot(glm::cross(nv, dpdu), -dpdv) < 0.0f ? -1.0f : 1.0f);
+      }
+    }
+    m->tangents.assign(n, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    for (size_t v = 0; v < n; ++v) {
+      glm::vec3 t = sum[v];
+      if (!m->normals.empty()) t -= glm::dot(m->normals[v], t) * m->normals[v];
+      float len = glm::length(t);
+      if (len > 1e-12f && std::isfinite(len)) m->tangents[v] = glm::vec4(t / len, handed[v] < 0.0f ? -1.0f : 1.0f);
+    }
   }
 
   // Triangles from TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN, zero-area ones skipped

@@ -129,6 +129,35 @@ TEST(GltfLoader, SceneExtrasChooseTheStrategy) {
   EXPECT_THROW(load_gltf(dir.write("bad2.gltf", j.dump())), Error);
 }
 
+// A normal-mapped mesh without TANGENT gets per-vertex tangents along dp/du of the normal
+// texture's coordinates, with w = -1 where the UVs are mirrored (glTF: bitangent =
+// cross(normal, tangent) w points toward decreasing v)
+TEST(GltfLoader, GeneratesTangentsForNormalMapsWithoutTangent) {
+  TempDir dir;
+  for (bool mirrored : {false, true}) {
+    GltfBuilder::Primitive p = quad();
+    p.normals.assign(4, glm::vec3(0, 0, 1));
+    if (mirrored) p.uvs = {{1, 1}, {0, 1}, {0, 0}, {1, 0}};
+    json j = quad_gltf(p).document();
+    j["images"] = {{{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="}}};
+    j["textures"] = {{{"source", 0}}};
+    j["materials"][0]["normalTexture"] = {{"index", 0}};
+    Scene s = load_gltf(dir.write(mirrored ? "m.gltf" : "n.gltf", j.dump()));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    ASSERT_EQ(s.meshes[0].tangents.size(), 4u);
+    for (const glm::vec4& t : s.meshes[0].tangents) {
+      EXPECT_NEAR(t.x, mirrored ? -1.0f : 1.0f, 1e-6f);
+      EXPECT_NEAR(t.y, 0.0f, 1e-6f);
+      EXPECT_NEAR(t.z, 0.0f, 1e-6f);
+      EXPECT_EQ(t.w, mirrored ? -1.0f : 1.0f);
+    }
+    EXPECT_TRUE(s.features().tangents);
+  }
+  // Without a normal texture nothing is generated
+  GltfBuilder::Primitive p = quad();
+  EXPECT_TRUE(load_gltf(dir.write("plain.gltf", quad_gltf(p).document().dump())).meshes[0].tangents.empty());
+}
+
 TEST(GltfLoader, MirroringTransformKeepsFrontFacesFront) {
   TempDir dir;
   json j = quad_gltf().document();
