@@ -75,6 +75,8 @@ void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
     d.flags = (m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.thin_walled ? MATERIAL_THIN_WALLED : 0u) |
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
+    d.flags |= m.null_boundary ? MATERIAL_NULL_BOUNDARY : 0u;
+    d.medium = NO_MEDIUM;  // compile_media sets the insides of closed surfaces
     d.alpha_cutoff = m.alpha_cutoff;
     d.ior = m.ior;
     for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
@@ -118,6 +120,61 @@ void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
     b->textures.push_back(info);
   }
   for (int i = 0; i < 256; ++i) b->srgb_to_linear.push_back(dev::srgb_to_linear(i / 255.0f));
+}
+
+dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
+  dev::Medium d{};
+  for (int c = 0; c < 3; ++c) {
+    d.sigma_a[c] = m.sigma_a[c];
+    d.sigma_s[c] = m.sigma_s[c];
+    d.emission[c] = m.emission[c];
+  }
+  d.g = m.g;
+  d.type = MEDIUM_HOMOGENEOUS;
+  d.density_scale = m.density_scale;
+  if (m.is_grid()) {
+    d.type = MEDIUM_GRID;
+    if (b->densities.size() + m.density.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+    d.grid_offset = uint32_t(b->densities.size());
+    b->densities.insert(b->densities.end(), m.density.begin(), m.density.end());
+    float max_density = *std::max_element(m.density.begin(), m.density.end());
+    glm::vec3 sigma_t = m.sigma_a + m.sigma_s;
+    // A bound of sigma_t over the box (trilinear values never exceed the largest node),
+    // a little above it so that rounding never makes a null-collision weight negative
+    d.majorant = m.density_scale * max_density * std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * 1.0001f;
+    for (int k = 0; k < 3; ++k) {
+      d.grid_size[k] = uint32_t(m.grid_size[k]);
+      d.grid_min[k] = m.grid_min[k];
+      d.grid_max[k] = m.grid_max[k];
+    }
+  }
+  return d;
+}
+
+// media[GLOBAL_MEDIUM] is the scene's global medium (a vacuum record when it has none);
+// then every MediumDesc; then, when needed, one vacuum record for the insides of clear solids
+// (so that fog does not fill a glass ball). Material.medium is set for closed surfaces that
+// rays cross: transmissive solids and null boundaries.
+void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b) {
+  if (!f.media) return;  // the kernel reads neither buffer nor Material.medium
+  b->media.push_back(scene.global_medium >= 0 ? compile_medium(scene.media[size_t(scene.global_medium)], b)
+                                              : dev::Medium{});
+  for (const MediumDesc& m : scene.media) b->media.push_back(compile_medium(m, b));
+  int vacuum = NO_MEDIUM;
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const MaterialDesc& m = scene.materials[i];
+    bool crossed = m.null_boundary || (m.transmission > 0.0f && !m.thin_walled);
+    if (!crossed) continue;
+    if (m.medium >= 0) {
+      b->materials[i].medium = 1 + m.medium;
+      continue;
+    }
+    if (vacuum == NO_MEDIUM) {
+      vacuum = int(b->media.size());
+      b->media.push_back(dev::Medium{});
+    }
+    b->materials[i].medium = vacuum;
+  }
 }
 
 glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {
@@ -310,6 +367,7 @@ CompiledScene compile_scene(const Scene& scene) {
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);
   compile_textures(scene, &c.buffers);
+  compile_media(scene, c.features, &c.buffers);
   c.environment_light = compile_lights(scene, &c.buffers);
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;
