@@ -6,6 +6,11 @@
 //                  arrives through shadow rays to sampled lights (skipped at delta lobes)
 //   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
 //                  punctual lights, which no ray can hit, contribute nothing)
+// Participating media (CD_FEATURE_MEDIA, cl/media.cl): a medium step after each closest
+// hit adds the medium's emission along the segment (under both strategies: media are not
+// lights) and may scatter the path there, a vertex like a surface one with the phase
+// function as its BSDF; null boundaries are passed without a bounce; shadow rays carry the
+// transmittance of the media they cross.
 
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {

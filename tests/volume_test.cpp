@@ -21,6 +21,7 @@
 #include <memory>
 
 #include "gltf_builder.hpp"
+#include "error.hpp"
 #include "gltf_loader.hpp"
 #include "renderer.hpp"
 #include "stats.hpp"
@@ -568,6 +569,90 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
     }
     EXPECT_EQ(v[0].s[3], 1.0f) << "the origin lies inside the box's medium";
   }
+}
+
+// Where media come from: KHR_materials_volume, extras, the scene; the compiled records
+TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
+  GltfBuilder g;
+  json glass = {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+                {"extensions",
+                 {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+                  {"KHR_materials_volume", {{"thicknessFactor", 1.0}, {"attenuationDistance", 2.0}, {"attenuationColor", {0.5, 0.25, 1.0}}}}}},
+                {"extras", {{"candela", {{"medium", {{"sigma_s", {0.1, 0.2, 0.3}}, {"g", 0.5}}}}}}}};
+  json clear = glass;
+  clear["extensions"]["KHR_materials_volume"] = {{"thicknessFactor", 1.0}};
+  clear.erase("extras");
+  json thin = clear;
+  thin["extensions"].erase("KHR_materials_volume");
+  int m_glass = g.add("materials", glass), m_clear = g.add("materials", clear), m_thin = g.add("materials", thin);
+  int m_null = g.add("materials", null_material(medium_json(glm::vec3(1.0f), glm::vec3(0.0f))));
+  int m_opaque = g.add("materials", diffuse(0.5f));
+  float x = 0.0f;
+  for (int m : {m_glass, m_clear, m_thin, m_null, m_opaque}) {
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(x), glm::vec3(x + 1.0f), m))}});
+    x += 3.0f;
+  }
+  g.doc["scenes"][0]["extras"]["candela"]["medium"] = medium_json(glm::vec3(0.0f), glm::vec3(0.05f), -0.3);
+  Scene scene = load(g, "loader");
+  ASSERT_GE(scene.global_medium, 0);
+  EXPECT_FLOAT_EQ(scene.media[size_t(scene.global_medium)].g, -0.3f);
+  const MaterialDesc& mg = scene.materials[size_t(m_glass)];
+  ASSERT_GE(mg.medium, 0);
+  const MediumDesc& md = scene.media[size_t(mg.medium)];
+  EXPECT_NEAR(md.sigma_a.x, std::log(2.0) / 2.0, 1e-6);  // -ln(0.5) / 2
+  EXPECT_NEAR(md.sigma_a.y, std::log(4.0) / 2.0, 1e-6);
+  EXPECT_EQ(md.sigma_a.z, 0.0f);
+  EXPECT_FLOAT_EQ(md.sigma_s.y, 0.2f);
+  EXPECT_FLOAT_EQ(md.g, 0.5f);
+  EXPECT_FALSE(mg.null_boundary);
+  EXPECT_EQ(scene.materials[size_t(m_clear)].medium, -1);
+  EXPECT_EQ(scene.materials[size_t(m_thin)].medium, -1);
+  EXPECT_TRUE(scene.materials[size_t(m_null)].null_boundary);
+  EXPECT_EQ(scene.materials[size_t(m_opaque)].medium, -1);
+  EXPECT_TRUE(scene.features().media);
+  EXPECT_NE(scene.features().build_options().find("-DCD_FEATURE_MEDIA=1"), std::string::npos);
+
+  CompiledScene c = compile_scene(scene);
+  const auto& b = c.buffers;
+  EXPECT_FLOAT_EQ(b.media[GLOBAL_MEDIUM].sigma_s[0], 0.05f);
+  EXPECT_EQ(b.materials[size_t(m_glass)].medium, 1 + mg.medium);
+  int vacuum = b.materials[size_t(m_clear)].medium;  // clear solids hold vacuum, not the fog
+  ASSERT_GT(vacuum, 0);
+  EXPECT_EQ(b.media[size_t(vacuum)].sigma_s[0] + b.media[size_t(vacuum)].sigma_a[0], 0.0f);
+  EXPECT_EQ(b.materials[size_t(m_thin)].medium, NO_MEDIUM);
+  EXPECT_EQ(b.materials[size_t(m_opaque)].medium, NO_MEDIUM);
+  EXPECT_TRUE(b.materials[size_t(m_null)].flags & MATERIAL_NULL_BOUNDARY);
+
+  // Without media the kernel has no media code and the buffers stay empty
+  GltfBuilder plain;
+  plain.add_node({{"mesh", plain.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), plain.add("materials", clear)))}});
+  Scene none = load(plain, "no-media");
+  EXPECT_FALSE(none.features().media);
+  EXPECT_TRUE(compile_scene(none).buffers.media.empty());
+}
+
+TEST(VolumeLoader, MalformedMediaAreClearErrors) {
+  const std::vector<json> bad = {
+      {{"sigma_a", {1, 2}}},
+      {{"sigma_s", {1, -1, 0}}},
+      {{"g", 1.0}},
+      {{"density_scale", -1}},
+      {{"grid", {{"size", {2, 2, 1}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(4, 1.0f)}}}},
+      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 0, 1}}, {"density", std::vector<float>(8, 1.0f)}}}},
+      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(7, 1.0f)}}}},
+      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(8, -1.0f)}}}},
+  };
+  int i = 0;
+  for (const json& medium : bad) {
+    GltfBuilder g;
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", null_material(medium))))}});
+    EXPECT_THROW(load(g, "bad-" + std::to_string(i++)), Error) << medium.dump();
+  }
+  // A global medium that emits where nothing attenuates would give infinite radiance
+  GltfBuilder g;
+  g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", diffuse(0.5f))))}});
+  g.doc["scenes"][0]["extras"]["candela"]["medium"] = medium_json(glm::vec3(0.0f, 1.0f, 1.0f), glm::vec3(0.0f), 0.0, glm::vec3(1.0f));
+  EXPECT_THROW(load(g, "bad-emitting-fog"), Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, VolumeRender, ::testing::Values("pocl", "rusticl"),
