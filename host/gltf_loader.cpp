@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "error.hpp"
+#include "vdb_grid.hpp"
 
 namespace candela {
 namespace {
@@ -222,7 +223,7 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
 // A medium from candela's extras: {"sigma_a": [r, g, b], "sigma_s": [r, g, b], "g": g,
 // "emission": [r, g, b], "density_scale": s, "grid": {"size": [nx, ny, nz], "min": [x, y, z],
 // "max": [x, y, z], "density": [nx ny nz values, x fastest]}}; every entry optional
-MediumDesc read_medium(const tinygltf::Value& v, const std::string& where) {
+MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir) {
   if (!v.IsObject()) throw Error(where + " must be an object");
   MediumDesc m;
   auto rgb = [&](const char* key, glm::vec3* out) {
@@ -246,6 +247,16 @@ MediumDesc read_medium(const tinygltf::Value& v, const std::string& where) {
   if (!v.Has("grid")) return m;
   const tinygltf::Value& grid = v.Get("grid");
   std::string gw = where + ".grid";
+  if (grid.Has("nanovdb")) {  // {"nanovdb": "file.nvdb", "name": "density"}, relative to the glTF file
+    const tinygltf::Value& file = grid.Get("nanovdb");
+    if (!file.IsString() || file.Get<std::string>().empty()) throw Error(gw + ".nanovdb must name a file");
+    if (base_dir.empty()) throw Error(gw + ".nanovdb: a scene loaded from memory cannot name files");
+    std::string name = grid.Has("name") && grid.Get("name").IsString() ? grid.Get("name").Get<std::string>() : "";
+    std::filesystem::path path(file.Get<std::string>());
+    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+    load_nanovdb_density(path.string(), name, &m);
+    return m;
+  }
   size_t count = 1;
   for (int k = 0; k < 3; ++k) {
     double n = number_or(grid, "size", k, 0.0);
@@ -324,9 +335,10 @@ PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, W
 class MaterialReader {
  public:
   // `image_errors`: why each image that load_checked_image left empty was not decoded
+  // `base_dir`: where files a medium names (NanoVDB grids) are found; empty: nowhere
   MaterialReader(const tinygltf::Model& model, const std::map<int, std::string>& image_errors, Scene* scene,
-                 Warnings* warn)
-      : model_(model), image_errors_(image_errors), scene_(scene), warn_(*warn) {}
+                 Warnings* warn, const std::string& base_dir)
+      : model_(model), image_errors_(image_errors), scene_(scene), warn_(*warn), base_dir_(base_dir) {}
 
   // Reads every material, then the default one (index = model's material count)
   void read_all() {
@@ -409,7 +421,7 @@ class MaterialReader {
     const tinygltf::Value& vol = extension(gm, "KHR_materials_volume");
     bool has_extra = gm.extras.Has("candela") && gm.extras.Get("candela").Has("medium");
     MediumDesc md;
-    if (has_extra) md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium");
+    if (has_extra) md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", base_dir_);
     bool solid = m->transmission > 0.0f && !m->thin_walled;
     if (solid) {
       double distance = number_or(vol, "attenuationDistance", -1, INFINITY);
@@ -607,6 +619,7 @@ class MaterialReader {
   const std::map<int, std::string>& image_errors_;
   Scene* scene_;
   Warnings& warn_;
+  std::string base_dir_;
   std::map<std::pair<int, bool>, int> texture_cache_;
 };
 
@@ -750,8 +763,8 @@ class MeshReader {
 // The default scene's node trees: transforms, meshes, the first camera, scene extras
 class NodeReader {
  public:
-  NodeReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
-      : model_(model), scene_(scene), warn_(*warn), meshes_(model, scene, warn) {}
+  NodeReader(const tinygltf::Model& model, Scene* scene, Warnings* warn, const std::string& base_dir)
+      : model_(model), scene_(scene), warn_(*warn), base_dir_(base_dir), meshes_(model, scene, warn) {}
 
   void read_scene() {
     std::vector<int> roots;
@@ -782,7 +795,7 @@ class NodeReader {
     if (!extras.Has("candela")) return;
     const tinygltf::Value& c = extras.Get("candela");
     if (c.Has("medium")) {
-      MediumDesc m = read_medium(c.Get("medium"), "scene extras candela.medium");
+      MediumDesc m = read_medium(c.Get("medium"), "scene extras candela.medium", base_dir_);
       // An infinite ray through a global medium gathers emission / sigma_t: finite only where sigma_t > 0
       for (int k = 0; k < 3; ++k)
         if (m.emission[k] > 0.0f && !m.is_grid() && !(m.sigma_a[k] + m.sigma_s[k] > 0.0f))
@@ -866,6 +879,7 @@ class NodeReader {
   const tinygltf::Model& model_;
   Scene* scene_;
   Warnings& warn_;
+  std::string base_dir_;
   MeshReader meshes_;
   std::vector<bool> visited_;  // nodes reached so far
 };
@@ -1086,8 +1100,8 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   }
   Warnings warnings(&scene.warnings);
   warn_model_wide(model, &warnings);
-  MaterialReader(model, image_errors, &scene, &warnings).read_all();
-  NodeReader(model, &scene, &warnings).read_scene();
+  MaterialReader(model, image_errors, &scene, &warnings, base_dir).read_all();
+  NodeReader(model, &scene, &warnings, base_dir).read_scene();
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
   return scene;
 }

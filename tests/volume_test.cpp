@@ -26,6 +26,12 @@
 #include "renderer.hpp"
 #include "stats.hpp"
 #include "test_support.hpp"
+#include "vdb_grid.hpp"
+
+#ifdef CANDELA_HAVE_NANOVDB
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/Primitives.h>
+#endif
 
 namespace candela::test {
 namespace {
@@ -653,6 +659,49 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", diffuse(0.5f))))}});
   g.doc["scenes"][0]["extras"]["candela"]["medium"] = medium_json(glm::vec3(0.0f, 1.0f, 1.0f), glm::vec3(0.0f), 0.0, glm::vec3(1.0f));
   EXPECT_THROW(load(g, "bad-emitting-fog"), Error);
+}
+
+// A NanoVDB fog sphere (written here with NanoVDB's own builder) becomes a dense grid that
+// matches it voxel by voxel, and renders as a white furnace
+TEST(VolumeNanoVdb, FogSphereLoadsAndIsAFurnace) {
+#ifndef CANDELA_HAVE_NANOVDB
+  EXPECT_FALSE(nanovdb_supported());
+  GTEST_SKIP() << "built without NanoVDB";
+#else
+  ASSERT_TRUE(nanovdb_supported());
+  auto handle = nanovdb::createFogVolumeSphere<float>(0.4f, nanovdb::Vec3f(0.1f, 0.0f, 0.0f), 0.05, 3.0,
+                                                      nanovdb::Vec3d(0.0), "density");
+  nanovdb::io::writeGrid(::testing::TempDir() + "volume-sphere.nvdb", handle);
+  GltfBuilder g;
+  json medium = medium_json(glm::vec3(0.0f), glm::vec3(1.0f, 2.0f, 4.0f), 0.3);
+  medium["grid"] = {{"nanovdb", "volume-sphere.nvdb"}, {"name", "density"}};
+  int m = g.add("materials", null_material(medium));
+  g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-0.8f), glm::vec3(0.8f), m))}});
+  g.add_camera(glm::vec3(0.0f, 0.3f, 2.5f), glm::vec3(0.0f), 0.6f);
+  g.set_background(glm::vec3(1.0f));
+  Scene scene = load(g, "nanovdb");
+  const MediumDesc& md = scene.media[size_t(scene.materials[size_t(m)].medium)];
+  ASSERT_TRUE(md.is_grid());
+  const nanovdb::FloatGrid* grid = handle.grid<float>();
+  nanovdb::Coord lo = grid->indexBBox().min() - nanovdb::Coord(1);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(md.grid_size[k], grid->indexBBox().max()[k] - grid->indexBBox().min()[k] + 3);
+    EXPECT_NEAR(md.grid_min[k], grid->indexToWorld(lo.asVec3d())[k], 1e-6);
+  }
+  auto acc = grid->getAccessor();
+  double interior = 0.0;
+  for (size_t i = 0; i < md.density.size(); i += 7) {
+    int x = int(i % size_t(md.grid_size.x)), y = int(i / size_t(md.grid_size.x) % size_t(md.grid_size.y)),
+        z = int(i / (size_t(md.grid_size.x) * size_t(md.grid_size.y)));
+    ASSERT_EQ(md.density[i], acc.getValue(lo + nanovdb::Coord(x, y, z))) << "node " << i;
+    interior = std::max(interior, double(md.density[i]));
+  }
+  EXPECT_EQ(interior, 1.0) << "a fog sphere is 1 inside";
+  Film f = render(scene, Strategy::Nee, 16, 64, 1000, 13);
+  Estimate e = image_mean(f);
+  EXPECT_LT(e.standard_error, 0.01);
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << "SE " << e.standard_error;
+#endif
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, VolumeRender, ::testing::Values("pocl", "rusticl"),
