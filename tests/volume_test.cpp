@@ -431,6 +431,31 @@ TEST_P(VolumeFurnace, InvisibleUnderUniformBackground) {
   EXPECT_EQ(f.dropped_samples(), 0u);
 }
 
+// A smooth glass sphere (ior 1.5) whose interior scatters with albedo 1 (extras.candela.medium
+// on a KHR_materials_volume material) is invisible too: the medium is entered and left by
+// refraction, and light reaches the medium only through the delta lobe (nee's shadow rays
+// from inside stop at the glass)
+class GlassFurnace : public ::testing::TestWithParam<Strategy> {};
+
+TEST_P(GlassFurnace, ScatteringGlassIsInvisible) {
+  GltfBuilder g;
+  json glass = {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+                {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}, {"KHR_materials_volume", {{"thicknessFactor", 1.0}}}}},
+                {"extras", {{"candela", {{"medium", medium_json(glm::vec3(0.0f), glm::vec3(2.0f, 1.0f, 0.5f), 0.5)}}}}}};
+  int m = g.add("materials", glass);
+  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
+  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
+  g.set_background(glm::vec3(1.0f));
+  Film f = render(load(g, "glass-furnace"), GetParam(), 16, 128, 1000, 21);
+  Estimate e = image_mean(f);
+  EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << name(GetParam()) << " SE " << e.standard_error;
+  EXPECT_EQ(f.dropped_samples(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Media, GlassFurnace, ::testing::Values(Strategy::Nee, Strategy::Bsdf),
+                         [](const auto& info) { return std::string(name(info.param)); });
+
 // The furnace has power: the same sphere with absorption (albedo 2/3) is visibly darker
 TEST(VolumeFurnaceControl, AbsorbingSphereIsDarker) {
   GltfBuilder g;
