@@ -174,7 +174,7 @@ typedef struct {
   float params[8];  // per-type parameters, see above
 } Light;
 
-// A participating medium, 112 bytes (media.cl). Coefficients are per unit length in linear
+// A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
 // RGB at density 1; MEDIUM_GRID multiplies them by the density at the point (grid value x
 // density_scale). `emission` is radiance emitted per unit length (the lecture's L_e(z)).
 typedef struct {
@@ -189,6 +189,9 @@ typedef struct {
   unsigned int grid_size[3];  // MEDIUM_GRID: nodes along x, y, z (each >= 2)
   float grid_min[4];  // MEDIUM_GRID: the box the nodes span (w unused); density 0 outside
   float grid_max[4];
+  unsigned int majorant_offset;  // MEDIUM_GRID: first majorant cell in `densities`
+  unsigned int majorant_size[3];  // MEDIUM_GRID: cells along x, y, z splitting the box evenly;
+                                  // each holds a bound of sigma_t over its part of the box
 } Medium;
 
 // Pinhole camera, 64 bytes: ray direction = forward + (2x-1) right + (1-2y) up.
@@ -269,9 +272,10 @@ typedef struct {
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
-  SIZE(Medium, 112) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
+  SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
   FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68) FIELD(Medium, grid_min, 80)       \
-  FIELD(Medium, grid_max, 96)                                                               \
+  FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)                           \
+  FIELD(Medium, majorant_size, 116)                                                         \
   SIZE(Camera, 64) FIELD(Camera, forward, 16) FIELD(Camera, right, 32) FIELD(Camera, up, 48) \
   SIZE(RenderParams, 116) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
   FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \

@@ -181,24 +181,91 @@ int media_sample_homogeneous(__global const Medium* m, Ray r, float tmax, Rng* r
   return MEDIUM_PASSED;
 }
 
-// Grid medium: delta tracking against the majorant sigma_bar (a constant bound of
-// density x sigma_t over the box). Tentative collisions come at rate sigma_bar; at each the
-// event is absorption, scattering or a null collision with probabilities avg(sigma_a),
+// Walks the majorant cells of a grid medium that a ray crosses, in order (3D DDA, Amanatides
+// and Woo 1987): `t` is where the current cell's part of the span starts.
+typedef struct {
+  float t, t1;  // current position and the end of the span inside the box
+  float3 t_next;  // ray distance to the next cell boundary along each axis
+  float3 t_delta;  // ray distance across one cell along each axis
+  int3 cell, step, size;
+  uint offset;  // the medium's first majorant cell in `densities`
+} MediaDda;
+
+// Starts the walk over the part of [0, tmax] inside the box; false: the ray misses it
+bool media_dda_start(__global const Medium* m, Ray r, float tmax, MediaDda* it) {
+  if (!(m->majorant > 0.0f) || !media_grid_span(m, r, tmax, &it->t, &it->t1)) return false;
+  float3 lo = load3(m->grid_min), hi = load3(m->grid_max);
+  it->size = (int3)((int)m->majorant_size[0], (int)m->majorant_size[1], (int)m->majorant_size[2]);
+  float3 cell_size = (hi - lo) / convert_float3(it->size);
+  float3 p = r.org + it->t * r.dir;
+  it->cell = clamp(convert_int3(floor((p - lo) / cell_size)), (int3)(0), it->size - 1);
+  it->step = (int3)(r.dir.x >= 0.0f ? 1 : -1, r.dir.y >= 0.0f ? 1 : -1, r.dir.z >= 0.0f ? 1 : -1);
+  float3 inv = safe_inverse(r.dir);
+  float3 boundary = lo + convert_float3(it->cell + max(it->step, (int3)(0))) * cell_size;
+  it->t_next = (boundary - r.org) * inv;
+  it->t_delta = fabs(cell_size * inv);
+  it->offset = m->majorant_offset;
+  return true;
+}
+
+// The current cell's majorant and where the ray leaves it (within the span); false: done
+bool media_dda_cell(const SceneData* sc, const MediaDda* it, float* sigma_bar, float* t_end) {
+  if (!(it->t < it->t1)) return false;
+  int3 c = it->cell;
+  *sigma_bar = sc->densities[it->offset + (uint)(c.x + it->size.x * (c.y + it->size.y * c.z))];
+  *t_end = fmin(it->t1, fmin(it->t_next.x, fmin(it->t_next.y, it->t_next.z)));
+  return true;
+}
+
+// On to the next cell (false: the ray leaves the grid)
+bool media_dda_advance(MediaDda* it) {
+  float3 tn = it->t_next;
+  int axis = tn.x <= tn.y && tn.x <= tn.z ? 0 : tn.y <= tn.z ? 1 : 2;
+  float t_end = axis == 0 ? tn.x : axis == 1 ? tn.y : tn.z;
+  it->t = fmax(it->t, fmin(t_end, it->t1));
+  if (axis == 0) { it->cell.x += it->step.x; it->t_next.x += it->t_delta.x; }
+  if (axis == 1) { it->cell.y += it->step.y; it->t_next.y += it->t_delta.y; }
+  if (axis == 2) { it->cell.z += it->step.z; it->t_next.z += it->t_delta.z; }
+  bool inside = all(it->cell >= (int3)(0)) && all(it->cell < it->size);
+  if (!inside) it->t = it->t1;
+  return inside;
+}
+
+// Next tentative collision of a grid medium along the walk: an optical depth drawn from
+// Exp(1) is spent cell by cell against each cell's majorant (cells of majorant 0 are
+// skipped at no cost). False: the ray leaves the span first. *sigma_bar: the majorant there.
+bool media_dda_collision(const SceneData* sc, MediaDda* it, Rng* rng, float* sigma_bar) {
+  float tau = -log(1.0f - rng_next(rng));
+  float sb, t_end;
+  while (media_dda_cell(sc, it, &sb, &t_end)) {
+    float room = sb * fmax(t_end - it->t, 0.0f);
+    if (tau < room) {
+      it->t += tau / sb;
+      *sigma_bar = sb;
+      return true;
+    }
+    tau -= room;
+    if (!media_dda_advance(it)) return false;
+  }
+  return false;
+}
+
+// Grid medium: delta tracking against the piecewise-constant majorant sigma_bar of the
+// majorant grid. Tentative collisions come at rate sigma_bar; at each the event is
+// absorption, scattering or a null collision with probabilities avg(sigma_a),
 // avg(sigma_s), avg(sigma_bar - sigma_t) over sigma_bar, weighted by sigma / (sigma_bar
 // P(event)) per channel (1 for grey media: analog delta tracking). Emission: each tentative
 // collision adds beta x emission / sigma_bar, an unbiased estimate of the integral of
 // T(t) emission(t) (tentative collisions happen at rate sigma_bar while the path goes on).
 int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, float tmax, Rng* rng,
                       float3* beta, float3* radiance, float3* p) {
-  float t, t1;
-  float sigma_bar = m->majorant;
-  if (!(sigma_bar > 0.0f) || !media_grid_span(m, r, tmax, &t, &t1)) return MEDIUM_PASSED;
+  MediaDda it;
+  if (!media_dda_start(m, r, tmax, &it)) return MEDIUM_PASSED;
   float3 sigma_a = media_sigma_a(m), sigma_s = media_sigma_s(m), emission = load3(m->emission);
   bool emits = max_component(emission) > 0.0f;
-  while (true) {
-    t += media_exp_step(sigma_bar, rng);
-    if (t >= t1) return MEDIUM_PASSED;
-    float3 x = r.org + t * r.dir;
+  float sigma_bar;
+  while (media_dda_collision(sc, &it, rng, &sigma_bar)) {
+    float3 x = r.org + it.t * r.dir;
     float d = media_density(sc, m, x);
     if (emits) *radiance += *beta * emission * (d / sigma_bar);
     float3 sa = d * sigma_a, ss = d * sigma_s, sn = fmax((float3)(sigma_bar) - sa - ss, 0.0f);
@@ -214,6 +281,7 @@ int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, floa
     if (!(an > 0.0f)) return MEDIUM_ABSORBED;  // only reachable through rounding
     *beta *= sn / an;
   }
+  return MEDIUM_PASSED;
 }
 
 // Emission the homogeneous medium sends along the segment [0, tmax] to its start
@@ -236,25 +304,24 @@ int media_sample_segment(const SceneData* sc, int medium, Ray r, float tmax, Rng
 }
 
 // Transmittance exp(-integral sigma_t) through `medium` along [0, tmax]: closed form for
-// homogeneous media, ratio tracking against the majorant for grids
+// homogeneous media, ratio tracking against the majorant grid for grids
 float3 media_segment_transmittance(const SceneData* sc, int medium, Ray r, float tmax, Rng* rng) {
   __global const Medium* m = &sc->media[medium];
   if (m->type != MEDIUM_GRID) {
     float3 sigma_t = media_sigma_t(m);
     return max_component(sigma_t) > 0.0f ? media_exp(-sigma_t * tmax) : (float3)(1.0f);
   }
-  float t, t1;
-  float sigma_bar = m->majorant;
   float3 tr = (float3)(1.0f);
-  if (!(sigma_bar > 0.0f) || !media_grid_span(m, r, tmax, &t, &t1)) return tr;
+  MediaDda it;
+  if (!media_dda_start(m, r, tmax, &it)) return tr;
   float3 sigma_t = media_sigma_t(m);
-  while (true) {
-    t += media_exp_step(sigma_bar, rng);
-    if (t >= t1) return tr;
-    float d = media_density(sc, m, r.org + t * r.dir);
+  float sigma_bar;
+  while (media_dda_collision(sc, &it, rng, &sigma_bar)) {
+    float d = media_density(sc, m, r.org + it.t * r.dir);
     tr *= fmax(1.0f - d * sigma_t / sigma_bar, 0.0f);
     if (max_component(tr) <= 0.0f) return tr;
   }
+  return tr;
 }
 
 // Transmittance of a shadow ray from r.org (in the media of `start`) to distance tmax

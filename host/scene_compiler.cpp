@@ -122,6 +122,9 @@ void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
   for (int i = 0; i < 256; ++i) b->srgb_to_linear.push_back(dev::srgb_to_linear(i / 255.0f));
 }
 
+// Majorant cells per axis of a density grid (fewer where the grid has fewer cells)
+constexpr int kMajorantCells = 16;
+
 dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
   dev::Medium d{};
   for (int c = 0; c < 3; ++c) {
@@ -134,19 +137,43 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
   d.density_scale = m.density_scale;
   if (m.is_grid()) {
     d.type = MEDIUM_GRID;
-    if (b->densities.size() + m.density.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+    if (b->densities.size() + m.density.size() + kMajorantCells * kMajorantCells * kMajorantCells > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
     d.grid_offset = uint32_t(b->densities.size());
     b->densities.insert(b->densities.end(), m.density.begin(), m.density.end());
-    float max_density = *std::max_element(m.density.begin(), m.density.end());
     glm::vec3 sigma_t = m.sigma_a + m.sigma_s;
-    // A bound of sigma_t over the box (trilinear values never exceed the largest node),
-    // a little above it so that rounding never makes a null-collision weight negative
-    d.majorant = m.density_scale * max_density * std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * 1.0001f;
+    // Bounds of sigma_t: trilinear values never exceed their largest node, and a little
+    // margin keeps rounding from making a null-collision weight negative
+    float scale = m.density_scale * std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * 1.0001f;
+    d.majorant = scale * *std::max_element(m.density.begin(), m.density.end());
     for (int k = 0; k < 3; ++k) {
       d.grid_size[k] = uint32_t(m.grid_size[k]);
       d.grid_min[k] = m.grid_min[k];
       d.grid_max[k] = m.grid_max[k];
     }
+    // The majorant grid: up to kMajorantCells cells per axis splitting the box evenly, each
+    // the largest node of the grid cells it overlaps
+    glm::ivec3 cells = glm::min(m.grid_size - 1, glm::ivec3(kMajorantCells));
+    d.majorant_offset = uint32_t(b->densities.size());
+    for (int k = 0; k < 3; ++k) d.majorant_size[k] = uint32_t(cells[k]);
+    auto node_range = [&](int axis, int c, int* lo, int* hi) {
+      double n = m.grid_size[axis] - 1;
+      *lo = int(std::floor(double(c) / cells[axis] * n));
+      *hi = std::min(int(std::ceil(double(c + 1) / cells[axis] * n)), m.grid_size[axis] - 1);
+    };
+    for (int cz = 0; cz < cells.z; ++cz)
+      for (int cy = 0; cy < cells.y; ++cy)
+        for (int cx = 0; cx < cells.x; ++cx) {
+          int x0, x1, y0, y1, z0, z1;
+          node_range(0, cx, &x0, &x1);
+          node_range(1, cy, &y0, &y1);
+          node_range(2, cz, &z0, &z1);
+          float peak = 0.0f;
+          for (int z = z0; z <= z1; ++z)
+            for (int y = y0; y <= y1; ++y)
+              for (int x = x0; x <= x1; ++x)
+                peak = std::max(peak, m.density[(size_t(z) * m.grid_size.y + y) * m.grid_size.x + x]);
+          b->densities.push_back(scale * peak);
+        }
   }
   return d;
 }

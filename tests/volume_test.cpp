@@ -550,12 +550,14 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
   GltfBuilder g;
   const glm::vec3 sigma_t(0.6f, 1.2f, 2.4f);
   json medium = medium_json(glm::vec3(0.6f, 1.2f, 2.4f) * 0.5f, sigma_t * 0.5f);
-  // density(x) = 0.2 + 0.8 (x + 1) / 2 on [-1, 1], nodes at x = -1 and 1
+  // density(x) = 0.2 + 0.8 (x + 1) / 2 on [-1, 1], 9 nodes along x (8 majorant cells, so
+  // the walk through the majorant grid is exercised), 2 along y and z
   std::vector<float> density;
+  const int nx = 9;
   for (int z = 0; z < 2; ++z)
     for (int y = 0; y < 2; ++y)
-      for (int x = 0; x < 2; ++x) density.push_back(x == 0 ? 0.2f : 1.0f);
-  medium["grid"] = {{"size", {2, 2, 2}}, {"min", {-1, -1, -1}}, {"max", {1, 1, 1}}, {"density", density}};
+      for (int x = 0; x < nx; ++x) density.push_back(0.2f + 0.8f * float(x) / float(nx - 1));
+  medium["grid"] = {{"size", {nx, 2, 2}}, {"min", {-1, -1, -1}}, {"max", {1, 1, 1}}, {"density", density}};
   int box = g.add("materials", null_material(medium));
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-1.0f), glm::vec3(1.0f), box))}});
   Scene scene = load(g, "linear-grid");
@@ -568,7 +570,9 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
     double tmax;
   };
   glm::dvec3 oblique = glm::normalize(glm::dvec3(1.0, 0.3, -0.2));
-  for (const Case& c : {Case{{-0.5, 0.1, 0.0}, {1, 0, 0}, 1.2}, Case{{-0.9, -0.2, 0.1}, oblique, INFINITY}}) {
+  glm::dvec3 backward = glm::normalize(glm::dvec3(-1.0, -0.4, 0.5));
+  for (const Case& c : {Case{{-0.5, 0.1, 0.0}, {1, 0, 0}, 1.2}, Case{{-0.9, -0.2, 0.1}, oblique, INFINITY},
+                        Case{{0.8, 0.3, -0.2}, backward, INFINITY}}) {
     const size_t n = 1 << 16;
     cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
     cl::Kernel k(rig.program, "test_media_transmittance");
