@@ -17,6 +17,7 @@
 #define MATERIAL_THIN_WALLED 2u  // transmission through a sheet (no KHR_materials_volume)
 #define MATERIAL_ALPHA_MASK 4u  // alphaMode MASK: cut out below alpha_cutoff
 #define MATERIAL_ALPHA_BLEND 8u  // alphaMode BLEND: stochastic opacity
+#define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
 
 // Texture slots of a material (Material.textures)
 #define TEX_BASE_COLOR 0
@@ -74,6 +75,11 @@
 #define NO_TEXTURE (-1)
 #define NO_LIGHT (-1)
 #define NO_MEDIUM (-1)
+#define GLOBAL_MEDIUM 0  // media[0] fills the scene (a vacuum record when none is declared)
+
+// Medium types (media.cl)
+#define MEDIUM_HOMOGENEOUS 0u
+#define MEDIUM_GRID 1u  // coefficients scaled by a density grid (trilinear), delta tracking
 
 // BVH node, 32 bytes; its encoding is private to bvh_builder.cpp and bvh_traverse.cl.
 typedef struct {
@@ -110,7 +116,7 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Material, 448 bytes. Colours are linear RGB; factors multiply their texture slots.
+// Material, 464 bytes. Colours are linear RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;  // MATERIAL_*
   unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
@@ -124,6 +130,8 @@ typedef struct {
   float metallic, roughness, transmission, normal_scale;
   float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
   TextureRef textures[TEX_SLOTS];  // TEX_* slots
+  int medium;  // the medium inside a closed surface (into `media`), or NO_MEDIUM
+  unsigned int pad[3];
 } Material;
 
 // A texture inside one of the shared texel arrays, 16 bytes.
@@ -180,6 +188,26 @@ typedef struct {
   float radiance[4];  // rgb
   float params[8];  // per-type parameters, see above
 } Light;
+
+// A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
+// RGB at density 1; MEDIUM_GRID multiplies them by the density at the point (grid value x
+// density_scale). `emission` is radiance emitted per unit length (the lecture's L_e(z)).
+typedef struct {
+  float sigma_a[4];  // absorption, rgb (w unused)
+  float sigma_s[4];  // scattering, rgb
+  float emission[4];  // emitted radiance per unit length, rgb
+  float g;  // Henyey-Greenstein asymmetry, in (-1, 1)
+  unsigned int type;  // MEDIUM_*
+  float density_scale;  // MEDIUM_GRID: density = scale x grid value
+  float majorant;  // MEDIUM_GRID: bound of density x max channel of sigma_t over the box
+  unsigned int grid_offset;  // MEDIUM_GRID: first value in `densities`, x fastest, then y, z
+  unsigned int grid_size[3];  // MEDIUM_GRID: nodes along x, y, z (each >= 2)
+  float grid_min[4];  // MEDIUM_GRID: the box the nodes span (w unused); density 0 outside
+  float grid_max[4];
+  unsigned int majorant_offset;  // MEDIUM_GRID: first majorant cell in `densities`
+  unsigned int majorant_size[3];  // MEDIUM_GRID: cells along x, y, z splitting the box evenly;
+                                  // each holds a bound of sigma_t over its part of the box
+} Medium;
 
 // Camera, 64 bytes. Pixel (x, y) in [-1, 1]^2 (x right, y up) maps to
 //   CAMERA_PERSPECTIVE:  direction forward + x right + y up from origin, with right and
@@ -244,6 +272,8 @@ typedef struct {
   X(Light, lights)           \
   X(AliasBin, light_alias)  \
   X(float, env_distribution) \
+  X(Medium, media)           \
+  X(float, densities)        \
   X(float, ggx_albedo)
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
@@ -256,17 +286,21 @@ typedef struct {
   FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
-  SIZE(Material, 448) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \
+  SIZE(Material, 464) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \
   FIELD(Material, emission, 32) FIELD(Material, specular_color, 48)                         \
   FIELD(Material, conductor_k, 80) FIELD(Material, metallic, 96)                            \
   FIELD(Material, clearcoat, 112) FIELD(Material, anisotropy_rotation, 124)                 \
-  FIELD(Material, textures, 128)                                                            \
+  FIELD(Material, textures, 128) FIELD(Material, medium, 448)                               \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
   SIZE(TexelF, 16)                                                                          \
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
+  SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
+  FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68) FIELD(Medium, grid_min, 80)       \
+  FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)                           \
+  FIELD(Medium, majorant_size, 116)                                                         \
   SIZE(Camera, 64) FIELD(Camera, type, 12) FIELD(Camera, forward, 16)                      \
   FIELD(Camera, lens_radius, 28) FIELD(Camera, right, 32) FIELD(Camera, focus_distance, 44) \
   FIELD(Camera, up, 48) FIELD(Camera, pad0, 60)                                             \

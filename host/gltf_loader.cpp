@@ -18,6 +18,7 @@
 
 #include "environment.hpp"
 #include "error.hpp"
+#include "vdb_grid.hpp"
 
 namespace candela {
 namespace {
@@ -221,6 +222,67 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
   return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// A medium from candela's extras: {"sigma_a": [r, g, b], "sigma_s": [r, g, b], "g": g,
+// "emission": [r, g, b], "density_scale": s, "grid": {"size": [nx, ny, nz], "min": [x, y, z],
+// "max": [x, y, z], "density": [nx ny nz values, x fastest]}}; every entry optional
+MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir) {
+  if (!v.IsObject()) throw Error(where + " must be an object");
+  MediumDesc m;
+  auto rgb = [&](const char* key, glm::vec3* out) {
+    if (!v.Has(key)) return;
+    const tinygltf::Value& a = v.Get(key);
+    if (!a.IsArray() || a.ArrayLen() != 3) throw Error(where + "." + key + " must be an array of 3 numbers");
+    for (int c = 0; c < 3; ++c) {
+      (*out)[c] = float(number_or(v, key, c, -1.0));
+      if (!((*out)[c] >= 0.0f) || !std::isfinite((*out)[c]))
+        throw Error(where + "." + key + " must hold finite non-negative numbers");
+    }
+  };
+  rgb("sigma_a", &m.sigma_a);
+  rgb("sigma_s", &m.sigma_s);
+  rgb("emission", &m.emission);
+  m.g = float(number_or(v, "g", -1, 0.0));
+  if (!(std::fabs(m.g) < 1.0f)) throw Error(where + ".g must lie in (-1, 1)");
+  m.density_scale = float(number_or(v, "density_scale", -1, 1.0));
+  if (!(m.density_scale >= 0.0f) || !std::isfinite(m.density_scale))
+    throw Error(where + ".density_scale must be finite and non-negative");
+  if (!v.Has("grid")) return m;
+  const tinygltf::Value& grid = v.Get("grid");
+  std::string gw = where + ".grid";
+  if (grid.Has("nanovdb")) {  // {"nanovdb": "file.nvdb", "name": "density"}, relative to the glTF file
+    const tinygltf::Value& file = grid.Get("nanovdb");
+    if (!file.IsString() || file.Get<std::string>().empty()) throw Error(gw + ".nanovdb must name a file");
+    if (base_dir.empty()) throw Error(gw + ".nanovdb: a scene loaded from memory cannot name files");
+    std::string name = grid.Has("name") && grid.Get("name").IsString() ? grid.Get("name").Get<std::string>() : "";
+    std::filesystem::path path(file.Get<std::string>());
+    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+    load_nanovdb_density(path.string(), name, &m);
+    return m;
+  }
+  size_t count = 1;
+  for (int k = 0; k < 3; ++k) {
+    double n = number_or(grid, "size", k, 0.0);
+    if (!(n >= 2.0 && n <= 1024.0) || n != std::floor(n)) throw Error(gw + ".size must hold 3 integers in [2, 1024]");
+    m.grid_size[k] = int(n);
+    count *= size_t(n);
+    m.grid_min[k] = float(number_or(grid, "min", k, NAN));
+    m.grid_max[k] = float(number_or(grid, "max", k, NAN));
+    if (!(m.grid_min[k] < m.grid_max[k]) || !std::isfinite(m.grid_min[k]) || !std::isfinite(m.grid_max[k]))
+      throw Error(gw + ": min and max must be finite with min < max on every axis");
+  }
+  if (!grid.Has("density") || !grid.Get("density").IsArray() || grid.Get("density").ArrayLen() != count)
+    throw Error(gw + ".density must be an array of size[0] x size[1] x size[2] numbers");
+  const tinygltf::Value& d = grid.Get("density");
+  m.density.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    const tinygltf::Value& x = d.Get(int(i));
+    m.density[i] = x.IsNumber() ? float(x.GetNumberAsDouble()) : -1.0f;
+    if (!(m.density[i] >= 0.0f) || !std::isfinite(m.density[i]))
+      throw Error(gw + ".density must hold finite non-negative numbers");
+  }
+  return m;
+}
+
 // KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv, and its texCoord
 void read_texture_transform(const tinygltf::Value& ext, TextureSlot* ref) {
   float ox = float(number_or(ext, "offset", 0, 0.0)), oy = float(number_or(ext, "offset", 1, 0.0));
@@ -275,9 +337,10 @@ PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, W
 class MaterialReader {
  public:
   // `image_errors`: why each image that load_checked_image left empty was not decoded
+  // `base_dir`: where files a medium names (NanoVDB grids) are found; empty: nowhere
   MaterialReader(const tinygltf::Model& model, const std::map<int, std::string>& image_errors, Scene* scene,
-                 Warnings* warn)
-      : model_(model), image_errors_(image_errors), scene_(scene), warn_(*warn) {}
+                 Warnings* warn, const std::string& base_dir)
+      : model_(model), image_errors_(image_errors), scene_(scene), warn_(*warn), base_dir_(base_dir) {}
 
   // Reads every material, then the default one (index = model's material count)
   void read_all() {
@@ -312,6 +375,7 @@ class MaterialReader {
     m.alpha_cutoff = float(gm.alphaCutoff);
     read_extensions(gm, &m);
     read_extras(gm.extras, name, &m);
+    read_medium_of(gm, name, &m);
     check_ranges(name, &m);
     warn_unsupported(gm);
     return m;
@@ -336,8 +400,8 @@ class MaterialReader {
     value_slot(m, TEX_TRANSMISSION, tr, "transmissionTexture", false);
     const tinygltf::Value& vol = extension(gm, "KHR_materials_volume");
     m->thin_walled = !(number_or(vol, "thicknessFactor", -1, 0.0) > 0.0);
-    if (vol.Has("attenuationDistance") || vol.Has("attenuationColor"))
-      warn_.add("KHR_materials_volume attenuation is not rendered yet (the volumes issue): volumes are clear");
+    if (vol.Has("thicknessTexture"))
+      warn_.add("KHR_materials_volume thicknessTexture is not used: a path tracer traces the real thickness");
     const tinygltf::Value& cc = extension(gm, "KHR_materials_clearcoat");
     m->clearcoat = float(number_or(cc, "clearcoatFactor", -1, 0.0));
     m->clearcoat_roughness = float(number_or(cc, "clearcoatRoughnessFactor", -1, 0.0));
@@ -349,6 +413,36 @@ class MaterialReader {
     m->anisotropy_strength = float(number_or(an, "anisotropyStrength", -1, 0.0));
     m->anisotropy_rotation = float(number_or(an, "anisotropyRotation", -1, 0.0));
     value_slot(m, TEX_ANISOTROPY, an, "anisotropyTexture", false);
+  }
+
+  // The medium inside a closed surface. KHR_materials_volume (thickness > 0, transmission):
+  // absorption sigma_a = -ln(attenuationColor) / attenuationDistance, the extension's
+  // definition. extras.candela.medium adds its coefficients (scattering, emission, a grid);
+  // on a material without transmission it makes the surface a null boundary.
+  void read_medium_of(const tinygltf::Material& gm, const std::string& name, MaterialDesc* m) {
+    const tinygltf::Value& vol = extension(gm, "KHR_materials_volume");
+    bool has_extra = gm.extras.Has("candela") && gm.extras.Get("candela").Has("medium");
+    MediumDesc md;
+    if (has_extra) md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", base_dir_);
+    bool solid = m->transmission > 0.0f && !m->thin_walled;
+    if (solid) {
+      double distance = number_or(vol, "attenuationDistance", -1, INFINITY);
+      if (!(distance > 0.0)) throw Error(name + ": KHR_materials_volume attenuationDistance must be positive");
+      for (int c = 0; c < 3; ++c) {
+        double color = number_or(vol, "attenuationColor", c, 1.0);
+        if (!(color >= 0.0 && color <= 1.0)) throw Error(name + ": KHR_materials_volume attenuationColor must lie in [0, 1]");
+        if (std::isfinite(distance)) md.sigma_a[c] += float(color > 0.0 ? -std::log(color) / distance : 1e30);
+      }
+    } else if (has_extra && m->transmission > 0.0f) {
+      warn_.add(name + ": a thin-walled material (no KHR_materials_volume thickness) has no interior: its medium is ignored");
+      return;
+    } else if (has_extra) {
+      m->null_boundary = true;
+    }
+    bool empty = md.sigma_a == glm::vec3(0.0f) && md.sigma_s == glm::vec3(0.0f) && md.emission == glm::vec3(0.0f);
+    if (!has_extra && empty) return;  // clear glass: vacuum inside
+    m->medium = int(scene_->media.size());
+    scene_->media.push_back(std::move(md));
   }
 
   // extras.candela.conductor: a preset name or {"eta": [r, g, b], "k": [r, g, b]}
@@ -527,6 +621,7 @@ class MaterialReader {
   const std::map<int, std::string>& image_errors_;
   Scene* scene_;
   Warnings& warn_;
+  std::string base_dir_;
   std::map<std::pair<int, bool>, int> texture_cache_;
 };
 
@@ -723,8 +818,8 @@ class MeshReader {
 // The default scene's node trees: transforms, meshes, the first camera, scene extras
 class NodeReader {
  public:
-  NodeReader(const tinygltf::Model& model, Scene* scene, Warnings* warn)
-      : model_(model), scene_(scene), warn_(*warn), meshes_(model, scene, warn) {}
+  NodeReader(const tinygltf::Model& model, Scene* scene, Warnings* warn, const std::string& base_dir)
+      : model_(model), scene_(scene), warn_(*warn), base_dir_(base_dir), meshes_(model, scene, warn) {}
 
   void read_scene() {
     std::vector<int> roots;
@@ -760,6 +855,15 @@ class NodeReader {
       if (!st.IsString() || (st.Get<std::string>() != "nee" && st.Get<std::string>() != "bsdf" && st.Get<std::string>() != "auto"))
         throw Error("scene extras candela.strategy must be \"nee\", \"bsdf\" or \"auto\"");
       scene_->strategy = st.Get<std::string>();
+    }
+    if (c.Has("medium")) {
+      MediumDesc m = read_medium(c.Get("medium"), "scene extras candela.medium", base_dir_);
+      // An infinite ray through a global medium gathers emission / sigma_t: finite only where sigma_t > 0
+      for (int k = 0; k < 3; ++k)
+        if (m.emission[k] > 0.0f && !m.is_grid() && !(m.sigma_a[k] + m.sigma_s[k] > 0.0f))
+          throw Error("scene extras candela.medium: an emitting channel needs sigma_a + sigma_s > 0 (rays reach infinity)");
+      scene_->global_medium = int(scene_->media.size());
+      scene_->media.push_back(std::move(m));
     }
     if (!c.Has("background")) return;
     const tinygltf::Value& bg = c.Get("background");
@@ -894,6 +998,7 @@ class NodeReader {
   const tinygltf::Model& model_;
   Scene* scene_;
   Warnings& warn_;
+  std::string base_dir_;
   MeshReader meshes_;
   std::vector<bool> visited_;  // nodes reached so far
 };
@@ -1114,8 +1219,8 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   }
   Warnings warnings(&scene.warnings);
   warn_model_wide(model, &warnings);
-  MaterialReader(model, image_errors, &scene, &warnings).read_all();
-  NodeReader(model, &scene, &warnings).read_scene();
+  MaterialReader(model, image_errors, &scene, &warnings, base_dir).read_all();
+  NodeReader(model, &scene, &warnings, base_dir).read_scene();
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
   if (scene.environment) {
     // The environment map's file, beside the glTF file; none is read from memory alone

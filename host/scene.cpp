@@ -11,7 +11,7 @@ std::string SceneFeatures::build_options() const {
   auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
   return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
          flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
-         flag("CD_FEATURE_ALPHA", alpha);
+         flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media);
 }
 
 bool MaterialDesc::alpha_tested() const {
@@ -62,7 +62,9 @@ SceneFeatures Scene::features() const {
     f.tangents |= !m.tangents.empty();
     for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
     f.alpha |= materials.at(m.material).alpha_tested();
+    f.media |= materials.at(m.material).medium >= 0;
   }
+  f.media |= global_medium >= 0;
   return f;
 }
 

@@ -23,6 +23,20 @@ struct TextureSlot {
 
 enum class AlphaMode { Opaque, Mask, Blend };
 
+// A participating medium (cl/media.cl): coefficients per unit length in linear RGB.
+// With a density grid the coefficients and the emission are scaled by the density at the
+// point (trilinear between the grid's nodes, which span [grid_min, grid_max] in world space).
+struct MediumDesc {
+  glm::vec3 sigma_a{0.0f}, sigma_s{0.0f};
+  glm::vec3 emission{0.0f};  // radiance emitted per unit length (the lecture's L_e(z))
+  float g = 0.0f;  // Henyey-Greenstein asymmetry, in (-1, 1)
+  glm::ivec3 grid_size{0};  // nodes along x, y, z (each >= 2) when there is a grid
+  std::vector<float> density;  // grid values, x fastest, then y, then z; empty: homogeneous
+  glm::vec3 grid_min{0.0f}, grid_max{0.0f};
+  float density_scale = 1.0f;
+  bool is_grid() const { return !density.empty(); }
+};
+
 // A material as glTF describes it (defaults: the glTF specification's), or a measured
 // conductor; factors multiply the textures of the same name
 struct MaterialDesc {
@@ -42,6 +56,10 @@ struct MaterialDesc {
   bool double_sided = false;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
+  int medium = -1;  // into Scene::media: what fills the closed surface (KHR_materials_volume
+                    // attenuation, extras.candela.medium); -1: vacuum
+  bool null_boundary = false;  // extras.candela.medium without transmission: the surface is
+                               // invisible and only bounds its medium
   TextureSlot textures[TEX_SLOTS];  // TEX_* slots
   const TextureSlot& texture(int slot) const { return textures[slot]; }
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
@@ -133,6 +151,7 @@ struct SceneFeatures {
   bool tangents = false;  // some mesh has TANGENT
   bool vertex_colors = false;  // some COLOR_0 is not white
   bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
+  bool media = false;  // a global medium, or a mesh whose material has an interior medium
   std::string build_options() const;
   // Every flag on: the generic kernel, correct for any scene (--generic)
   static SceneFeatures all() { return {true, true, true, true, true}; }
@@ -147,6 +166,8 @@ struct Scene {
   glm::vec3 background{0.0f};  // constant environment radiance
   std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
   std::optional<EnvironmentDesc> environment;  // a map; when present, background is not used
+  std::vector<MediumDesc> media;  // the global medium and the materials' interiors
+  int global_medium = -1;  // into media: what fills the scene (scene extras); -1: vacuum
   std::vector<std::string> warnings;  // each unsupported feature named once
 
   size_t triangles() const;

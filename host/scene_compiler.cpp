@@ -76,6 +76,8 @@ void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
     d.flags = (m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.thin_walled ? MATERIAL_THIN_WALLED : 0u) |
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
+    d.flags |= m.null_boundary ? MATERIAL_NULL_BOUNDARY : 0u;
+    d.medium = NO_MEDIUM;  // compile_media sets the insides of closed surfaces
     d.alpha_cutoff = m.alpha_cutoff;
     d.ior = m.ior;
     for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
@@ -119,6 +121,88 @@ void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
     b->textures.push_back(info);
   }
   for (int i = 0; i < 256; ++i) b->srgb_to_linear.push_back(dev::srgb_to_linear(i / 255.0f));
+}
+
+// Majorant cells per axis of a density grid (fewer where the grid has fewer cells)
+constexpr int kMajorantCells = 16;
+
+dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
+  dev::Medium d{};
+  for (int c = 0; c < 3; ++c) {
+    d.sigma_a[c] = m.sigma_a[c];
+    d.sigma_s[c] = m.sigma_s[c];
+    d.emission[c] = m.emission[c];
+  }
+  d.g = m.g;
+  d.type = MEDIUM_HOMOGENEOUS;
+  d.density_scale = m.density_scale;
+  if (m.is_grid()) {
+    d.type = MEDIUM_GRID;
+    if (b->densities.size() + m.density.size() + kMajorantCells * kMajorantCells * kMajorantCells > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+    d.grid_offset = uint32_t(b->densities.size());
+    b->densities.insert(b->densities.end(), m.density.begin(), m.density.end());
+    glm::vec3 sigma_t = m.sigma_a + m.sigma_s;
+    // Bounds of sigma_t: trilinear values never exceed their largest node, and a little
+    // margin keeps rounding from making a null-collision weight negative
+    float scale = m.density_scale * std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * 1.0001f;
+    d.majorant = scale * *std::max_element(m.density.begin(), m.density.end());
+    for (int k = 0; k < 3; ++k) {
+      d.grid_size[k] = uint32_t(m.grid_size[k]);
+      d.grid_min[k] = m.grid_min[k];
+      d.grid_max[k] = m.grid_max[k];
+    }
+    // The majorant grid: up to kMajorantCells cells per axis splitting the box evenly, each
+    // the largest node of the grid cells it overlaps
+    glm::ivec3 cells = glm::min(m.grid_size - 1, glm::ivec3(kMajorantCells));
+    d.majorant_offset = uint32_t(b->densities.size());
+    for (int k = 0; k < 3; ++k) d.majorant_size[k] = uint32_t(cells[k]);
+    auto node_range = [&](int axis, int c, int* lo, int* hi) {
+      double n = m.grid_size[axis] - 1;
+      *lo = int(std::floor(double(c) / cells[axis] * n));
+      *hi = std::min(int(std::ceil(double(c + 1) / cells[axis] * n)), m.grid_size[axis] - 1);
+    };
+    for (int cz = 0; cz < cells.z; ++cz)
+      for (int cy = 0; cy < cells.y; ++cy)
+        for (int cx = 0; cx < cells.x; ++cx) {
+          int x0, x1, y0, y1, z0, z1;
+          node_range(0, cx, &x0, &x1);
+          node_range(1, cy, &y0, &y1);
+          node_range(2, cz, &z0, &z1);
+          float peak = 0.0f;
+          for (int z = z0; z <= z1; ++z)
+            for (int y = y0; y <= y1; ++y)
+              for (int x = x0; x <= x1; ++x)
+                peak = std::max(peak, m.density[(size_t(z) * m.grid_size.y + y) * m.grid_size.x + x]);
+          b->densities.push_back(scale * peak);
+        }
+  }
+  return d;
+}
+
+// media[GLOBAL_MEDIUM] is the scene's global medium (a vacuum record when it has none);
+// then every MediumDesc; then, when needed, one vacuum record for the insides of clear solids
+// (so that fog does not fill a glass ball). Material.medium is set for closed surfaces that
+// rays cross: transmissive solids and null boundaries.
+void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b) {
+  if (!f.media) return;  // the kernel reads neither buffer nor Material.medium
+  b->media.push_back(scene.global_medium >= 0 ? compile_medium(scene.media[size_t(scene.global_medium)], b)
+                                              : dev::Medium{});
+  for (const MediumDesc& m : scene.media) b->media.push_back(compile_medium(m, b));
+  int vacuum = NO_MEDIUM;
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const MaterialDesc& m = scene.materials[i];
+    bool crossed = m.null_boundary || (m.transmission > 0.0f && !m.thin_walled);
+    if (!crossed) continue;
+    if (m.medium >= 0) {
+      b->materials[i].medium = 1 + m.medium;
+      continue;
+    }
+    if (vacuum == NO_MEDIUM) {
+      vacuum = int(b->media.size());
+      b->media.push_back(dev::Medium{});
+    }
+    b->materials[i].medium = vacuum;
+  }
 }
 
 glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {
@@ -357,6 +441,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);
   compile_textures(scene, &c.buffers);
+  compile_media(scene, c.features, &c.buffers);
   c.environment_light = compile_lights(scene, &c.buffers);
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;

@@ -864,6 +864,207 @@ def make_many_lights(path):
 
 
 # ---------------------------------------------------------------------------
+# Volumes
+
+def oriented(tri, wanted):
+    """Triangle (a, b, c) wound so that its front faces direction `wanted`."""
+    a, b, c = tri
+    return tri if dot(cross(sub(b, a), sub(c, a)), wanted) > 0 else (a, c, b)
+
+
+def box_tris(lo, hi, inward=False):
+    """Twelve triangles of the axis-aligned box [lo, hi], fronts outward (or inward)."""
+    centre = scale(add(lo, hi), 0.5)
+    size = sub(hi, lo)
+    tris = []
+    for tri in cube(1.0):
+        moved = tuple(f32v([centre[k] + size[k] * p[k] for k in range(3)]) for p in tri)
+        tris.append((moved[0], moved[2], moved[1]) if inward else moved)
+    return tris
+
+
+def wall_with_window(x, lo, hi, window):
+    """The wall x = const spanning y, z in lo..hi (pairs) around a window
+    (y0, y1, z0, z1), as quads facing +x."""
+    (y_lo, z_lo), (y_hi, z_hi) = lo, hi
+    y0, y1, z0, z1 = window
+    rects = [(y_lo, y0, z_lo, z_hi), (y1, y_hi, z_lo, z_hi),
+             (y0, y1, z_lo, z0), (y0, y1, z1, z_hi)]
+    tris = []
+    for a, b, c, d in rects:
+        quad = [f32v((x, a, c)), f32v((x, b, c)), f32v((x, b, d)), f32v((x, a, d))]
+        tris += quad_triangles(orient_quad(quad, (1.0, 0.0, 0.0)))
+    return tris
+
+
+def null_medium_material(g, name, medium):
+    """An invisible boundary (no transmission) around the medium in extras."""
+    return g.pbr_material(name, {"baseColorFactor": [1, 1, 1, 1]},
+                          extras={"candela": {"medium": medium}})
+
+
+def make_god_rays(path):
+    """A dusty room lit by a low sun through one window: the fog fills the room
+    (a null boundary just inside the walls) and shows the beam."""
+    g = GltfWriter(GENERATOR)
+    wall = g.material("plaster", (0.7, 0.68, 0.65, 1.0))
+    floor_mat = g.material("floor", (0.45, 0.4, 0.35, 1.0))
+    lo, hi = (-2.0, 0.0, -2.0), (2.0, 3.0, 2.0)
+    room = [t for t in box_tris(lo, hi, inward=True)
+            if not all(abs(p[0] - lo[0]) < 1e-6 for p in t)]  # the window wall apart
+    floor = [t for t in room if all(abs(p[1]) < 1e-6 for p in t)]
+    rest = [t for t in room if t not in floor]
+    g.node("walls", mesh=g.mesh("walls", *flat_mesh(rest), wall))
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(floor), floor_mat))
+    g.node("window wall", mesh=g.mesh("window wall", *flat_mesh(
+        wall_with_window(lo[0], (lo[1], lo[2]), (hi[1], hi[2]), (1.2, 2.4, -0.6, 0.6))), wall))
+    block = g.material("block", (0.6, 0.2, 0.15, 1.0))
+    g.node("block", mesh=g.mesh("block", *flat_mesh(box_tris((0.3, 0.0, -0.5), (1.1, 0.8, 0.3))), block))
+    fog = null_medium_material(g, "fog", {"sigma_a": [0.01, 0.01, 0.01],
+                                          "sigma_s": [0.2, 0.2, 0.2], "g": 0.6})
+    inset = 0.001
+    g.node("fog", mesh=g.mesh("fog", *flat_mesh(box_tris(
+        add(lo, (inset, inset, inset)), sub(hi, (inset, inset, inset)))), fog))
+    sun = g.punctual_light("sun", "directional", (1.0, 0.9, 0.75), 25.0)
+    g.light_node("sun", sun, rotation=look_at_rotation((-3.0, 3.2, 0.8), (0.0, 0.0, 0.0)))
+    eye = (1.8, 1.5, 1.8)
+    g.node("camera", camera=g.camera("camera", 1.1, 1.5), translation=list(eye),
+           rotation=look_at_rotation(eye, (-1.0, 1.0, -0.6)))
+    g.set_background([0.3, 0.4, 0.6])  # sky seen through the window
+    g.write(path)
+
+
+def cup_tris(r_out, r_in, height, bottom, segments=48):
+    """A closed glass cup: outer wall and base, inner wall and floor at
+    `bottom`, and the rim; fronts face out of the glass."""
+    tris = []
+    ring = [(math.cos(2 * math.pi * k / segments), math.sin(2 * math.pi * k / segments))
+            for k in range(segments)]
+    for k in range(segments):
+        (c0, s0), (c1, s1) = ring[k], ring[(k + 1) % segments]
+        mid = ((c0 + c1) / 2, 0.0, (s0 + s1) / 2)
+
+        def p(r, c, s, y):
+            return f32v((r * c, y, r * s))
+        ob0, ob1 = p(r_out, c0, s0, 0.0), p(r_out, c1, s1, 0.0)
+        ot0, ot1 = p(r_out, c0, s0, height), p(r_out, c1, s1, height)
+        ib0, ib1 = p(r_in, c0, s0, bottom), p(r_in, c1, s1, bottom)
+        it0, it1 = p(r_in, c0, s0, height), p(r_in, c1, s1, height)
+        centre_lo, centre_in = f32v((0.0, 0.0, 0.0)), f32v((0.0, bottom, 0.0))
+        tris += [oriented(t, mid) for t in ((ob0, ob1, ot1), (ob0, ot1, ot0))]
+        tris += [oriented(t, scale(mid, -1.0)) for t in ((ib0, ib1, it1), (ib0, it1, it0))]
+        tris.append(oriented((centre_lo, ob0, ob1), (0.0, -1.0, 0.0)))
+        tris.append(oriented((centre_in, ib0, ib1), (0.0, 1.0, 0.0)))
+        tris += [oriented(t, (0.0, 1.0, 0.0)) for t in ((ot0, ot1, it1), (ot0, it1, it0))]
+    return tris
+
+
+def cylinder_tris(radius, y0, y1, segments=48):
+    """A closed cylinder around the y axis, fronts outward."""
+    tris = []
+    for k in range(segments):
+        a0, a1 = 2 * math.pi * k / segments, 2 * math.pi * (k + 1) / segments
+        c0, s0, c1, s1 = math.cos(a0), math.sin(a0), math.cos(a1), math.sin(a1)
+        mid = ((c0 + c1) / 2, 0.0, (s0 + s1) / 2)
+        b0, b1 = f32v((radius * c0, y0, radius * s0)), f32v((radius * c1, y0, radius * s1))
+        t0, t1 = f32v((radius * c0, y1, radius * s0)), f32v((radius * c1, y1, radius * s1))
+        tris += [oriented(t, mid) for t in ((b0, b1, t1), (b0, t1, t0))]
+        tris.append(oriented((f32v((0.0, y0, 0.0)), b0, b1), (0.0, -1.0, 0.0)))
+        tris.append(oriented((f32v((0.0, y1, 0.0)), b0, b1), (0.0, 1.0, 0.0)))
+    return tris
+
+
+def make_liquid_glass(path):
+    """A clear glass of red-orange liquid (KHR_materials_volume attenuation) on
+    a table under an area light. The liquid reaches 1 mm into the glass wall:
+    the medium stack hands the ray from glass to liquid there."""
+    g = GltfWriter(GENERATOR)
+    table = g.material("table", (0.55, 0.55, 0.5, 1.0))
+    s = 3.0
+    top = [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)]
+    g.node("table", mesh=g.mesh("table", *flat_mesh(quad_triangles(orient_quad(top, (0.0, 1.0, 0.0)))), table))
+    light = g.material("light", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 0.95, 0.9), strength=12.0)
+    lq = [f32v(p) for p in ((-0.5, 2.2, -0.9), (0.5, 2.2, -0.9), (0.5, 2.2, 0.1), (-0.5, 2.2, 0.1))]
+    g.node("light", mesh=g.mesh("light", *flat_mesh(quad_triangles(orient_quad(lq, (0.0, -1.0, 0.0)))), light))
+    volume_ext = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                  "KHR_materials_ior": {"ior": 1.5},
+                  "KHR_materials_volume": {"thicknessFactor": 0.05}}
+    glass = g.pbr_material("glass", {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0,
+                                     "roughnessFactor": 0.0}, volume_ext)
+    liquid_ext = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                  "KHR_materials_ior": {"ior": 1.33},
+                  "KHR_materials_volume": {"thicknessFactor": 0.3, "attenuationDistance": 0.15,
+                                           "attenuationColor": [0.9, 0.35, 0.08]}}
+    liquid = g.pbr_material("liquid", {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0,
+                                       "roughnessFactor": 0.0}, liquid_ext)
+    r_out, r_in, bottom = 0.32, 0.29, 0.05
+    g.node("glass", mesh=g.mesh("glass", *flat_mesh(cup_tris(r_out, r_in, 0.9, bottom)), glass))
+    g.node("liquid", mesh=g.mesh("liquid", *flat_mesh(cylinder_tris(r_in + 0.001, bottom - 0.001, 0.6)), liquid))
+    eye = (0.0, 1.1, 2.2)
+    g.node("camera", camera=g.camera("camera", 0.6, 1.0), translation=list(eye),
+           rotation=look_at_rotation(eye, (0.0, 0.4, 0.0)))
+    g.set_background([0.15, 0.16, 0.18])
+    g.write(path)
+
+
+def value_noise(x, y, z, seed):
+    """Smooth value noise in [0, 1] on the integer lattice (a hash per node)."""
+    def node(i, j, k):
+        h = (i * 73856093) ^ (j * 19349663) ^ (k * 83492791) ^ (seed * 2654435761)
+        h = (h ^ (h >> 13)) * 1274126177 & 0xFFFFFFFF
+        return ((h ^ (h >> 16)) & 0xFFFF) / 65535.0
+    i, j, k = math.floor(x), math.floor(y), math.floor(z)
+    fx, fy, fz = x - i, y - j, z - k
+    sx, sy, sz = (f * f * (3 - 2 * f) for f in (fx, fy, fz))
+
+    def lerp(a, b, t):
+        return a + (b - a) * t
+    c = [[[node(i + a, j + b, k + c_) for c_ in (0, 1)] for b in (0, 1)] for a in (0, 1)]
+    return lerp(lerp(lerp(c[0][0][0], c[1][0][0], sx), lerp(c[0][1][0], c[1][1][0], sx), sy),
+                lerp(lerp(c[0][0][1], c[1][0][1], sx), lerp(c[0][1][1], c[1][1][1], sx), sy), sz)
+
+
+def cloud_density(n, seed=7):
+    """An n^3 density grid: three octaves of value noise under a soft
+    ellipsoid falloff, 0 at the box's faces."""
+    values = []
+    for z in range(n):
+        for y in range(n):
+            for x in range(n):
+                u, v, w = (2.0 * c / (n - 1) - 1.0 for c in (x, y, z))
+                r2 = u * u + (1.6 * v) * (1.6 * v) + w * w
+                shape = max(0.0, 1.0 - r2)
+                f = sum(value_noise(u * 3 * 2 ** o + 10, v * 3 * 2 ** o, w * 3 * 2 ** o, seed + o) / 2 ** o
+                        for o in range(3)) / 1.75
+                values.append(round(max(0.0, shape * 2.0 * f - 0.15) * 1.5, 4))
+    return values
+
+
+def make_cloud(path):
+    """A procedural noise cloud (a density grid in the medium's extras) inside
+    a null-boundary box, lit by the sun over a ground plane and a sky."""
+    g = GltfWriter(GENERATOR)
+    ground = g.material("ground", (0.35, 0.4, 0.3, 1.0))
+    s = 8.0
+    plane = [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)]
+    g.node("ground", mesh=g.mesh("ground", *flat_mesh(quad_triangles(orient_quad(plane, (0.0, 1.0, 0.0)))), ground))
+    lo, hi = (-1.5, 0.6, -1.5), (1.5, 2.4, 1.5)
+    n = 24
+    medium = {"sigma_a": [0.05, 0.05, 0.05], "sigma_s": [4.0, 4.0, 4.0], "g": 0.5,
+              "grid": {"size": [n, n, n], "min": list(lo), "max": list(hi),
+                       "density": cloud_density(n)}}
+    cloud = null_medium_material(g, "cloud", medium)
+    g.node("cloud", mesh=g.mesh("cloud", *flat_mesh(box_tris(lo, hi)), cloud))
+    sun = g.punctual_light("sun", "directional", (1.0, 0.95, 0.85), 3.0)
+    g.light_node("sun", sun, rotation=look_at_rotation((2.0, 3.0, 1.0), (0.0, 0.0, 0.0)))
+    eye = (0.0, 1.4, 5.5)
+    g.node("camera", camera=g.camera("camera", 0.75, 1.5), translation=list(eye),
+           rotation=look_at_rotation(eye, (0.0, 1.3, 0.0)))
+    g.set_background([0.35, 0.5, 0.8])
+    g.write(path)
+
+
+# ---------------------------------------------------------------------------
 
 MAPS = [
     ("scenes/lights/sky.hdr", make_sky_map),
@@ -881,6 +1082,9 @@ SCENES = [
     ("scenes/lights/small-light.gltf", make_small_light),
     ("scenes/lights/large-light-glossy.gltf", make_large_light_glossy),
     ("scenes/lights/many-lights.gltf", make_many_lights),
+    ("scenes/volumes/god-rays.gltf", make_god_rays),
+    ("scenes/volumes/liquid-glass.gltf", make_liquid_glass),
+    ("scenes/volumes/cloud.gltf", make_cloud),
 ]
 
 

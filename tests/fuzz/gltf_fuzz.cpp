@@ -41,6 +41,15 @@ void check_compiled(const candela::CompiledScene& c) {
       require(t->index == NO_TEXTURE || (t->index >= 0 && size_t(t->index) < b.textures.size()), "texture index");
       require(t->index == NO_TEXTURE || t->texcoord <= 1, "texcoord set");
     }
+  for (const auto& m : b.materials) {
+    require(m.medium == NO_MEDIUM || (m.medium >= 0 && size_t(m.medium) < b.media.size()), "material medium index");
+  }
+  for (const auto& m : b.media) {
+    if (m.type != MEDIUM_GRID) continue;
+    size_t n = size_t(m.grid_size[0]) * m.grid_size[1] * m.grid_size[2];
+    require(m.grid_size[0] >= 2 && m.grid_size[1] >= 2 && m.grid_size[2] >= 2, "grid size");
+    require(size_t(m.grid_offset) + n <= b.densities.size(), "grid densities");
+  }
   for (const auto& t : b.textures) {
     size_t texels = (t.flags & TEXTURE_FLOAT) ? b.texelsf.size() : b.texels8.size();
     require(t.width > 0 && t.height > 0, "texture size");
