@@ -42,7 +42,7 @@ PathState path_start(Ray ray) {
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
                          float3 wo, bool delta_only, Rng* rng) {
   uint x_select = rng_next_uint(rng);
-  float2 u = (float2)(rng_next(rng), rng_next(rng));
+  float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
   if (delta_only && !ls.is_delta) return (float3)(0.0f);
@@ -109,7 +109,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 
     // Continue the path by sampling the BSDF
     float uc = rng_next(rng);
-    float2 u = (float2)(rng_next(rng), rng_next(rng));
+    float2 u = rng_next_2d(rng);
     BsdfSample bs;
     if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
     ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
