@@ -85,7 +85,7 @@ float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
                          float3 wo, bool delta_only, const MediumStack* media, int interior, Rng* rng) {
   uint x_select = rng_next_uint(rng);
-  float2 u = (float2)(rng_next(rng), rng_next(rng));
+  float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
   if (delta_only && !ls.is_delta) return (float3)(0.0f);
@@ -123,7 +123,7 @@ float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 w
   ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
   ctx.transmits = true;
   uint x_select = rng_next_uint(rng);
-  float2 u = (float2)(rng_next(rng), rng_next(rng));
+  float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, &ctx, x_select, u, &ls)) return (float3)(0.0f);
   float3 contrib = ls.radiance * (phase_eval(g, wo, ls.wi) / ls.pdf);
@@ -144,7 +144,7 @@ int path_medium_step(const SceneData* sc, PathState* ps, float tmax, bool nee, R
   float g = sc->media[ps->medium].g;
   float3 wo = -ps->ray.dir;
   if (nee) ps->radiance += ps->beta * path_medium_direct_light(sc, p, g, wo, &ps->media, rng);
-  float2 u = (float2)(rng_next(rng), rng_next(rng));
+  float2 u = rng_next_2d(rng);
   float pdf;
   float3 wi = phase_sample(g, wo, u, &pdf);  // exact sampling: the weight f / pdf is 1
   ps->specular_bounce = !nee;  // emission found next counts unless light sampling took it
@@ -211,7 +211,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 
     // Continue the path by sampling the BSDF
     float uc = rng_next(rng);
-    float2 u = (float2)(rng_next(rng), rng_next(rng));
+    float2 u = rng_next_2d(rng);
     BsdfSample bs;
     if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
     ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal

@@ -52,6 +52,7 @@ struct RenderArgs {
   std::optional<float> fov;  // degrees
   std::optional<float> aperture, focus_distance;
   std::string filter = "box";
+  std::string sampler = "sobol";
   bool quiet = false;
   std::string variance;  // --variance: variance-of-the-mean image (host/image_stats.hpp)
   bool generic = false;  // --generic: the kernel with every scene feature compiled in
@@ -165,6 +166,12 @@ PixelFilter parse_filter(const std::string& name) {
   throw Error("--filter must be box, tent or gaussian, not '" + name + "'");
 }
 
+Sampler parse_sampler(const std::string& name) {
+  if (name == "sobol") return Sampler::Sobol;
+  if (name == "independent") return Sampler::Independent;
+  throw Error("--sampler must be sobol or independent, not '" + name + "'");
+}
+
 Strategy parse_strategy(const std::string& name) {
   if (name == "nee") return Strategy::Nee;
   if (name == "bsdf") return Strategy::Bsdf;
@@ -266,6 +273,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"strategy", a.strategy},
                       {"energy_compensation", settings.energy_compensation},
                       {"filter", a.filter},
+                      {"sampler", a.sampler},
                       {"max_depth", a.max_depth},
                       {"seed", a.seed},
                       {"interrupted", r.interrupted},
@@ -279,6 +287,7 @@ int run_render(RenderArgs a) {
   RenderSettings settings;
   if (!a.strategy.empty()) parse_strategy(a.strategy);  // a bad name fails before loading
   settings.filter = parse_filter(a.filter);
+  settings.sampler = parse_sampler(a.sampler);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
   check_variance_path(a);
@@ -315,7 +324,8 @@ int run_render(RenderArgs a) {
       {"device", device.description()},        {"seed", std::to_string(a.seed)},
       {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
       {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene},
-      {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter}};
+      {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter},
+      {"sampler", a.sampler}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
@@ -367,6 +377,8 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
                      "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
                      "camera's extras, else the scene bounds' centre)");
   render->add_option("--filter", a.filter, "Pixel filter: box (default), tent (radius 1 pixel) or gaussian (sigma 0.5 pixel)");
+  render->add_option("--sampler", a.sampler,
+                     "Random numbers: sobol (Owen-scrambled Sobol, stratified; default) or independent");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
   add_accuracy_render_options(render, &a);
   return render;

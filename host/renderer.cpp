@@ -68,6 +68,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
   std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
+  options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
   ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;

@@ -23,6 +23,10 @@ enum class Strategy : uint32_t { Nee = STRATEGY_NEE, Bsdf = STRATEGY_BSDF, Auto 
 // Pixel filter, importance-sampled by the kernel (cl/filter.cl)
 enum class PixelFilter : uint32_t { Box = FILTER_BOX, Tent = FILTER_TENT, Gaussian = FILTER_GAUSSIAN };
 
+// Where the kernels' random numbers come from (cl/rng.cl): Owen-scrambled Sobol
+// (stratified) or independent hashes; a build option of the kernel program
+enum class Sampler : uint32_t { Sobol, Independent };
+
 // The film's per-pixel sample count is a float: exact up to 2^24
 constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
 
@@ -34,6 +38,7 @@ struct RenderSettings {
   Strategy strategy = Strategy::Nee;
   bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/energy.cl)
   PixelFilter filter = PixelFilter::Box;
+  Sampler sampler = Sampler::Sobol;
   double launch_seconds = 0.2;  // target duration of one launch
 };
 

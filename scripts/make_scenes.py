@@ -768,8 +768,8 @@ def look_camera(g, eye, target, yfov, aspect):
 def make_veach(path):
     """Veach's (1997, fig. 9.2) layout with numbers of our own: four metal plates of
     glTF roughness 0.5, 0.3, 0.15, 0.05 (alpha 0.25 ... 0.0025), each tilted to reflect a
-    row of four spherical lights of radius 0.03, 0.1, 0.3, 0.9 and equal power
-    (radiance 2 (0.9 / r)^2) toward the camera, in front of a dark wall."""
+    row of four spherical lights of radius 0.1, 0.2, 0.4, 0.8 and equal power
+    (radiance 2 (0.8 / r)^2) toward the camera, in front of a dark wall."""
     g = GltfWriter(GENERATOR)
     eye, light_row = (0.0, 2.0, 10.0), (0.0, 4.0, -3.5)
     for k, (roughness, centre) in enumerate(zip((0.5, 0.3, 0.15, 0.05), (
@@ -778,8 +778,8 @@ def make_veach(path):
         mat = metal_pbr(g, "plate-r%.2f" % roughness, roughness)
         g.node("plate%d" % k, mesh=g.mesh("plate%d" % k, *flat_mesh(quad_triangles(
             plate_quad(centre, normal, 4.0, 0.45))), mat))
-    for k, radius in enumerate((0.03, 0.1, 0.3, 0.9)):
-        radiance = 2.0 * (0.9 / radius) ** 2
+    for k, radius in enumerate((0.1, 0.2, 0.4, 0.8)):
+        radiance = 2.0 * (0.8 / radius) ** 2
         mat = g.material("light-r%.2f" % radius, (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0),
                          strength=radiance, double_sided=False)
         g.node("light%d" % k, mesh=g.mesh("light%d" % k, *flat_mesh(icosphere(3, radius=radius)), mat),

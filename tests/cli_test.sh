@@ -52,6 +52,7 @@ expect_error "negative aperture" "aperture must be a non-negative radius" -- "$b
 expect_error "zero focus distance" "focus-distance must be a positive distance" -- "$bin" render "$scene" -o "$tmp/x.png" --focus-distance 0 --device pocl
 expect_error "negative focus distance" "focus-distance must be a positive distance" -- "$bin" render "$scene" -o "$tmp/x.png" --focus-distance -1 --device pocl
 expect_error "unknown filter" "filter must be box, tent or gaussian" -- "$bin" render "$scene" -o "$tmp/x.png" --filter lanczos --device pocl
+expect_error "unknown sampler" "sampler must be sobol or independent" -- "$bin" render "$scene" -o "$tmp/x.png" --sampler halton --device pocl
 # The Cornell box seen by an orthographic camera 0.4 wide and 0.3 high
 python3 - "$scene" "$tmp/ortho.gltf" <<'PY'
 import json, sys
@@ -243,6 +244,19 @@ PY
   else
     fail "compare: pocl and rusticl are consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
   fi
+fi
+
+# Both samplers render, and the sampler is recorded (sobol by default)
+if "$bin" render "$scene" -o "$tmp/ind.exr" --spp 2 --width 16 --height 16 --device pocl --sampler independent \
+    --stats "$tmp/ind.json" -q >/dev/null 2>"$tmp/err" &&
+  "$bin" render "$scene" -o "$tmp/sob.exr" --spp 2 --width 16 --height 16 --device pocl --stats "$tmp/sob.json" -q \
+    >/dev/null 2>>"$tmp/err" &&
+  python3 -c "import json; assert json.load(open('$tmp/ind.json'))['sampler'] == 'independent'" &&
+  python3 -c "import json; assert json.load(open('$tmp/sob.json'))['sampler'] == 'sobol'" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/ind.exr" | grep -q 'candela:sampler: "independent"'; }; then
+  pass "--sampler independent and sobol render and are recorded"
+else
+  fail "--sampler independent and sobol render and are recorded"; cat "$tmp/err"
 fi
 
 # Ctrl-C during a long render writes what was rendered and exits 130
