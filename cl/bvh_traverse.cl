@@ -15,7 +15,7 @@
 struct SceneData;
 bool scene_alpha_passes(const struct SceneData* sc, uint prim, float b1, float b2, Ray ray);
 
-bool bvh_leaf_triangle_hit(const WatertightRay* r, __global const BvhTriangle* tri, float tmax,
+CD_ALWAYS_INLINE bool bvh_leaf_triangle_hit(const WatertightRay* r, __global const BvhTriangle* tri, float tmax,
                            float* t, float* b1, float* b2) {
   return intersect_triangle(r, load3(tri->v0), load3(tri->v1), load3(tri->v2), tmax, t, b1, b2);
 }
