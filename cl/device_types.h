@@ -81,16 +81,30 @@
 #define MEDIUM_HOMOGENEOUS 0u
 #define MEDIUM_GRID 1u  // coefficients scaled by a density grid (trilinear), delta tracking
 
-// BVH node, 32 bytes; its encoding is private to bvh_builder.cpp and bvh_traverse.cl.
+// 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
+// bvh_traverse.cl. The four child boxes are stored by coordinate (structure of arrays) so
+// that one float4 operation tests a slab of all four: lo_x[i] .. hi_z[i] bound child i.
+// child[i]: >= 0 an inner node's index; < 0 a leaf, ~child[i] its first BvhTriangle (the
+// leaf runs to the triangle flagged BVH_TRI_LAST). Unused slots have lo = +1e30 > hi =
+// -1e30, which no ray enters, and child 0.
 typedef struct {
-  float bmin[3];
-  int left;  // interior: index of the left child; leaf: first BvhTriangle
-  float bmax[3];
-  int right;  // interior: index of the right child; leaf: -(triangle count)
+  float lo_x[4];
+  float hi_x[4];  // must follow lo_x (and hi_y lo_y, hi_z lo_z): traversal picks by offset
+  float lo_y[4];
+  float hi_y[4];
+  float lo_z[4];
+  float hi_z[4];
+  int child[4];
+  int pad[4];
 } BvhNode;
+
+// Traversal stack entries: at most 3 per node on the way down (the builder's
+// depth limit keeps the tree within it)
+#define BVH_STACK_SIZE 96
 
 // A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
 #define BVH_TRI_ALPHA_TEST 1u  // hits must pass scene_alpha_passes (alphaMode MASK / BLEND)
+#define BVH_TRI_LAST 2u  // the last triangle of its leaf
 typedef struct {
   float v0[3];
   unsigned int prim;  // stable primitive index (Prim array)
@@ -280,8 +294,9 @@ typedef struct {
 // FIELD(type, field, offset). The host static_asserts these; tests/cl checks them on
 // each device.
 #define CD_LAYOUT(SIZE, FIELD)                                                              \
-  SIZE(BvhNode, 32) FIELD(BvhNode, left, 12) FIELD(BvhNode, bmax, 16)                       \
-  FIELD(BvhNode, right, 28)                                                                 \
+  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32)                      \
+  FIELD(BvhNode, hi_y, 48) FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80)                \
+  FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)                                        \
   SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16)             \
   FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \

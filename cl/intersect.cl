@@ -48,8 +48,16 @@ float edge_function(float px, float py, float qx, float qy) {
   return swap ? -e : e;
 }
 
+// Always inlined where the compiler takes Clang's attribute (PoCL, rusticl and most
+// others): a call in the BVH's leaf loop spills every vector register of the traversal
+#ifdef __clang__
+#define CD_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define CD_ALWAYS_INLINE
+#endif
+
 // Hit in (0, tmax)? On a hit sets *t and the barycentric weights of v1 and v2.
-bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax,
+CD_ALWAYS_INLINE bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax,
                         float* t, float* b1, float* b2) {
   // No fused multiply-adds: keeps the edge values and t as the paper rounds them
 #pragma OPENCL FP_CONTRACT OFF

@@ -1,6 +1,7 @@
-// Binned-SAH BVH over the scene's primitives, flattened for bvh_traverse.cl. The node
-// and leaf layout (BvhNode, BvhTriangle) is private to this file and bvh_traverse.cl:
-// the rest of candela refers to triangles by their stable primitive index.
+// Binned-SAH BVH over the scene's primitives, collapsed into a 4-wide BVH for
+// bvh_traverse.cl. The node and leaf layout (BvhNode, BvhTriangle) is private to this
+// file and bvh_traverse.cl: the rest of candela refers to triangles by their stable
+// primitive index.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -11,13 +12,13 @@
 namespace candela {
 
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;  // root at 0
+  std::vector<dev::BvhNode> nodes;  // 4-wide, root at 0
   std::vector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
-  int depth = 0;
+  int depth = 0;  // of the binary SAH tree before collapsing (the 4-wide tree is half as deep)
 };
 
-// The kernel's traversal stack holds BVH_STACK_SIZE (64) entries; the builder keeps
-// the tree shallower than that.
+// Depth limit of the binary SAH tree; it bounds the kernel's traversal stack
+// (BVH_STACK_SIZE entries, 3 per 4-wide node on a path).
 constexpr int kMaxBvhDepth = 60;
 
 // `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order);

@@ -127,6 +127,69 @@ class BvhTest : public ::testing::TestWithParam<std::string> {};
 
 }  // namespace
 
+// Every triangle in exactly one leaf run (ending at a BVH_TRI_LAST triangle), child
+// boxes holding their triangles and nodes, and no path pushing more than the kernel's
+// traversal stack holds
+static void check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
+  EXPECT_LE(bvh.depth, kMaxBvhDepth);
+  ASSERT_EQ(bvh.tris.size(), tris.size());
+  std::vector<int> seen(tris.size(), 0);
+  for (const auto& t : bvh.tris) seen[t.prim]++;
+  for (int s : seen) ASSERT_EQ(s, 1);
+  std::vector<int> covered(tris.size(), 0), node_seen(bvh.nodes.size(), 0);
+  int max_pushes = 0;
+  struct Item {
+    int node, pushes;
+  };
+  std::vector<Item> todo = {{0, 0}};
+  while (!todo.empty()) {
+    Item item = todo.back();
+    todo.pop_back();
+    ASSERT_GE(item.node, 0);
+    ASSERT_LT(item.node, int(bvh.nodes.size()));
+    ASSERT_EQ(node_seen[item.node]++, 0) << "node reached twice";
+    const dev::BvhNode& node = bvh.nodes[item.node];
+    int used = 0;
+    for (int i = 0; i < 4; ++i) used += node.lo_x[i] <= node.hi_x[i];
+    int pushes = item.pushes + std::max(0, used - 1);
+    max_pushes = std::max(max_pushes, pushes);
+    for (int i = 0; i < 4; ++i) {
+      glm::vec3 lo(node.lo_x[i], node.lo_y[i], node.lo_z[i]), hi(node.hi_x[i], node.hi_y[i], node.hi_z[i]);
+      if (lo.x > hi.x) {  // unused slot: empty on every axis
+        ASSERT_GT(lo.y, hi.y);
+        ASSERT_GT(lo.z, hi.z);
+        continue;
+      }
+      auto inside = [&](const glm::vec3& p) {
+        for (int a = 0; a < 3; ++a)
+          if (p[a] < lo[a] || p[a] > hi[a]) return false;
+        return true;
+      };
+      int c = node.child[i];
+      if (c < 0) {
+        for (int t = ~c;; ++t) {
+          ASSERT_LT(t, int(bvh.tris.size()));
+          covered[t]++;
+          for (const auto& p : tris[bvh.tris[t].prim].p) ASSERT_TRUE(inside(p));
+          if (bvh.tris[t].flags & BVH_TRI_LAST) break;
+        }
+      } else {
+        ASSERT_GT(c, 0);
+        const dev::BvhNode& child = bvh.nodes[c];
+        for (int k = 0; k < 4; ++k) {
+          if (child.lo_x[k] > child.hi_x[k]) continue;
+          ASSERT_TRUE(inside(glm::vec3(child.lo_x[k], child.lo_y[k], child.lo_z[k])));
+          ASSERT_TRUE(inside(glm::vec3(child.hi_x[k], child.hi_y[k], child.hi_z[k])));
+        }
+        todo.push_back({c, pushes});
+      }
+    }
+  }
+  for (int c : covered) ASSERT_EQ(c, 1);
+  for (int n : node_seen) ASSERT_EQ(n, 1);
+  EXPECT_LE(max_pushes, BVH_STACK_SIZE);
+}
+
 TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
@@ -137,34 +200,20 @@ TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
   }
   // Many copies of one triangle: no spatial split exists
   for (int i = 0; i < 100; ++i) tris.push_back(tris[0]);
-  Bvh bvh = Soup(tris).bvh;
-  EXPECT_LE(bvh.depth, kMaxBvhDepth);
-  ASSERT_EQ(bvh.tris.size(), tris.size());
-  std::vector<int> seen(tris.size(), 0);
-  for (const auto& t : bvh.tris) seen[t.prim]++;
-  for (int s : seen) ASSERT_EQ(s, 1);
-  std::vector<int> covered(tris.size(), 0);
-  for (size_t n = 0; n < bvh.nodes.size(); ++n) {
-    const auto& node = bvh.nodes[n];
-    auto inside = [&](const glm::vec3& p) {
-      for (int a = 0; a < 3; ++a)
-        if (p[a] < node.bmin[a] || p[a] > node.bmax[a]) return false;
-      return true;
-    };
-    if (node.right < 0) {
-      for (int i = node.left; i < node.left - node.right; ++i) {
-        covered[i]++;
-        for (const auto& p : tris[bvh.tris[i].prim].p) ASSERT_TRUE(inside(p));
-      }
-    } else {
-      for (int c : {node.left, node.right})
-        for (int a = 0; a < 3; ++a) {
-          ASSERT_GE(bvh.nodes[c].bmin[a], node.bmin[a]);
-          ASSERT_LE(bvh.nodes[c].bmax[a], node.bmax[a]);
-        }
-    }
+  check_bvh(Soup(tris).bvh, tris);
+}
+
+// A chain of ever smaller triangles, split off a few at a time: a deep tree stays within
+// the depth limit and the traversal stack
+TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
+  std::vector<Tri> tris;
+  for (int i = 0; i < 120; ++i) {
+    float s = std::ldexp(1.0f, -i), x = s;
+    tris.push_back(make_tri(glm::vec3(x, 0, 0), glm::vec3(x + 0.01f * s, 0.01f * s, 0), glm::vec3(x, 0, 0.01f * s)));
   }
-  for (int c : covered) ASSERT_EQ(c, 1);
+  Bvh bvh = Soup(tris).bvh;
+  EXPECT_GT(bvh.depth, 30);
+  check_bvh(bvh, tris);
 }
 
 TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {

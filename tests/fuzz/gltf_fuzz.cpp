@@ -68,13 +68,18 @@ void check_compiled(const candela::CompiledScene& c) {
               (c.environment_light >= 0 && size_t(c.environment_light) < b.lights.size()),
           "environment light index");
   for (const auto& t : b.bvh_tris) require(t.prim < b.prims.size(), "BVH triangle prim");
-  for (const auto& n : b.bvh_nodes) {
-    if (n.right < 0)
-      require(n.left >= 0 && size_t(n.left) + size_t(-int64_t(n.right)) <= b.bvh_tris.size(), "BVH leaf range");
-    else
-      require(n.left > 0 && size_t(n.left) < b.bvh_nodes.size() && size_t(n.right) < b.bvh_nodes.size(),
-              "BVH child index");
-  }
+  require(!b.bvh_nodes.empty(), "BVH root");
+  for (const auto& n : b.bvh_nodes)
+    for (int i = 0; i < 4; ++i) {
+      if (n.lo_x[i] > n.hi_x[i]) continue;  // unused slot
+      if (n.child[i] < 0) {  // leaf run: ends at a BVH_TRI_LAST triangle inside the array
+        size_t t = size_t(~n.child[i]);
+        while (t < b.bvh_tris.size() && !(b.bvh_tris[t].flags & BVH_TRI_LAST)) ++t;
+        require(t < b.bvh_tris.size(), "BVH leaf range");
+      } else {
+        require(n.child[i] > 0 && size_t(n.child[i]) < b.bvh_nodes.size(), "BVH child index");
+      }
+    }
   require(c.bvh_depth <= candela::kMaxBvhDepth, "BVH depth");
   require(finite3(c.camera.position) && finite3(c.camera.forward) && finite3(c.camera.up), "finite camera");
 }
