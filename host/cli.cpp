@@ -20,6 +20,7 @@
 #include "renderer.hpp"
 #include "compare.hpp"
 #include "image_stats.hpp"
+#include "merge.hpp"
 
 namespace {
 
@@ -55,6 +56,7 @@ struct RenderArgs {
   bool quiet = false;
   std::string variance;  // --variance: variance-of-the-mean image (host/image_stats.hpp)
   bool generic = false;  // --generic: the kernel with every scene feature compiled in
+  uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
 };
 
 glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
@@ -265,7 +267,7 @@ std::shared_ptr<const CompiledScene> compile_for_render(const RenderArgs& a, con
 
 // ---- end of --variance and --generic ----
 
-// ---- Several devices and machines: --device LIST|all (README) ----
+// ---- Several devices and machines: --device LIST|all, --sample-offset (README) ----
 
 // --device: one selector (host/device.hpp), a comma-separated list of them, or `all`
 // (every device `candela devices` lists, each once). A device named twice in a list gets
@@ -353,6 +355,17 @@ void print_device_shares(const std::vector<DeviceEntry>& devices, const RenderRe
                 d["description"].get<std::string>().c_str());
 }
 
+void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
+  render->add_option("--sample-offset", a->sample_offset,
+                     "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
+                     "stored as candela:sample_offset");
+}
+
+void check_sample_offset(const RenderArgs& a, uint32_t spp) {
+  if (spp > 0 && uint64_t(a.sample_offset) + spp > (uint64_t(1) << 32))
+    throw Error("--sample-offset + --spp must not pass 2^32 sample indices");
+}
+
 // ---- end of several devices and machines ----
 
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
@@ -369,6 +382,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"lights", renderer.lights()},
                       {"device", joined_descriptions(devices)},
                       {"devices", device_shares_json(devices, r)},
+                      {"sample_offset", a.sample_offset},
                       {"width", settings.width},
                       {"height", settings.height},
                       {"strategy", a.strategy},
@@ -398,6 +412,7 @@ int run_render(RenderArgs a) {
   settings.energy_compensation = !a.no_energy_compensation;
 
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
+  check_sample_offset(a, spp);
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   std::string device_text = joined_descriptions(devices);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", device_text.c_str());
@@ -409,7 +424,7 @@ int run_render(RenderArgs a) {
   ProgressBar bar(!a.quiet, pixels);
   bar.show_device_shares(devices.size() > 1);
   RenderResult r = renderer.render(
-      0, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
+      a.sample_offset, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
       [] { return g_interrupted.load(); });
   bar.finish();
   std::signal(SIGINT, SIG_DFL);
@@ -422,7 +437,8 @@ int run_render(RenderArgs a) {
       {"device", device_text},                 {"seed", std::to_string(a.seed)},
       {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
       {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene},
-      {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter}};
+      {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter},
+      {"sample_offset", std::to_string(a.sample_offset)}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
@@ -477,6 +493,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--filter", a.filter, "Pixel filter: box (default), tent (radius 1 pixel) or gaussian (sigma 0.5 pixel)");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
   add_accuracy_render_options(render, &a);
+  add_distributed_render_options(render, &a);
   return render;
 }
 
@@ -524,6 +541,19 @@ int run_compare_command(CLI::App* cmd, CompareCli* c) {
 
 // ---- end of compare ----
 
+// ---- `candela merge` (host/merge.cpp) ----
+
+CLI::App* add_merge_command(CLI::App* app, MergeArgs* m) {
+  auto* cmd = app->add_subcommand(
+      "merge", "Merge .exr images of disjoint sample ranges of one render (render --sample-offset K --spp N) into one, "
+               "weighted by each file's spp");
+  cmd->add_option("inputs", m->inputs, "Images written by candela render (.exr with candela metadata)")->required();
+  cmd->add_option("-o,--output", m->output, "Merged image (.exr)")->required();
+  cmd->add_flag("-q,--quiet", m->quiet, "Only the 'wrote' line");
+  return cmd;
+}
+
+// ---- end of merge ----
 
 }  // namespace
 
@@ -542,6 +572,8 @@ int main(int argc, char** argv) {
   add_render_command(&app, &a);
   CompareCli compare_cli;
   auto* compare_cmd = add_compare_command(&app, &compare_cli);
+  MergeArgs merge_args;
+  auto* merge_cmd = add_merge_command(&app, &merge_args);
 
   try {
     app.parse(argc, argv);
@@ -568,6 +600,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*compare_cmd) return run_compare_command(compare_cmd, &compare_cli);
+    if (*merge_cmd) return run_merge(merge_args);
     return run_render(a);
   } catch (const Error& e) {
     std::fprintf(stderr, "candela: error: %s\n", e.what());

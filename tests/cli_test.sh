@@ -322,6 +322,54 @@ else
   fail "--time with two devices"; cat "$tmp/err"
 fi
 
+# Shards: sample indices [0,8) and [8,16) merged give the 16-spp render (float rounding:
+# measured max relative difference 3e-7)
+shard="--width 32 --height 32 --seed 7 --device pocl -q"
+"$bin" render "$scene" -o "$tmp/s0.exr" --sample-offset 0 --spp 8 $shard >/dev/null 2>&1
+"$bin" render "$scene" -o "$tmp/s1.exr" --sample-offset 8 --spp 8 $shard >/dev/null 2>&1
+"$bin" render "$scene" -o "$tmp/s01.exr" --spp 16 $shard >/dev/null 2>&1
+if "$bin" merge "$tmp/s0.exr" "$tmp/s1.exr" -o "$tmp/merged.exr" >"$tmp/out" 2>"$tmp/err" &&
+  { ! command -v oiiotool >/dev/null ||
+    { oiiotool --info -v "$tmp/s1.exr" | grep -q 'candela:sample_offset: "8"' &&
+      oiiotool --info -v "$tmp/merged.exr" | grep -q 'candela:spp: "16"' &&
+      oiiotool --info -v "$tmp/merged.exr" | grep -q 'candela:sample_ranges: "0:16"'; }; } &&
+  { [ $have_oiio_py -eq 0 ] || images_close "$tmp/s01.exr" "$tmp/merged.exr" 0 1e-5; } &&
+  { [ $have_oiio_py -eq 0 ] || ! images_close "$tmp/s01.exr" "$tmp/s0.exr" 0 1e-5 2>/dev/null; }; then
+  pass "merge of shards [0,8) and [8,16) equals the 16-spp render"
+else
+  fail "merge of shards"; cat "$tmp/out" "$tmp/err"
+fi
+# A merged file merges on with a disjoint shard, not with one it holds
+"$bin" render "$scene" -o "$tmp/s2.exr" --sample-offset 16 --spp 4 $shard >/dev/null 2>&1
+if "$bin" merge "$tmp/merged.exr" "$tmp/s2.exr" -o "$tmp/merged2.exr" >/dev/null 2>"$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/merged2.exr" | grep -q 'candela:spp: "20"'; }; then
+  pass "merge of a merged image and a further shard"
+else
+  fail "merge of a merged image and a further shard"; cat "$tmp/err"
+fi
+expect_error "merge: overlap with a merged image" "overlapping sample ranges" -- "$bin" merge "$tmp/merged.exr" "$tmp/s1.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_overlap.exr" --sample-offset 4 --spp 8 $shard >/dev/null 2>&1
+expect_error "merge: overlapping ranges" "overlapping sample ranges" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_overlap.exr" -o "$tmp/x.exr"
+expect_error "merge: same file twice" "overlapping sample ranges" -- "$bin" merge "$tmp/s0.exr" "$tmp/s0.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_size.exr" --sample-offset 8 --spp 8 --width 16 --height 32 --seed 7 --device pocl -q >/dev/null 2>&1
+expect_error "merge: different sizes" "is 16x32" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_size.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_seed.exr" --sample-offset 8 --spp 8 --width 32 --height 32 --seed 8 --device pocl -q >/dev/null 2>&1
+expect_error "merge: different seeds" "different seed" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_seed.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_strat.exr" --sample-offset 8 --spp 8 --strategy bsdf $shard >/dev/null 2>&1
+expect_error "merge: different strategies" "different strategy" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_strat.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_depth.exr" --sample-offset 8 --spp 8 --max-depth 3 $shard >/dev/null 2>&1
+expect_error "merge: different max depth" "different max_depth" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_depth.exr" -o "$tmp/x.exr"
+"$bin" render "$root/scenes/materials/materials.gltf" -o "$tmp/s_scene.exr" --sample-offset 8 --spp 1 $shard >/dev/null 2>&1
+expect_error "merge: different scenes" "different scene" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_scene.exr" -o "$tmp/x.exr"
+if command -v oiiotool >/dev/null; then
+  oiiotool --create 32x32 3 -o "$tmp/plain.exr"
+  expect_error "merge: no candela metadata" "no candela metadata" -- "$bin" merge "$tmp/s0.exr" "$tmp/plain.exr" -o "$tmp/x.exr"
+fi
+expect_error "merge: one input" "at least two" -- "$bin" merge "$tmp/s0.exr" -o "$tmp/x.exr"
+expect_error "merge: PNG input" "reads .exr images" -- "$bin" merge "$tmp/s0.exr" "$tmp/x.png" -o "$tmp/x.exr"
+expect_error "merge: missing input" "not found" -- "$bin" merge "$tmp/s0.exr" "$tmp/nope.exr" -o "$tmp/x.exr"
+[ ! -e "$tmp/x.exr" ] && pass "refused merges write nothing" || fail "a refused merge wrote $tmp/x.exr"
+
 # Ctrl-C during a long render writes what was rendered and exits 130
 "$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \
   --stats "$tmp/int.json" >"$tmp/int.out" 2>"$tmp/int.err" &
