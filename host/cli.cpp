@@ -21,6 +21,7 @@
 #include "compare.hpp"
 #include "image_stats.hpp"
 #include "merge.hpp"
+#include "mpi_render.hpp"
 
 namespace {
 
@@ -57,6 +58,7 @@ struct RenderArgs {
   std::string variance;  // --variance: variance-of-the-mean image (host/image_stats.hpp)
   bool generic = false;  // --generic: the kernel with every scene feature compiled in
   uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
+  bool mpi = false;  // --mpi: spread the samples over the ranks of an MPI job
 };
 
 glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
@@ -359,6 +361,54 @@ void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
   render->add_option("--sample-offset", a->sample_offset,
                      "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
                      "stored as candela:sample_offset");
+  render->add_flag("--mpi", a->mpi,
+                   "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank "
+                   "renders a block of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)");
+}
+
+// --mpi: the job's session while a render runs under it (main), else null
+MpiSession* g_mpi = nullptr;
+
+// Under --mpi, this rank's first sample index and sample count (its block of the
+// render's); other ranks than 0 render quietly
+uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
+  if (!g_mpi) return a->sample_offset;
+  if (*spp == 0) throw Error("--mpi needs --spp: each rank renders a fixed block of the sample indices");
+  if (*spp < uint32_t(g_mpi->size()))
+    throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) + " ranks");
+  uint32_t begin = 0, count = 0;
+  mpi_block(*spp, g_mpi->rank(), g_mpi->size(), &begin, &count);
+  if (g_mpi->rank() != 0) a->quiet = true;
+  *spp = count;
+  return a->sample_offset + begin;
+}
+
+// Under --mpi, rank 0 gets every rank's samples merged into its result; returns whether
+// this rank writes the outputs (rank 0 only)
+bool mpi_combine(RenderResult* r) {
+  if (!g_mpi) return true;
+  r->film = mpi_gather_films(*g_mpi, r->film, &r->spp, &r->seconds, &r->interrupted, &r->partial_pass);
+  return g_mpi->rank() == 0;
+}
+
+// `render --mpi`: the session around the render; an error on one rank ends the job (the
+// others would wait for its film for ever)
+int run_render_under_mpi(const RenderArgs& a, int (*run)(RenderArgs)) {
+  MpiSession session;
+  g_mpi = &session;
+  try {
+    int rc = run(a);
+    g_mpi = nullptr;
+    return rc;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), cl_error_message(e.what(), e.err()).c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), e.what());
+  }
+  std::fflush(stderr);
+  if (session.size() > 1) mpi_abort(1);
+  g_mpi = nullptr;
+  return 1;
 }
 
 void check_sample_offset(const RenderArgs& a, uint32_t spp) {
@@ -383,6 +433,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"device", joined_descriptions(devices)},
                       {"devices", device_shares_json(devices, r)},
                       {"sample_offset", a.sample_offset},
+                      {"mpi_ranks", g_mpi ? g_mpi->size() : 0},
                       {"width", settings.width},
                       {"height", settings.height},
                       {"strategy", a.strategy},
@@ -413,6 +464,7 @@ int run_render(RenderArgs a) {
 
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
   check_sample_offset(a, spp);
+  uint32_t first_sample = mpi_shard(&a, &spp);
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   std::string device_text = joined_descriptions(devices);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", device_text.c_str());
@@ -424,10 +476,11 @@ int run_render(RenderArgs a) {
   ProgressBar bar(!a.quiet, pixels);
   bar.show_device_shares(devices.size() > 1);
   RenderResult r = renderer.render(
-      a.sample_offset, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
+      first_sample, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
       [] { return g_interrupted.load(); });
   bar.finish();
   std::signal(SIGINT, SIG_DFL);
+  if (!mpi_combine(&r)) return 0;
 
   if (r.spp == 0) throw Error("interrupted before any sample was rendered; nothing written");
   double samples_per_second = r.spp * pixels / std::max(r.seconds, 1e-9);
@@ -601,6 +654,7 @@ int main(int argc, char** argv) {
     }
     if (*compare_cmd) return run_compare_command(compare_cmd, &compare_cli);
     if (*merge_cmd) return run_merge(merge_args);
+    if (a.mpi) return run_render_under_mpi(a, run_render);
     return run_render(a);
   } catch (const Error& e) {
     std::fprintf(stderr, "candela: error: %s\n", e.what());
