@@ -20,6 +20,8 @@
 #include "renderer.hpp"
 #include "compare.hpp"
 #include "image_stats.hpp"
+#include "merge.hpp"
+#include "mpi_render.hpp"
 
 namespace {
 
@@ -56,6 +58,8 @@ struct RenderArgs {
   bool quiet = false;
   std::string variance;  // --variance: variance-of-the-mean image (host/image_stats.hpp)
   bool generic = false;  // --generic: the kernel with every scene feature compiled in
+  uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
+  bool mpi = false;  // --mpi: spread the samples over the ranks of an MPI job
 };
 
 glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
@@ -77,11 +81,26 @@ std::string format_duration(double s) {
   return buf;
 }
 
+// "  devices 0: 52% 1: 48%": each worker's share of the samples so far
+std::string format_device_shares(const RenderProgress& p) {
+  double total = 0.0;
+  for (double v : p.worker_spp) total += v;
+  std::string s = "  devices";
+  char buf[32];
+  for (size_t i = 0; i < p.worker_spp.size(); ++i) {
+    std::snprintf(buf, sizeof buf, " %zu: %.0f%%", i, total > 0 ? 100.0 * p.worker_spp[i] / total : 0.0);
+    s += buf;
+  }
+  return s;
+}
+
 // A bar redrawn in place on a terminal; elsewhere (logs, CI) a line every 10 seconds
 class ProgressBar {
  public:
   ProgressBar(bool enabled, double pixels)
       : enabled_(enabled), terminal_(isatty(STDERR_FILENO)), pixels_(pixels) {}
+  // With several devices, each one's share of the samples follows the line
+  void show_device_shares(bool on) { shares_ = on; }
   void update(const RenderProgress& p) {
     if (!enabled_) return;
     if (!terminal_) {
@@ -94,9 +113,10 @@ class ProgressBar {
     double eta = frac > 0 ? p.seconds * (1.0 - frac) / frac : 0.0;
     int width = 30, filled = int(frac * width + 0.5);
     std::string bar = std::string(filled, '#') + std::string(width - filled, '-');
-    std::fprintf(stderr, terminal_ ? "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s   " : "[%s] %u%s spp  %.2f Msamples/s  ETA %s\n", bar.c_str(), p.spp_done,
+    std::string shares = shares_ ? format_device_shares(p) : "";
+    std::fprintf(stderr, terminal_ ? "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s%s   " : "[%s] %u%s spp  %.2f Msamples/s  ETA %s%s\n", bar.c_str(), p.spp_done,
                  p.spp_target ? ("/" + std::to_string(p.spp_target)).c_str() : "", rate * 1e-6,
-                 format_duration(eta).c_str());
+                 format_duration(eta).c_str(), shares.c_str());
     std::fflush(stderr);
     drawn_ = true;
   }
@@ -106,6 +126,7 @@ class ProgressBar {
 
  private:
   bool enabled_, terminal_;
+  bool shares_ = false;
   double pixels_;
   double next_line_ = 10.0;
   bool drawn_ = false;
@@ -255,8 +276,157 @@ std::shared_ptr<const CompiledScene> compile_for_render(const RenderArgs& a, con
 
 // ---- end of --variance and --generic ----
 
+// ---- Several devices and machines: --device LIST|all, --sample-offset (README) ----
+
+// --device: one selector (host/device.hpp), a comma-separated list of them, or `all`
+// (every device `candela devices` lists, each once). A device named twice in a list gets
+// two workers (two contexts and queues on it), as asked.
+std::vector<DeviceEntry> select_render_devices(const std::string& selector) {
+  std::string trimmed = selector;
+  trimmed.erase(0, trimmed.find_first_not_of(" \t"));
+  trimmed.erase(trimmed.find_last_not_of(" \t") + 1);
+  std::string lower = trimmed;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (lower == "all") {
+    std::vector<DeviceEntry> all = list_devices();
+    if (all.empty()) throw Error("--device all: OpenCL platforms are installed but none has a device");
+    return all;
+  }
+  if (trimmed.find(',') == std::string::npos) return {select_device(trimmed)};
+  std::vector<DeviceEntry> devices;
+  std::stringstream ss(trimmed);
+  for (std::string sel; std::getline(ss, sel, ',');) {
+    if (sel.find_first_not_of(" \t") == std::string::npos)
+      throw Error("--device has an empty entry: '" + selector + "'");
+    std::string l = sel;
+    l.erase(0, l.find_first_not_of(" \t"));
+    l.erase(l.find_last_not_of(" \t") + 1);
+    std::transform(l.begin(), l.end(), l.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (l == "all")
+      throw Error("--device all stands alone, not in a list: '" + selector + "'");
+    devices.push_back(select_device(sel));
+  }
+  if (trimmed.back() == ',') throw Error("--device has an empty entry: '" + selector + "'");
+  return devices;
+}
+
+std::string joined_descriptions(const std::vector<DeviceEntry>& devices) {
+  std::string s;
+  for (size_t i = 0; i < devices.size(); ++i) s += (i ? " + " : "") + devices[i].description();
+  return s;
+}
+
+// The scene summary: the single-device lines as before; with several devices one line
+// each (its kernel build) and a note for a device named more than once
+void print_render_summary(const Renderer& r, const std::vector<DeviceEntry>& devices) {
+  if (devices.size() == 1) {
+    std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; kernel build %.2fs%s\n", r.triangles(),
+                 r.lights(), r.bvh_build_seconds(), r.kernel_build_seconds(), r.kernel_from_cache() ? " (cached)" : "");
+    return;
+  }
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const DeviceRenderer& w = r.worker(i);
+    std::fprintf(stderr, "device %zu: %s [%s]; kernel build %.2fs%s\n", i, devices[i].description().c_str(),
+                 devices[i].selector().c_str(), w.kernel_build_seconds(), w.kernel_from_cache() ? " (cached)" : "");
+    for (size_t j = 0; j < i; ++j)
+      if (devices[j].global_index == devices[i].global_index) {
+        std::fprintf(stderr, "note: device %zu is device %zu again: two workers share its compute units\n", i, j);
+        break;
+      }
+  }
+  std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; %zu devices\n", r.triangles(), r.lights(),
+               r.bvh_build_seconds(), devices.size());
+}
+
+// --stats "devices": each worker's samples (summed over pixels), share and rate
+nlohmann::json device_shares_json(const std::vector<DeviceEntry>& devices, const RenderResult& r) {
+  double total = 0.0;
+  for (uint64_t n : r.worker_samples) total += double(n);
+  nlohmann::json arr = nlohmann::json::array();
+  for (size_t i = 0; i < devices.size(); ++i) {
+    uint64_t n = i < r.worker_samples.size() ? r.worker_samples[i] : 0;
+    arr.push_back({{"index", i},
+                   {"selector", devices[i].selector()},
+                   {"description", devices[i].description()},
+                   {"samples", n},
+                   {"share", total > 0 ? double(n) / total : 0.0},
+                   {"samples_per_second", double(n) / std::max(r.seconds, 1e-9)}});
+  }
+  return arr;
+}
+
+void print_device_shares(const std::vector<DeviceEntry>& devices, const RenderResult& r) {
+  if (devices.size() < 2) return;
+  nlohmann::json shares = device_shares_json(devices, r);
+  for (const auto& d : shares)
+    std::printf("  device %zu: %.1f%% of the samples, %.3f Msamples/s, %s\n", d["index"].get<size_t>(),
+                100.0 * d["share"].get<double>(), d["samples_per_second"].get<double>() * 1e-6,
+                d["description"].get<std::string>().c_str());
+}
+
+void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
+  render->add_option("--sample-offset", a->sample_offset,
+                     "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
+                     "stored as candela:sample_offset");
+  render->add_flag("--mpi", a->mpi,
+                   "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank "
+                   "renders a block of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)");
+}
+
+// --mpi: the job's session while a render runs under it (main), else null
+MpiSession* g_mpi = nullptr;
+
+// Under --mpi, this rank's first sample index and sample count (its block of the
+// render's); other ranks than 0 render quietly
+uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
+  if (!g_mpi) return a->sample_offset;
+  if (*spp == 0) throw Error("--mpi needs --spp: each rank renders a fixed block of the sample indices");
+  if (*spp < uint32_t(g_mpi->size()))
+    throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) + " ranks");
+  uint32_t begin = 0, count = 0;
+  mpi_block(*spp, g_mpi->rank(), g_mpi->size(), &begin, &count);
+  if (g_mpi->rank() != 0) a->quiet = true;
+  *spp = count;
+  return a->sample_offset + begin;
+}
+
+// Under --mpi, rank 0 gets every rank's samples merged into its result; returns whether
+// this rank writes the outputs (rank 0 only)
+bool mpi_combine(RenderResult* r) {
+  if (!g_mpi) return true;
+  r->film = mpi_gather_films(*g_mpi, r->film, &r->spp, &r->seconds, &r->interrupted, &r->partial_pass);
+  return g_mpi->rank() == 0;
+}
+
+// `render --mpi`: the session around the render; an error on one rank ends the job (the
+// others would wait for its film for ever)
+int run_render_under_mpi(const RenderArgs& a, int (*run)(RenderArgs)) {
+  MpiSession session;
+  g_mpi = &session;
+  try {
+    int rc = run(a);
+    g_mpi = nullptr;
+    return rc;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), cl_error_message(e.what(), e.err()).c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), e.what());
+  }
+  std::fflush(stderr);
+  if (session.size() > 1) mpi_abort(1);
+  g_mpi = nullptr;
+  return 1;
+}
+
+void check_sample_offset(const RenderArgs& a, uint32_t spp) {
+  if (spp > 0 && uint64_t(a.sample_offset) + spp > (uint64_t(1) << 32))
+    throw Error("--sample-offset + --spp must not pass 2^32 sample indices");
+}
+
+// ---- end of several devices and machines ----
+
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
-                 const RenderResult& r, double samples_per_second) {
+                 const RenderResult& r, double samples_per_second, const std::vector<DeviceEntry>& devices) {
   nlohmann::json j = {{"spp", r.spp},
                       {"seconds", r.seconds},
                       {"samples_per_second", samples_per_second},
@@ -267,7 +437,10 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"scene_device_bytes", renderer.scene().buffers.bytes()},
                       {"triangles", renderer.triangles()},
                       {"lights", renderer.lights()},
-                      {"device", renderer.worker().device().description()},
+                      {"device", joined_descriptions(devices)},
+                      {"devices", device_shares_json(devices, r)},
+                      {"sample_offset", a.sample_offset},
+                      {"mpi_ranks", g_mpi ? g_mpi->size() : 0},
                       {"width", settings.width},
                       {"height", settings.height},
                       {"strategy", a.strategy},
@@ -298,45 +471,49 @@ int run_render(RenderArgs a) {
   settings.max_depth = a.max_depth;
   settings.energy_compensation = !a.no_energy_compensation;
 
-  DeviceEntry device = select_device(a.device);
-  if (!a.quiet) std::fprintf(stderr, "device: %s\n", device.description().c_str());
-  Renderer renderer(device, compile_for_render(a, scene), settings);
-  if (!a.quiet)
-    std::fprintf(stderr, "scene: %zu triangles, %zu lights, BVH %.2fs; kernel build %.2fs%s\n",
-                 renderer.triangles(), renderer.lights(), renderer.bvh_build_seconds(),
-                 renderer.kernel_build_seconds(), renderer.kernel_from_cache() ? " (cached)" : "");
-
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
+  check_sample_offset(a, spp);
+  uint32_t first_sample = mpi_shard(&a, &spp);
+  std::vector<DeviceEntry> devices = select_render_devices(a.device);
+  std::string device_text = joined_descriptions(devices);
+  if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", device_text.c_str());
+  Renderer renderer(devices, compile_for_render(a, scene), settings);
+  if (!a.quiet) print_render_summary(renderer, devices);
+
   std::signal(SIGINT, on_sigint);
   double pixels = double(settings.width) * settings.height;
   ProgressBar bar(!a.quiet, pixels);
+  bar.show_device_shares(devices.size() > 1);
   RenderResult r = renderer.render(
-      0, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
+      first_sample, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
       [] { return g_interrupted.load(); });
   bar.finish();
   std::signal(SIGINT, SIG_DFL);
+  if (!mpi_combine(&r)) return 0;
 
   if (r.spp == 0) throw Error("interrupted before any sample was rendered; nothing written");
   double samples_per_second = r.spp * pixels / std::max(r.seconds, 1e-9);
   uint64_t dropped = r.film.dropped_samples();
   std::map<std::string, std::string> meta = {
       {"spp", std::to_string(r.spp)},          {"seconds", std::to_string(r.seconds)},
-      {"device", device.description()},        {"seed", std::to_string(a.seed)},
+      {"device", device_text},                 {"seed", std::to_string(a.seed)},
       {"strategy", a.strategy},                {"max_depth", std::to_string(a.max_depth)},
       {"dropped_samples", std::to_string(dropped)}, {"scene", a.scene},
       {"energy_compensation", settings.energy_compensation ? "on" : "off"}, {"filter", a.filter},
-      {"sampler", a.sampler}};
+      {"sampler", a.sampler},
+      {"sample_offset", std::to_string(a.sample_offset)}};
   for (const auto& out : a.outputs) {
     write_image(out, r.film, meta, a.exposure);
     std::printf("wrote %s\n", out.c_str());
   }
   write_variance_output(a, r.film, meta);
   std::printf("%u spp in %.2fs: %.3f Msamples/s on %s%s\n", r.spp, r.seconds, samples_per_second * 1e-6,
-              device.description().c_str(), r.interrupted ? " (interrupted)" : "");
+              device_text.c_str(), r.interrupted ? " (interrupted)" : "");
+  print_device_shares(devices, r);
   if (r.partial_pass)
     std::fprintf(stderr, "note: stopped inside a pass; some pixels hold more than %u samples\n", r.spp);
   if (dropped) std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)dropped);
-  if (!a.stats.empty()) write_stats(a, settings, renderer, r, samples_per_second);
+  if (!a.stats.empty()) write_stats(a, settings, renderer, r, samples_per_second, devices);
   return r.interrupted ? 130 : 0;
 }
 
@@ -351,7 +528,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
       ->excludes(spp_opt);
   render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")->check(CLI::Range(1, 65536));
   render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")->check(CLI::Range(1, 65536));
-  render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU");
+  render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once");
   render->add_option("--seed", a.seed, "Random seed (default 0)");
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
   render->add_option("--strategy", a.strategy, "nee (next-event estimation), bsdf (BSDF sampling only) or auto (per vertex: bsdf at near-specular surfaces, nee elsewhere); default: the scene's extras candela.strategy, else nee");
@@ -381,6 +558,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
                      "Random numbers: sobol (Owen-scrambled Sobol, stratified; default) or independent");
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
   add_accuracy_render_options(render, &a);
+  add_distributed_render_options(render, &a);
   return render;
 }
 
@@ -428,6 +606,20 @@ int run_compare_command(CLI::App* cmd, CompareCli* c) {
 
 // ---- end of compare ----
 
+// ---- `candela merge` (host/merge.cpp) ----
+
+CLI::App* add_merge_command(CLI::App* app, MergeArgs* m) {
+  auto* cmd = app->add_subcommand(
+      "merge", "Merge .exr images of disjoint sample ranges of one render (render --sample-offset K --spp N) into one, "
+               "weighted by each file's spp");
+  cmd->add_option("inputs", m->inputs, "Images written by candela render (.exr with candela metadata)")->required();
+  cmd->add_option("-o,--output", m->output, "Merged image (.exr)")->required();
+  cmd->add_flag("-q,--quiet", m->quiet, "Only the 'wrote' line");
+  return cmd;
+}
+
+// ---- end of merge ----
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -445,6 +637,8 @@ int main(int argc, char** argv) {
   add_render_command(&app, &a);
   CompareCli compare_cli;
   auto* compare_cmd = add_compare_command(&app, &compare_cli);
+  MergeArgs merge_args;
+  auto* merge_cmd = add_merge_command(&app, &merge_args);
 
   try {
     app.parse(argc, argv);
@@ -471,6 +665,8 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*compare_cmd) return run_compare_command(compare_cmd, &compare_cli);
+    if (*merge_cmd) return run_merge(merge_args);
+    if (a.mpi) return run_render_under_mpi(a, run_render);
     return run_render(a);
   } catch (const Error& e) {
     std::fprintf(stderr, "candela: error: %s\n", e.what());

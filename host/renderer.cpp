@@ -182,7 +182,7 @@ class SampleScheduler {
  public:
   SampleScheduler(uint32_t spp, double time_limit, size_t workers)
       : limit_(spp > 0 ? spp : kMaxSamplesPerPixel), time_limit_(spp > 0 ? 0.0 : time_limit),
-        partial_(workers, 0.0), start_(Clock::now()) {}
+        partial_(workers, 0.0), done_by_(workers, 0), start_(Clock::now()) {}
 
   // The next range (offsets from the render's first sample) for a worker that wants
   // `want` samples per pixel; false when the render is over
@@ -206,6 +206,7 @@ class SampleScheduler {
     std::lock_guard<std::mutex> lock(mutex_);
     partial_[worker] = 0.0;
     if (whole) done_ += count;
+    if (whole) done_by_[worker] += count;
     if (!whole) partial_pass_ = ended_ = true;
     if (interrupted) interrupted_ = ended_ = true;
   }
@@ -218,6 +219,8 @@ class SampleScheduler {
     RenderProgress p;
     p.spp_done = done_;
     for (double v : partial_) p.spp_partial += v;
+    p.worker_spp.resize(partial_.size());
+    for (size_t i = 0; i < partial_.size(); ++i) p.worker_spp[i] = done_by_[i] + partial_[i];
     p.spp_target = spp;
     p.time_limit = time_limit_;
     p.seconds = seconds();
@@ -234,6 +237,7 @@ class SampleScheduler {
   const uint32_t limit_;
   const double time_limit_;
   std::vector<double> partial_;
+  std::vector<uint32_t> done_by_;  // whole ranges per worker, samples per pixel
   Clock::time_point start_;
   uint32_t next_ = 0, done_ = 0;
   bool ended_ = false, interrupted_ = false, partial_pass_ = false;
@@ -281,8 +285,14 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
   result.seconds = sched.seconds();
   result.interrupted = sched.interrupted();
   result.partial_pass = sched.partial_pass();
-  result.film = workers[0]->film();
-  for (size_t i = 1; i < workers.size(); ++i) result.film = merge_films(result.film, workers[i]->film());
+  // Each worker's share: the samples its film holds (partial ranges included)
+  for (size_t i = 0; i < workers.size(); ++i) {
+    Film f = workers[i]->film();
+    double total = 0.0;
+    for (size_t p = 0; p < f.pixels(); ++p) total += f.samples(p);
+    result.worker_samples.push_back(uint64_t(total + 0.5));
+    result.film = i == 0 ? std::move(f) : merge_films(result.film, f);
+  }
   return result;
 }
 
@@ -291,12 +301,33 @@ Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSe
 
 Renderer::Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
                    const RenderSettings& settings)
-    : scene_(std::move(scene)), worker_(device, *scene_, settings) {}
+    : Renderer(std::vector<DeviceEntry>{device}, std::move(scene), settings) {}
+
+Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
+                   const RenderSettings& settings)
+    : scene_(std::move(scene)) {
+  if (devices.empty()) throw Error("a render needs at least one device");
+  for (const auto& d : devices) workers_.push_back(std::make_unique<DeviceRenderer>(d, *scene_, settings));
+}
+
+double Renderer::kernel_build_seconds() const {
+  double s = 0.0;
+  for (const auto& w : workers_) s += w->kernel_build_seconds();
+  return s;
+}
+
+bool Renderer::kernel_from_cache() const {
+  for (const auto& w : workers_)
+    if (!w->kernel_from_cache()) return false;
+  return true;
+}
 
 RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_limit,
                               const std::function<void(const RenderProgress&)>& progress,
                               const std::function<bool()>& stop) {
-  return render_samples({&worker_}, sample_begin, spp, time_limit, progress, stop);
+  std::vector<DeviceRenderer*> workers;
+  for (auto& w : workers_) workers.push_back(w.get());
+  return render_samples(workers, sample_begin, spp, time_limit, progress, stop);
 }
 
 }  // namespace candela

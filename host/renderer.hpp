@@ -48,6 +48,7 @@ struct RenderProgress {
   uint32_t spp_target = 0;  // 0 when rendering for a time budget
   double seconds = 0.0;
   double time_limit = 0.0;
+  std::vector<double> worker_spp;  // per worker: samples per pixel done and under way
 };
 
 struct RenderResult {
@@ -56,6 +57,7 @@ struct RenderResult {
   double seconds = 0.0;
   bool interrupted = false;  // stopped by the caller
   bool partial_pass = false;  // stopped inside a range: some pixels hold more samples
+  std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
 };
 
 // One device's worker: renders ranges of sample indices of a compiled scene into its film
@@ -111,11 +113,16 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
                             const std::function<void(const RenderProgress&)>& progress = {},
                             const std::function<bool()>& stop = {});
 
-// A scene compiled once and rendered on one device
+// A scene compiled once and rendered on one device, or on several (one worker each,
+// sharing the ranges of sample indices)
 class Renderer {
  public:
   Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
   Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+           const RenderSettings& settings);
+  // One DeviceRenderer per entry (an entry listed twice gets two workers); builds the
+  // kernels one device after the other. Throws Error when `devices` is empty.
+  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
            const RenderSettings& settings);
 
   RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
@@ -123,17 +130,21 @@ class Renderer {
                       const std::function<bool()>& stop = {});
 
   const CompiledScene& scene() const { return *scene_; }
-  DeviceRenderer& worker() { return worker_; }
-  const DeviceRenderer& worker() const { return worker_; }
-  double kernel_build_seconds() const { return worker_.kernel_build_seconds(); }
-  bool kernel_from_cache() const { return worker_.kernel_from_cache(); }
+  DeviceRenderer& worker() { return *workers_.front(); }
+  const DeviceRenderer& worker() const { return *workers_.front(); }
+  size_t worker_count() const { return workers_.size(); }
+  DeviceRenderer& worker(size_t i) { return *workers_.at(i); }
+  const DeviceRenderer& worker(size_t i) const { return *workers_.at(i); }
+  // The first worker's kernel build; with several devices, the sum of all of them
+  double kernel_build_seconds() const;
+  bool kernel_from_cache() const;  // every worker's kernel came from the cache
   double bvh_build_seconds() const { return scene_->bvh_build_seconds; }
   size_t triangles() const { return scene_->triangles; }
   size_t lights() const { return scene_->buffers.lights.size(); }
 
  private:
   std::shared_ptr<const CompiledScene> scene_;
-  DeviceRenderer worker_;
+  std::vector<std::unique_ptr<DeviceRenderer>> workers_;
 };
 
 }  // namespace candela

@@ -259,6 +259,161 @@ else
   fail "--sampler independent and sobol render and are recorded"; cat "$tmp/err"
 fi
 
+# ---- Several devices and machines: --device LIST|all, --sample-offset, merge ----
+# Pixel comparison of two EXRs on Debian's python3 (python3-openimageio, python3-numpy)
+sys_py=/usr/bin/python3
+have_oiio_py=0
+$sys_py -c "import OpenImageIO, numpy" 2>/dev/null && have_oiio_py=1
+# images_close A B ABS REL: every channel of every pixel within ABS + REL * |A|
+images_close() {
+  $sys_py - "$@" <<'PY'
+import sys, numpy as np, OpenImageIO as oiio
+a = oiio.ImageBuf(sys.argv[1]).get_pixels(oiio.FLOAT)
+b = oiio.ImageBuf(sys.argv[2]).get_pixels(oiio.FLOAT)
+tol_abs, tol_rel = float(sys.argv[3]), float(sys.argv[4])
+assert a.shape == b.shape, (a.shape, b.shape)
+assert a.mean() > 0.01, a.mean()
+d = np.abs(a - b)
+bad = d > tol_abs + tol_rel * np.abs(a)
+assert not bad.any(), "max abs diff %g, %d values off" % (d.max(), bad.sum())
+PY
+}
+mdev="--spp 8 --width 32 --height 32 --seed 7"
+expect_error "unknown device in a list" "no OpenCL device matches --device 'quantum'" -- "$bin" render "$scene" -o "$tmp/x.exr" --device pocl,quantum $mdev
+expect_error "empty device in a list" "empty entry" -- "$bin" render "$scene" -o "$tmp/x.exr" --device pocl,,pocl $mdev
+expect_error "all inside a list" "all stands alone" -- "$bin" render "$scene" -o "$tmp/x.exr" --device pocl,all $mdev
+"$bin" render "$scene" -o "$tmp/d1.exr" --device pocl $mdev -q >/dev/null 2>"$tmp/err"
+# Two workers on the one PoCL device: the same samples, merged: float rounding only
+# (measured: max relative difference 3e-7)
+if "$bin" render "$scene" -o "$tmp/d2.exr" --device pocl,pocl $mdev --stats "$tmp/d2.json" >"$tmp/out" 2>"$tmp/err" &&
+  grep -q "^device 1: .*Portable Computing Language" "$tmp/err" && grep -q "device 1 is device 0 again" "$tmp/err" &&
+  grep -q "^  device 1: .*% of the samples" "$tmp/out" &&
+  python3 - "$tmp/d2.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+d = s["devices"]
+assert len(d) == 2 and all("Portable Computing Language" in x["description"] for x in d), d
+assert abs(sum(x["share"] for x in d) - 1) < 1e-12, d
+assert sum(x["samples"] for x in d) == 8 * 32 * 32, d
+assert all(x["samples_per_second"] >= 0 for x in d), d
+PY
+then
+  if [ $have_oiio_py -eq 1 ] && ! images_close "$tmp/d1.exr" "$tmp/d2.exr" 0 1e-5; then
+    fail "--device pocl,pocl gives the single-device image"
+  else
+    pass "--device pocl,pocl: both devices in the stats, the single-device image"
+  fi
+else
+  fail "--device pocl,pocl"; cat "$tmp/out" "$tmp/err"
+fi
+# PoCL and rusticl: the same sample indices, rusticl's floating point differs a little
+# (measured on a whole rusticl render against PoCL's: max abs difference 2.6e-6)
+if RUSTICL_ENABLE=llvmpipe "$bin" devices | grep -q rusticl; then
+  if "$bin" render "$scene" -o "$tmp/dr.exr" --device pocl,rusticl $mdev --stats "$tmp/dr.json" >"$tmp/out" 2>"$tmp/err" &&
+    python3 -c "
+import json; d = json.load(open('$tmp/dr.json'))['devices']
+assert len(d) == 2 and 'rusticl' in d[1]['description'] and abs(d[0]['share'] + d[1]['share'] - 1) < 1e-12, d" &&
+    { [ $have_oiio_py -eq 0 ] || images_close "$tmp/d1.exr" "$tmp/dr.exr" 2e-5 1e-4; }; then
+    pass "--device pocl,rusticl"
+  else
+    fail "--device pocl,rusticl"; cat "$tmp/out" "$tmp/err"
+  fi
+fi
+# all: every device `candela devices` lists (same environment), once each
+ndev=$("$bin" devices | grep -c '^[0-9]')
+if "$bin" render "$scene" -o "$tmp/all.exr" --device all --spp 2 --width 8 --height 8 -q --stats "$tmp/all.json" >/dev/null 2>"$tmp/err" &&
+  python3 -c "import json; d = json.load(open('$tmp/all.json'))['devices']; assert len(d) == $ndev, d"; then
+  pass "--device all renders on the $ndev listed device(s)"
+else
+  fail "--device all"; cat "$tmp/err"
+fi
+if "$bin" render "$scene" -o "$tmp/t2.exr" --device pocl,pocl --time 0.5 --width 16 --height 16 --stats "$tmp/t2.json" >/dev/null 2>"$tmp/err" &&
+  python3 -c "
+import json; s = json.load(open('$tmp/t2.json'))
+assert s['spp'] >= 1 and len(s['devices']) == 2 and sum(x['samples'] for x in s['devices']) >= s['spp'] * 256, s"; then
+  pass "--time with two devices"
+else
+  fail "--time with two devices"; cat "$tmp/err"
+fi
+
+# Shards: sample indices [0,8) and [8,16) merged give the 16-spp render (float rounding:
+# measured max relative difference 3e-7)
+shard="--width 32 --height 32 --seed 7 --device pocl -q"
+"$bin" render "$scene" -o "$tmp/s0.exr" --sample-offset 0 --spp 8 $shard >/dev/null 2>&1
+"$bin" render "$scene" -o "$tmp/s1.exr" --sample-offset 8 --spp 8 $shard >/dev/null 2>&1
+"$bin" render "$scene" -o "$tmp/s01.exr" --spp 16 $shard >/dev/null 2>&1
+if "$bin" merge "$tmp/s0.exr" "$tmp/s1.exr" -o "$tmp/merged.exr" >"$tmp/out" 2>"$tmp/err" &&
+  { ! command -v oiiotool >/dev/null ||
+    { oiiotool --info -v "$tmp/s1.exr" | grep -q 'candela:sample_offset: "8"' &&
+      oiiotool --info -v "$tmp/merged.exr" | grep -q 'candela:spp: "16"' &&
+      oiiotool --info -v "$tmp/merged.exr" | grep -q 'candela:sample_ranges: "0:16"'; }; } &&
+  { [ $have_oiio_py -eq 0 ] || images_close "$tmp/s01.exr" "$tmp/merged.exr" 0 1e-5; } &&
+  { [ $have_oiio_py -eq 0 ] || ! images_close "$tmp/s01.exr" "$tmp/s0.exr" 0 1e-5 2>/dev/null; }; then
+  pass "merge of shards [0,8) and [8,16) equals the 16-spp render"
+else
+  fail "merge of shards"; cat "$tmp/out" "$tmp/err"
+fi
+# A merged file merges on with a disjoint shard, not with one it holds
+"$bin" render "$scene" -o "$tmp/s2.exr" --sample-offset 16 --spp 4 $shard >/dev/null 2>&1
+if "$bin" merge "$tmp/merged.exr" "$tmp/s2.exr" -o "$tmp/merged2.exr" >/dev/null 2>"$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || oiiotool --info -v "$tmp/merged2.exr" | grep -q 'candela:spp: "20"'; }; then
+  pass "merge of a merged image and a further shard"
+else
+  fail "merge of a merged image and a further shard"; cat "$tmp/err"
+fi
+expect_error "merge: overlap with a merged image" "overlapping sample ranges" -- "$bin" merge "$tmp/merged.exr" "$tmp/s1.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_overlap.exr" --sample-offset 4 --spp 8 $shard >/dev/null 2>&1
+expect_error "merge: overlapping ranges" "overlapping sample ranges" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_overlap.exr" -o "$tmp/x.exr"
+expect_error "merge: same file twice" "overlapping sample ranges" -- "$bin" merge "$tmp/s0.exr" "$tmp/s0.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_size.exr" --sample-offset 8 --spp 8 --width 16 --height 32 --seed 7 --device pocl -q >/dev/null 2>&1
+expect_error "merge: different sizes" "is 16x32" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_size.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_seed.exr" --sample-offset 8 --spp 8 --width 32 --height 32 --seed 8 --device pocl -q >/dev/null 2>&1
+expect_error "merge: different seeds" "different seed" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_seed.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_strat.exr" --sample-offset 8 --spp 8 --strategy bsdf $shard >/dev/null 2>&1
+expect_error "merge: different strategies" "different strategy" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_strat.exr" -o "$tmp/x.exr"
+"$bin" render "$scene" -o "$tmp/s_depth.exr" --sample-offset 8 --spp 8 --max-depth 3 $shard >/dev/null 2>&1
+expect_error "merge: different max depth" "different max_depth" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_depth.exr" -o "$tmp/x.exr"
+"$bin" render "$root/scenes/materials/materials.gltf" -o "$tmp/s_scene.exr" --sample-offset 8 --spp 1 $shard >/dev/null 2>&1
+expect_error "merge: different scenes" "different scene" -- "$bin" merge "$tmp/s0.exr" "$tmp/s_scene.exr" -o "$tmp/x.exr"
+if command -v oiiotool >/dev/null; then
+  oiiotool --create 32x32 3 -o "$tmp/plain.exr"
+  expect_error "merge: no candela metadata" "no candela metadata" -- "$bin" merge "$tmp/s0.exr" "$tmp/plain.exr" -o "$tmp/x.exr"
+fi
+expect_error "merge: one input" "at least two" -- "$bin" merge "$tmp/s0.exr" -o "$tmp/x.exr"
+expect_error "merge: PNG input" "reads .exr images" -- "$bin" merge "$tmp/s0.exr" "$tmp/x.png" -o "$tmp/x.exr"
+expect_error "merge: missing input" "not found" -- "$bin" merge "$tmp/s0.exr" "$tmp/nope.exr" -o "$tmp/x.exr"
+[ ! -e "$tmp/x.exr" ] && pass "refused merges write nothing" || fail "a refused merge wrote $tmp/x.exr"
+
+# --mpi: without MPI built in, one clear error; with it (CANDELA_MPI_BIN, e.g. a
+# -DCANDELA_MPI=ON build, and mpirun), two ranks give the 16-spp render
+if "$bin" render "$scene" -o "$tmp/mpi1.exr" --mpi $shard --spp 16 >/dev/null 2>"$tmp/err"; then
+  pass "--mpi as a single rank (an MPI build)"
+else
+  expect_error "--mpi without MPI" "built without MPI" -- "$bin" render "$scene" -o "$tmp/x.exr" --mpi $shard --spp 16
+fi
+mpi_bin=${CANDELA_MPI_BIN:-}
+if [ -n "$mpi_bin" ] && command -v mpirun >/dev/null; then
+  mpirun_args="-np 2"
+  [ "$(id -u)" = 0 ] && mpirun_args="$mpirun_args --allow-run-as-root"
+  mpirun --version 2>/dev/null | grep -q "Open MPI" && mpirun_args="$mpirun_args --oversubscribe"
+  if mpirun $mpirun_args "$mpi_bin" render "$scene" -o "$tmp/mpi.exr" --mpi --spp 16 $shard --stats "$tmp/mpi.json" \
+    >"$tmp/out" 2>"$tmp/err" &&
+    python3 -c "import json; s = json.load(open('$tmp/mpi.json')); assert s['spp'] == 16 and s['mpi_ranks'] == 2, s" &&
+    [ "$(grep -c '^wrote' "$tmp/out")" -eq 1 ] &&
+    { [ $have_oiio_py -eq 0 ] || images_close "$tmp/s01.exr" "$tmp/mpi.exr" 0 1e-5; }; then
+    pass "mpirun -np 2 render --mpi gives the 16-spp render"
+  else
+    fail "render --mpi on 2 ranks"; cat "$tmp/out" "$tmp/err"
+  fi
+  # Every rank reports the error (rank-prefixed), and the job exits non-zero
+  if ! mpirun $mpirun_args "$mpi_bin" render "$scene" -o "$tmp/x.exr" --mpi --time 1 --width 8 --device pocl -q \
+    >"$tmp/out" 2>"$tmp/err" && grep -q "^candela: error: rank 0: --mpi needs --spp" "$tmp/err"; then
+    pass "--mpi with --time is refused"
+  else
+    fail "--mpi with --time is refused"; cat "$tmp/err"
+  fi
+fi
+
 # Ctrl-C during a long render writes what was rendered and exits 130
 "$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \
   --stats "$tmp/int.json" >"$tmp/int.out" 2>"$tmp/int.err" &

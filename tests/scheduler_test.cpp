@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "error.hpp"
 #include "gltf_loader.hpp"
 #include "renderer.hpp"
 #include "test_support.hpp"
@@ -48,6 +49,37 @@ TEST(Scheduler, TimeLimitWithTwoWorkersKeepsWholeRanges) {
   RenderResult r = render_samples({&a, &b}, 0, 0, 0.3);
   EXPECT_GE(r.spp, 1u);
   for (size_t i = 0; i < r.film.pixels(); ++i) ASSERT_GE(r.film.samples(i), float(r.spp)) << "pixel " << i;
+}
+
+// Renderer on a list of devices (the same PoCL device twice: two workers): the image of
+// the single-device render, the shares of the samples adding up to all of them, and the
+// progress reporting each worker's samples
+TEST(Scheduler, RendererOnTwoDevicesReportsEachShare) {
+  auto scene = std::make_shared<const CompiledScene>(compile_scene(load_gltf(scene_path("cornell-box/cornell-box.gltf"))));
+  RenderSettings settings;
+  settings.width = settings.height = 16;
+  settings.seed = 5;
+  settings.launch_seconds = 1e-3;
+  DeviceEntry device = pocl_device();
+  Film one = Renderer(device, scene, settings).render(4, 24).film;
+
+  Renderer two({device, device}, scene, settings);
+  ASSERT_EQ(two.worker_count(), 2u);
+  std::vector<double> last;
+  RenderResult r = two.render(4, 24, 0.0, [&](const RenderProgress& p) { last = p.worker_spp; });
+  EXPECT_EQ(r.spp, 24u);
+  ASSERT_EQ(r.worker_samples.size(), 2u);
+  EXPECT_GT(r.worker_samples[0], 0u);
+  EXPECT_GT(r.worker_samples[1], 0u);
+  EXPECT_EQ(r.worker_samples[0] + r.worker_samples[1], uint64_t(24) * 16 * 16);
+  ASSERT_EQ(last.size(), 2u);
+  EXPECT_DOUBLE_EQ(last[0] + last[1], 24.0);
+  for (size_t i = 0; i < one.pixels(); ++i) {
+    ASSERT_EQ(r.film.samples(i), 24.0f) << "pixel " << i;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(r.film.pixel(i)[c], one.pixel(i)[c], 1e-4f * (1.0f + one.pixel(i)[c])) << "pixel " << i;
+  }
+  EXPECT_THROW(Renderer(std::vector<DeviceEntry>{}, scene, settings), Error);
 }
 
 }  // namespace candela::test
