@@ -40,8 +40,8 @@ using nlohmann::json;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kPhaseSamples = 1 << 20;
-const std::vector<float> kPhaseG = {0.0f, 0.3f, 0.7f, -0.5f, 0.95f};
-constexpr int kChiSquareTests = 5 * 2;  // kPhaseG on each device
+const std::vector<float> kPhaseG = {0.0f, 0.3f, 0.5f, 0.7f, -0.3f, -0.5f, -0.9f, 0.95f};
+constexpr int kChiSquareTests = 8 * 2;  // kPhaseG on each device
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 
 KernelRig& rig_for(const std::string& name) {
@@ -89,15 +89,15 @@ PhaseSamples sample_phase(KernelRig& rig, float g, cl_uint seed) {
   return s;
 }
 
-// Cells: kCos rings with edges crowded toward c = -1 (the forward peak, wi = -wo) and
+// Cells: kCos rings with edges crowded toward c = -1 and c = 1 (the forward peak at
+// wi = -wo for g > 0, the backward one for g < 0) and
 // kPhi sectors. Expected probabilities integrate the host pdf over each ring (Simpson).
 constexpr int kCos = 48, kPhi = 8;
-double cos_edge(int i) {  // -1 .. 1, dense near -1
-  double x = double(i) / kCos;
-  return -1.0 + 2.0 * x * x;
+double cos_edge(int i) {  // -1 .. 1, dense near both ends (forward and backward peaks)
+  return -std::cos(kPi * double(i) / kCos);
 }
 int cos_cell(double c) {
-  double x = std::sqrt(std::clamp((c + 1.0) / 2.0, 0.0, 1.0));
+  double x = std::acos(-std::clamp(c, -1.0, 1.0)) / kPi;
   return std::min(kCos - 1, int(x * kCos));
 }
 
@@ -196,7 +196,7 @@ TEST_P(PhaseTest, PdfIntegratesToOne) {
   std::vector<double> weights;
   for (int i = 0; i < nc; ++i) {
     double x0 = double(i) / nc, x1 = double(i + 1) / nc, xm = 0.5 * (x0 + x1);
-    double c = -1.0 + 2.0 * xm * xm, dc = 2.0 * (x1 * x1 - x0 * x0);
+    double c = -std::cos(kPi * xm), dc = std::cos(kPi * x0) - std::cos(kPi * x1);
     double sn = std::sqrt(std::max(0.0, 1.0 - c * c));
     for (int j = 0; j < np; ++j) {
       double phi = 2.0 * kPi * (j + 0.5) / np;
