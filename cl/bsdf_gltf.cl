@@ -131,13 +131,29 @@ GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e, const GltfL
 // Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor, at the coat lobe's wo.h
 float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->coat * (0.04f + 0.96f * schlick_weight(cos_i)); }
 
-// Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample
-float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
+// What depends on wo alone: the albedo-table lookups, the layers and the mixture weights
+// (computed once per sample: bsdf_gltf_sample evaluates with the ones it sampled with)
+typedef struct {
+  GgxEnergy e;
+  GltfLayer spec, coat;
+  GltfLobes w;
+} GltfAtWo;
+
+GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
+  GltfAtWo g;
+  g.e = gltf_energy(b, cos_o);
+  g.spec = gltf_spec_layer(b, &g.e, cos_o);
+  g.coat = gltf_coat_layer(b, cos_o);
+  g.w = gltf_lobes(b, cos_o, &g.e, &g.spec, &g.coat);
+  return g;
+}
+
+// Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
+float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
-  if (wo.z <= 0.0f) return (float3)(0.0f);
-  GgxEnergy e = gltf_energy(b, wo.z);
-  GltfLayer spec = gltf_spec_layer(b, &e, wo.z), coat = gltf_coat_layer(b, wo.z);
-  GltfLobes w = gltf_lobes(b, wo.z, &e, &spec, &coat);
+  GgxEnergy e = g->e;
+  GltfLayer spec = g->spec, coat = g->coat;
+  GltfLobes w = g->w;
   float m = b->metallic, t = b->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
   float cos_h = wo.z;  // wo.h of reflections
@@ -175,6 +191,14 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   return f;
 }
 
+// Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample
+float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
+  *pdf = 0.0f;
+  if (wo.z <= 0.0f) return (float3)(0.0f);
+  GltfAtWo g = gltf_at_wo(b, wo.z);
+  return gltf_eval_at(b, &g, wo, wi, pdf);
+}
+
 // A mirror reflection (a delta component) of weight `weight`, chosen with probability p
 bool gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
   bs->wi = (float3)(-wo.x, -wo.y, wo.z);
@@ -187,9 +211,9 @@ bool gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
 
 bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
-  GgxEnergy e = gltf_energy(b, wo.z);
-  GltfLayer spec = gltf_spec_layer(b, &e, wo.z), coat = gltf_coat_layer(b, wo.z);
-  GltfLobes w = gltf_lobes(b, wo.z, &e, &spec, &coat);
+  GltfAtWo at_wo = gltf_at_wo(b, wo.z);
+  GltfLayer coat = at_wo.coat;
+  GltfLobes w = at_wo.w;
   float m = b->metallic, t = b->transmission;
   // Component by uc (coat, metal, spec, diffuse, ms, glass); uc is then rescaled to [0, 1)
   // within the component for reuse
@@ -222,7 +246,7 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
     }
   }
   bool transmits = bs->wi.z < 0.0f;
-  bs->f = bsdf_gltf_eval(b, wo, bs->wi, &bs->pdf);
+  bs->f = gltf_eval_at(b, &at_wo, wo, bs->wi, &bs->pdf);
   bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | (c == 3 ? BSDF_DIFFUSE : BSDF_GLOSSY);
   bs->eta = transmits && !b->thin ? b->eta : 1.0f;
   return bs->pdf > 0.0f;
