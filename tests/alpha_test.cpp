@@ -259,15 +259,6 @@ double z_score(const Estimate& a, const Estimate& b) {
   return (a.mean - b.mean) / std::sqrt(a.standard_error * a.standard_error + b.standard_error * b.standard_error);
 }
 
-Film render(const Scene& scene, Strategy strategy, int size, uint32_t spp, uint32_t max_depth, uint32_t seed) {
-  RenderSettings settings;
-  settings.width = settings.height = size;
-  settings.strategy = strategy;
-  settings.max_depth = max_depth;
-  settings.seed = seed;
-  return Renderer(pocl_device(), scene, settings).render(0, spp).film;
-}
-
 // A black card z = 0, |x|, |y| <= 1, filling the view of a camera at z = 2, before a
 // background of radiance 1: every sample is 1 (through the card) or 0 (on it)
 Scene window_scene(const MaterialDesc& card_material) {
@@ -288,7 +279,7 @@ Scene window_scene(const MaterialDesc& card_material) {
 // Pixels wholly inside a quadrant are exact; by the checker's mirror symmetry half the
 // view is hole, so the image mean is 1/2 within its standard error.
 TEST(AlphaRender, CameraRaysSeeThroughMaskHoles) {
-  Film f = render(window_scene(card(AlphaMode::Mask, 1.0f, true)), Strategy::Nee, 16, 32, 4, 1);
+  Film f = render_film(window_scene(card(AlphaMode::Mask, 1.0f, true)), Strategy::Nee, 16, 16, 32, 4, 1);
   for (int y : {1, 3, 6})
     for (int x : {1, 3, 6}) {
       EXPECT_EQ(f.pixel(size_t(y) * 16 + x).y, 0.0f) << "top-left " << x << "," << y;
@@ -299,13 +290,13 @@ TEST(AlphaRender, CameraRaysSeeThroughMaskHoles) {
   Estimate e = image_mean(f);
   EXPECT_NEAR(e.mean, 0.5, 4.0 * e.standard_error + 1e-6);
   // OPAQUE ignores alpha: the same card, factor alpha 0 and the checker, hides everything
-  Film opaque = render(window_scene(card(AlphaMode::Opaque, 0.0f, true)), Strategy::Nee, 16, 8, 4, 1);
+  Film opaque = render_film(window_scene(card(AlphaMode::Opaque, 0.0f, true)), Strategy::Nee, 16, 16, 8, 4, 1);
   for (size_t i = 0; i < opaque.pixels(); ++i) ASSERT_EQ(opaque.pixel(i).y, 0.0f) << "pixel " << i;
 }
 
 // BLEND at alpha 0.5: every pixel shows half the background, within its standard error
 TEST(AlphaRender, BlendAtHalfAlphaTransmitsHalfTheBackground) {
-  Film f = render(window_scene(card(AlphaMode::Blend, 0.5f, false)), Strategy::Nee, 16, 64, 4, 3);
+  Film f = render_film(window_scene(card(AlphaMode::Blend, 0.5f, false)), Strategy::Nee, 16, 16, 64, 4, 3);
   Estimate e = image_mean(f);
   EXPECT_NEAR(e.mean, 0.5, 4.0 * e.standard_error);
   EXPECT_LT(e.standard_error, 0.01);
@@ -360,11 +351,11 @@ Scene shadow_scene(Card kind) {
 TEST(AlphaRender, MaskedAndBlendedCardsCastHalfTheShadow) {
   const int size = 24;
   const uint32_t spp = 64;
-  Estimate none = image_mean(render(shadow_scene(Card::None), Strategy::Nee, size, spp, 1, 1));
-  Estimate full = image_mean(render(shadow_scene(Card::Opaque), Strategy::Nee, size, spp, 1, 2));
-  Estimate mask = image_mean(render(shadow_scene(Card::Mask), Strategy::Nee, size, spp, 1, 3));
-  Estimate inverted = image_mean(render(shadow_scene(Card::MaskInverted), Strategy::Nee, size, spp, 1, 4));
-  Estimate blend = image_mean(render(shadow_scene(Card::Blend), Strategy::Nee, size, spp, 1, 5));
+  Estimate none = image_mean(render_film(shadow_scene(Card::None), Strategy::Nee, size, size, spp, 1, 1));
+  Estimate full = image_mean(render_film(shadow_scene(Card::Opaque), Strategy::Nee, size, size, spp, 1, 2));
+  Estimate mask = image_mean(render_film(shadow_scene(Card::Mask), Strategy::Nee, size, size, spp, 1, 3));
+  Estimate inverted = image_mean(render_film(shadow_scene(Card::MaskInverted), Strategy::Nee, size, size, spp, 1, 4));
+  Estimate blend = image_mean(render_film(shadow_scene(Card::Blend), Strategy::Nee, size, size, spp, 1, 5));
   EXPECT_LT(full.mean, 0.7 * none.mean) << "the card must cast a clear shadow";
   Estimate half{0.5 * (none.mean + full.mean),
                 0.5 * std::sqrt(none.standard_error * none.standard_error + full.standard_error * full.standard_error)};
@@ -411,8 +402,8 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
   ASSERT_TRUE(scene.textures.at(0).nearest);
   ASSERT_TRUE(scene.features().alpha);
   const int size = 16;
-  Film nee = render(scene, Strategy::Nee, size, 256, 3, 1);
-  Film bsdf = render(scene, Strategy::Bsdf, size, 2048, 3, 2);
+  Film nee = render_film(scene, Strategy::Nee, size, size, 256, 3, 1);
+  Film bsdf = render_film(scene, Strategy::Bsdf, size, size, 2048, 3, 2);
   double chi2 = 0.0;
   int blocks = 0;
   for (int by = 0; by < size; by += 4)

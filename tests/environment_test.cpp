@@ -317,16 +317,6 @@ INSTANTIATE_TEST_SUITE_P(Devices, EnvironmentKernels, ::testing::Values("pocl", 
 
 namespace {
 
-Film render(const Scene& scene, Strategy s, int w, int h, uint32_t spp, uint32_t max_depth, uint32_t seed) {
-  RenderSettings settings;
-  settings.width = w;
-  settings.height = h;
-  settings.strategy = s;
-  settings.max_depth = max_depth;
-  settings.seed = seed;
-  return Renderer(pocl_device(), scene, settings).render(0, spp).film;
-}
-
 nlohmann::json lambert(float albedo) {
   return {{"pbrMetallicRoughness", {{"baseColorFactor", {albedo, albedo, albedo, 1}}, {"metallicFactor", 0.0}}},
           {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
@@ -346,7 +336,7 @@ TEST(EnvironmentRender, WhiteSphereUnderConstantMapIsInvisible) {
   Scene scene = load_gltf(path);
   scene.environment = env_of(make_map(16, 8, [](int, int) { return glm::vec3(0.6f); }), 1.5f, 20.0f);
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
-    Film f = render(scene, s, 16, 16, 256, 1000, 7);
+    Film f = render_film(scene, s, 16, 16, 256, 1000, 7);
     Estimate e = image_mean(f);
     EXPECT_LT(e.standard_error, 0.01);
     EXPECT_NEAR(e.mean, 0.9, 4.0 * e.standard_error + 1e-5) << (s == Strategy::Nee ? "nee" : "bsdf");
@@ -369,8 +359,8 @@ TEST(EnvironmentRender, TinySunNeeAgreesWithBsdfAndHasLowerVariance) {
   scene.environment = load_environment(scene_path("lights/tiny-sun.hdr"), 1.0f, 0.0f);
   const int size = 16;
   const uint32_t nee_spp = 64, bsdf_spp = 4096;
-  Film nee = render(scene, Strategy::Nee, size, size, nee_spp, 3, 1);
-  Film bsdf = render(scene, Strategy::Bsdf, size, size, bsdf_spp, 3, 2);
+  Film nee = render_film(scene, Strategy::Nee, size, size, nee_spp, 3, 1);
+  Film bsdf = render_film(scene, Strategy::Bsdf, size, size, bsdf_spp, 3, 2);
   Estimate a = image_mean(nee), b = image_mean(bsdf);
   double se = std::sqrt(a.standard_error * a.standard_error + b.standard_error * b.standard_error);
   EXPECT_GT(a.mean, 0.1) << "the sun lights the scene";
@@ -409,7 +399,7 @@ TEST(EnvironmentRender, RotationMovesTheSun) {
       cam.forward = glm::vec3(d);
       cam.yfov = 0.2f * float(kPi) / 180.0f;  // a pixel far inside one texel
       scene.camera = cam;
-      Film f = render(scene, Strategy::Nee, 1, 1, 4, 0, 0);
+      Film f = render_film(scene, Strategy::Nee, 1, 1, 4, 0, 0);
       bool want_sun = rotation == 0.0f ? d == d0 : d == d90;
       glm::ivec2 t = host_texel(d, w, h, rotation);
       float texel = env.image.rgbaf[4 * (size_t(t.y) * w + t.x)];

@@ -15,16 +15,6 @@ namespace {
 
 using nlohmann::json;
 
-const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : "bsdf"; }
-
-Film render(const Scene& scene, Strategy s, int size, uint32_t spp, uint32_t max_depth, uint32_t seed) {
-  RenderSettings settings;
-  settings.width = settings.height = size;
-  settings.strategy = s;
-  settings.max_depth = max_depth;
-  settings.seed = seed;
-  return Renderer(pocl_device(), scene, settings).render(0, spp).film;
-}
 
 // A sphere of `material` filling most of the view under a uniform background of 1
 Scene furnace_scene(const json& material, const std::string& file) {
@@ -80,11 +70,11 @@ TEST_P(MaterialFurnace, InvisibleUnderUniformBackground) {
   Strategy s = std::get<1>(GetParam());
   if (c.bsdf_only && s == Strategy::Nee) GTEST_SKIP() << "nee is heavy-tailed on near-delta glass";
   Scene scene = furnace_scene(c.material, std::string("furnace-") + c.label + ".gltf");
-  Film f = render(scene, s, 16, 256, 1000, 7);
+  Film f = render_film(scene, s, 16, 16, 256, 1000, 7);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
-  EXPECT_LE(e.mean, 1.0 + 4.0 * e.standard_error + 1e-5) << c.label << " " << name(s) << " creates energy";
-  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + c.tolerance) << c.label << " " << name(s) << " SE " << e.standard_error;
+  EXPECT_LE(e.mean, 1.0 + 4.0 * e.standard_error + 1e-5) << c.label << " " << strategy_name(s) << " creates energy";
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + c.tolerance) << c.label << " " << strategy_name(s) << " SE " << e.standard_error;
   for (int by = 0; by < 16; by += 4)
     for (int bx = 0; bx < 16; bx += 4) {
       Estimate b = region_mean(f, 1, bx, bx + 4, by, by + 4);
@@ -98,7 +88,7 @@ INSTANTIATE_TEST_SUITE_P(Materials, MaterialFurnace,
                                             ::testing::Values(Strategy::Nee, Strategy::Bsdf)),
                          [](const auto& info) {
                            return std::string(furnace_cases()[size_t(std::get<0>(info.param))].label) + "_" +
-                                  name(std::get<1>(info.param));
+                                  strategy_name(std::get<1>(info.param));
                          });
 
 // A mirror sphere and a glass sphere under a small area light over a dark floor: under
@@ -128,8 +118,8 @@ TEST_P(SpecularShowsLight, NeeSeesTheLightAndStrategiesAgree) {
   g.write(path);
   Scene scene = load_gltf(path);
   const int size = 24;
-  Film nee = render(scene, Strategy::Nee, size, 256, 12, 3);
-  Film bsdf = render(scene, Strategy::Bsdf, size, 2048, 12, 4);
+  Film nee = render_film(scene, Strategy::Nee, size, size, 256, 12, 3);
+  Film bsdf = render_film(scene, Strategy::Bsdf, size, size, 2048, 12, 4);
   // The light, seen via the sphere, makes the brightest pixels of the nee image
   float brightest = 0.0f;
   for (size_t i = 0; i < nee.pixels(); ++i) brightest = std::max(brightest, nee.pixel(i).y);
@@ -183,17 +173,17 @@ TEST_P(ShadingNormals, NoBlackFringesAtSilhouettesOfSmoothedCoarseMeshes) {
   g.write(path);
   Scene scene = load_gltf(path);
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
-    Film f = render(scene, s, 64, 64, 8, 3);
+    Film f = render_film(scene, s, 64, 64, 64, 8, 3);
     // Dark pixels: the BSDF-sampled furnace is nearly noise-free (every path ends in the
     // background with weight about 1); light sampling of glossy lobes is too noisy per pixel
     size_t dark = 0;
     for (size_t i = 0; i < f.pixels() && s == Strategy::Bsdf; ++i)
       if (f.pixel(i).x < 0.6f) ++dark;
     Estimate e = image_mean(f);
-    std::printf("material %d %s: %zu of %zu pixels below 0.6, image mean %.4f +- %.4f\n", GetParam(), name(s), dark,
+    std::printf("material %d %s: %zu of %zu pixels below 0.6, image mean %.4f +- %.4f\n", GetParam(), strategy_name(s), dark,
                 f.pixels(), e.mean, e.standard_error);
-    EXPECT_EQ(dark, 0u) << name(s);
-    EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01) << name(s);
+    EXPECT_EQ(dark, 0u) << strategy_name(s);
+    EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01) << strategy_name(s);
   }
 }
 INSTANTIATE_TEST_SUITE_P(WhiteMaterials, ShadingNormals, ::testing::Values(0, 1, 2));

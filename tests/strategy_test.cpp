@@ -26,16 +26,6 @@ namespace {
 
 constexpr int kWidth = 96, kHeight = 64;
 
-Film render(const Scene& scene, Strategy s, uint32_t spp, uint32_t max_depth, uint32_t seed) {
-  RenderSettings settings;
-  settings.width = kWidth;
-  settings.height = kHeight;
-  settings.strategy = s;
-  settings.max_depth = max_depth;
-  settings.seed = seed;
-  return Renderer(pocl_device(), scene, settings).render(0, spp).film;
-}
-
 double rel_mse(const Film& f, const Film& ref) {
   double sum = 0.0;
   for (size_t i = 0; i < f.pixels(); ++i)
@@ -45,8 +35,6 @@ double rel_mse(const Film& f, const Film& ref) {
     }
   return sum / double(3 * f.pixels());
 }
-
-const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : s == Strategy::Bsdf ? "bsdf" : "auto"; }
 
 struct Errors {
   double nee = 0.0, bsdf = 0.0, automatic = 0.0;
@@ -62,12 +50,12 @@ struct Errors {
 Errors compare(const std::string& file, uint32_t max_depth, uint32_t spp, int seeds, Strategy ref_strategy,
                uint32_t ref_spp, std::vector<Strategy> agree) {
   Scene scene = load_gltf(scene_path(file));
-  Film ref = render(scene, ref_strategy, ref_spp, max_depth, 1000);
+  Film ref = render_film(scene, ref_strategy, kWidth, kHeight, ref_spp, max_depth, 1000);
   Estimate ref_mean = image_mean(ref);
   Errors e;
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf, Strategy::Auto})
     for (int k = 0; k < seeds; ++k) {
-      Film f = render(scene, s, spp, max_depth, uint32_t(k + 1));
+      Film f = render_film(scene, s, kWidth, kHeight, spp, max_depth, uint32_t(k + 1));
       double err = rel_mse(f, ref);
       (s == Strategy::Nee ? e.nee : s == Strategy::Bsdf ? e.bsdf : e.automatic) += err / seeds;
       EXPECT_TRUE(std::isfinite(err));
@@ -75,7 +63,7 @@ Errors compare(const std::string& file, uint32_t max_depth, uint32_t spp, int se
       Estimate m = image_mean(f);
       double se = std::hypot(m.standard_error, ref_mean.standard_error);
       EXPECT_NEAR(m.mean, ref_mean.mean, 5.0 * se + 0.01 * ref_mean.mean)
-          << file << " " << name(s) << " seed " << k + 1 << " disagrees with the reference";
+          << file << " " << strategy_name(s) << " seed " << k + 1 << " disagrees with the reference";
     }
   std::printf("%s (depth %u, %d x %u spp): relMSE nee %.5f, bsdf %.5f, auto %.5f\n", file.c_str(), max_depth, seeds,
               spp, e.nee, e.bsdf, e.automatic);
@@ -89,7 +77,7 @@ TEST(Strategies, SmallLightFavoursLightSampling) {
   EXPECT_LT(3.0 * e.nee, e.bsdf);
   // Every vertex is diffuse: auto takes the same light samples as nee, number for number
   Scene scene = load_gltf(scene_path("lights/small-light.gltf"));
-  Film a = render(scene, Strategy::Auto, 4, 4, 7), n = render(scene, Strategy::Nee, 4, 4, 7);
+  Film a = render_film(scene, Strategy::Auto, kWidth, kHeight, 4, 4, 7), n = render_film(scene, Strategy::Nee, kWidth, kHeight, 4, 4, 7);
   EXPECT_EQ(a.mean, n.mean);
 }
 
@@ -118,10 +106,10 @@ TEST(Strategies, HeavyTailedStrategiesAgreeAtHighSampleCounts) {
   for (const Case& c : {Case{"lights/small-light.gltf", Strategy::Nee, Strategy::Bsdf},
                         Case{"lights/large-light-glossy.gltf", Strategy::Bsdf, Strategy::Nee}}) {
     Scene scene = load_gltf(scene_path(c.file));
-    Estimate good = image_mean(render(scene, c.good, 256, 4, 1000));
-    Estimate heavy = image_mean(render(scene, c.heavy, 2048, 4, 2000));
-    std::printf("%s: %s %.5f +- %.5f, %s %.5f +- %.5f\n", c.file, name(c.good), good.mean, good.standard_error,
-                name(c.heavy), heavy.mean, heavy.standard_error);
+    Estimate good = image_mean(render_film(scene, c.good, kWidth, kHeight, 256, 4, 1000));
+    Estimate heavy = image_mean(render_film(scene, c.heavy, kWidth, kHeight, 2048, 4, 2000));
+    std::printf("%s: %s %.5f +- %.5f, %s %.5f +- %.5f\n", c.file, strategy_name(c.good), good.mean, good.standard_error,
+                strategy_name(c.heavy), heavy.mean, heavy.standard_error);
     EXPECT_NEAR(heavy.mean, good.mean, 4.0 * std::hypot(good.standard_error, heavy.standard_error) + 0.02 * good.mean)
         << c.file;
   }

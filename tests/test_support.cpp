@@ -90,3 +90,25 @@ std::string scene_path(const std::string& relative) {
 }
 
 }  // namespace candela::test
+
+namespace candela::test {
+
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
+                 uint32_t seed, const DeviceEntry& device) {
+  RenderSettings settings;
+  settings.width = w;
+  settings.height = h;
+  settings.strategy = strategy;
+  settings.max_depth = max_depth;
+  settings.seed = seed;
+  return Renderer(device, scene, settings).render(0, spp).film;
+}
+
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
+                 uint32_t seed) {
+  return render_film(scene, strategy, w, h, spp, max_depth, seed, pocl_device());
+}
+
+const char* strategy_name(Strategy s) { return s == Strategy::Nee ? "nee" : s == Strategy::Bsdf ? "bsdf" : "auto"; }
+
+}  // namespace candela::test

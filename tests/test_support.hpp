@@ -10,6 +10,7 @@
 #include "film.hpp"
 #include "device_types.hpp"
 #include "gltf_builder.hpp"
+#include "renderer.hpp"
 #include "scene_compiler.hpp"
 
 namespace candela::test {
@@ -59,5 +60,14 @@ Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1);  // 
 Estimate image_mean(const Film& f);  // all pixels, channels averaged
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
+
+// A w x h render of `scene` with `spp` samples per pixel (sample indices [0, spp)) on
+// `device`; every other setting is RenderSettings' default
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
+                 uint32_t seed, const DeviceEntry& device);
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
+                 uint32_t seed);  // on PoCL
+
+const char* strategy_name(Strategy s);  // "nee", "bsdf" or "auto", as the CLI spells them
 
 }  // namespace candela::test
