@@ -148,19 +148,26 @@ struct EnergyRig {
     return {mean, std::sqrt(std::max(sum2 / kSamples - mean * mean, 0.0) / kSamples)};
   }
 
-  // kSamples of bsdf_sample: per sample (wi, pdf), (f, flags), (bsdf_eval, bsdf_pdf)
-  std::vector<cl_float4> sample(const dev::Material& m, bool with_table, glm::dvec3 wo, cl_uint seed) {
+  // One work-item per sample of a kernel (material, table, with_table, wo, seed, out) that
+  // writes `per_item` float4 per work-item
+  std::vector<cl_float4> per_sample(const char* kernel, const dev::Material& m, bool with_table, glm::dvec3 wo,
+                                    cl_uint seed, size_t n, size_t per_item) {
     cl::Buffer mat = input(std::vector<dev::Material>{m});
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, 3 * kSamples * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_sample");
+    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, per_item * n * sizeof(cl_float4));
+    cl::Kernel k(rig.program, kernel);
     k.setArg(0, mat);
     k.setArg(1, table.buffer);
     k.setArg(2, cl_uint(with_table));
     k.setArg(3, f4(wo));
     k.setArg(4, seed);
     k.setArg(5, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
-    return read<cl_float4>(out, 3 * kSamples);
+    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
+    return read<cl_float4>(out, per_item * n);
+  }
+
+  // kSamples of bsdf_sample: per sample (wi, pdf), (f, flags), (bsdf_eval, bsdf_pdf)
+  std::vector<cl_float4> sample(const dev::Material& m, bool with_table, glm::dvec3 wo, cl_uint seed) {
+    return per_sample("test_energy_sample", m, with_table, wo, seed, kSamples, 3);
   }
 
   // (bsdf_eval, bsdf_pdf) for pairs (wo, wi)
@@ -185,17 +192,7 @@ struct EnergyRig {
   // Mean sample weight f cos / pdf per channel (0 for a failed sample): the albedo
   std::array<Mean, 3> albedo(const dev::Material& m, bool with_table, glm::dvec3 wo, cl_uint seed,
                              size_t n = kSamples) {
-    cl::Buffer mat = input(std::vector<dev::Material>{m});
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_albedo");
-    k.setArg(0, mat);
-    k.setArg(1, table.buffer);
-    k.setArg(2, cl_uint(with_table));
-    k.setArg(3, f4(wo));
-    k.setArg(4, seed);
-    k.setArg(5, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    std::vector<cl_float4> w = read<cl_float4>(out, n);
+    std::vector<cl_float4> w = per_sample("test_energy_albedo", m, with_table, wo, seed, n, 1);
     std::array<Mean, 3> a;
     for (int c = 0; c < 3; ++c) {
       double sum = 0.0, sum2 = 0.0;
