@@ -85,13 +85,6 @@ bool checker_opaque(double x, double y) {
   return (col + row) % 2 == 0;
 }
 
-KernelRig& rig_for(const DeviceEntry& d, const std::string& name) {
-  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
-  auto& r = rigs[name];
-  if (!r) r = std::make_unique<KernelRig>(d);
-  return *r;
-}
-
 struct Traced {
   std::vector<cl_float4> hits;  // (t, b1, b2, prim)
   std::vector<cl_int> occluded;
@@ -143,7 +136,7 @@ class AlphaTraceTest : public ::testing::TestWithParam<std::string> {
   void SetUp() override {
     DeviceEntry d;
     CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &rig_for(d, GetParam());
+    rig_ = &shared_rig(GetParam(), d);
   }
   // Closest hits over the whole ray, and shadow rays that end between card and wall
   // agreeing with closest hits over the same span, ray by ray
@@ -424,7 +417,7 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
 
 // 2x1 texture, texels (0.2, 0.4, 0.6, 1) and (1, 0.8, 0, 0.5), linear RGBA8, repeating
 TEST(Textures, NearestLookupReturnsExactTexelsWhereBilinearBlends) {
-  KernelRig& rig = rig_for(pocl_device(), "pocl");
+  KernelRig& rig = shared_rig("pocl", pocl_device());
   Scene s;
   TextureDesc t;
   t.width = 2;

@@ -34,13 +34,6 @@ constexpr size_t kSamples = 1 << 20;
 constexpr int kChiSquareTests = 2 * 2;  // per device: sky and sun at two rotations
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 
-KernelRig& rig_for(const DeviceEntry& d, const std::string& name) {
-  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
-  auto& r = rigs[name];
-  if (!r) r = std::make_unique<KernelRig>(d);
-  return *r;
-}
-
 // A w x h float map whose texel (x, y) is rgb(x, y)
 TextureDesc make_map(int w, int h, const std::function<glm::vec3(int, int)>& rgb) {
   TextureDesc t;
@@ -113,7 +106,7 @@ class EnvironmentKernels : public ::testing::TestWithParam<std::string> {
   void SetUp() override {
     DeviceEntry d;
     CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &rig_for(d, GetParam());
+    rig_ = &shared_rig(GetParam(), d);
   }
 
   void use(const EnvironmentDesc& env) {

@@ -27,14 +27,6 @@ const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 // Flags of test_lights_sample (tests/cl/test_lights.cl)
 constexpr unsigned kOk = 1, kCompared = 2, kShadowClear = 4, kAtInfinity = 8, kDelta = 16;
 
-// One program per device for the whole file
-KernelRig& rig_for(const DeviceEntry& d, const std::string& name) {
-  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
-  auto& r = rigs[name];
-  if (!r) r = std::make_unique<KernelRig>(d);
-  return *r;
-}
-
 cl_float4 f4(const glm::dvec3& v) { return {{float(v.x), float(v.y), float(v.z), 0.0f}}; }
 glm::dvec3 d3(const cl_float4& v) { return {v.s[0], v.s[1], v.s[2]}; }
 
@@ -119,7 +111,7 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
   void SetUp() override {
     DeviceEntry d;
     CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &rig_for(d, GetParam());
+    rig_ = &shared_rig(GetParam(), d);
   }
 
   void use_scene(const Scene& s) {

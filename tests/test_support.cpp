@@ -1,6 +1,8 @@
 #include "test_support.hpp"
 
 #include <cmath>
+#include <map>
+#include <memory>
 
 #include "error.hpp"
 #include "kernel_sources.hpp"
@@ -92,6 +94,13 @@ std::string scene_path(const std::string& relative) {
 }  // namespace candela::test
 
 namespace candela::test {
+
+KernelRig& shared_rig(const std::string& name, const DeviceEntry& device) {
+  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
+  auto& r = rigs[name];
+  if (!r) r = std::make_unique<KernelRig>(device);
+  return *r;
+}
 
 Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
                  uint32_t seed, const DeviceEntry& device) {

@@ -40,6 +40,10 @@ struct KernelRig {
   explicit KernelRig(const DeviceEntry& d);
 };
 
+// The test program on the device called `name` ("pocl", "rusticl"), built on first use and
+// kept for the rest of the process
+KernelRig& shared_rig(const std::string& name, const DeviceEntry& device);
+
 // A compiled scene uploaded for test kernels that take CD_SCENE_BUFFERS(CD_SCENE_PARAM)
 // followed by a `__global const RenderParams*` (as render_paths does): bind() sets those
 // arguments from `first_arg` on and returns the index of the next argument.
