@@ -42,11 +42,9 @@ static inline ulong pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offse
   return (ulong)buf[w] | ((ulong)buf[w + 1u] << 32);
 }
 
-// The header copies bits between private scalars (its float/int reinterpretation)
-static inline void nanovdb_copy_bytes(void* dst, const void* src, uint n) {
-  for (uint i = 0u; i < n; ++i) ((uchar*)dst)[i] = ((const uchar*)src)[i];
-}
-#define pnanovdb_memcpy(dst, src, n) nanovdb_copy_bytes((void*)(dst), (const void*)(src), (uint)(n))
+// The header reinterprets the bits of a private scalar as another type of the same size
+// with memcpy(&to, &from, sizeof(to)) (float from uint; the double one is never called)
+#define pnanovdb_memcpy(dst, src, n) (*(dst) = *(const __typeof__(*(dst))*)(src))
 
 #define double float
 #include <nanovdb/PNanoVDB.h>
