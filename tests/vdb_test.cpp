@@ -352,7 +352,7 @@ TEST(VolumeVdbFurnace, RotatedFogSphereIsInvisible) {
   settings.width = settings.height = 16;
   settings.max_depth = 1000;
   settings.seed = 17;
-  Film f = Renderer(*device_by_name("pocl"), scene, settings).render(0, 64).film;
+  Film f = Renderer(*device_by_name("pocl"), scene, settings).render(0, 128).film;
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01);
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << "SE " << e.standard_error;
