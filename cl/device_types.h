@@ -79,7 +79,8 @@
 
 // Medium types (media.cl)
 #define MEDIUM_HOMOGENEOUS 0u
-#define MEDIUM_GRID 1u  // coefficients scaled by a density grid (trilinear), delta tracking
+#define MEDIUM_GRID 1u  // coefficients scaled by a dense density grid (trilinear), delta tracking
+#define MEDIUM_NANOVDB 2u  // as MEDIUM_GRID, the density from a NanoVDB float grid (nanovdb.cl)
 
 // 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
 // bvh_traverse.cl. The four child boxes are stored by coordinate (structure of arrays) so
@@ -204,8 +205,13 @@ typedef struct {
 } Light;
 
 // A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
-// RGB at density 1; MEDIUM_GRID multiplies them by the density at the point (grid value x
-// density_scale). `emission` is radiance emitted per unit length (the lecture's L_e(z)).
+// RGB at density 1; MEDIUM_GRID and MEDIUM_NANOVDB multiply them by the density at the point
+// (grid value x density_scale). `emission` is radiance emitted per unit length (the
+// lecture's L_e(z)). MEDIUM_NANOVDB uses the grid fields differently: grid_offset is the
+// grid's first word in `nanovdb`, grid_size is unused, and grid_min/grid_max are the box in
+// the grid's index space that the majorant cells split (the active voxels and one voxel
+// around them); rays are mapped to index space once per segment (the map is affine, so the
+// ray parameter t is the same in both spaces).
 typedef struct {
   float sigma_a[4];  // absorption, rgb (w unused)
   float sigma_s[4];  // scattering, rgb
@@ -265,7 +271,8 @@ typedef struct {
 // generates the kernel's parameters and SceneData (cl/scene_data.cl) and the host's
 // SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
 // Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
-// vertex; an array the scene does not need holds one dummy element. env_distribution holds
+// vertex; an array the scene does not need holds one dummy element. nanovdb holds the NanoVDB
+// grids of MEDIUM_NANOVDB media, each a NanoVDB buffer starting on a 32-byte boundary. env_distribution holds
 // the environment map's sampling CDFs (cl/environment.cl), one dummy without a map. ggx_albedo is no part
 // of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
 #define CD_SCENE_BUFFERS(X)  \
@@ -288,6 +295,7 @@ typedef struct {
   X(float, env_distribution) \
   X(Medium, media)           \
   X(float, densities)        \
+  X(unsigned int, nanovdb)   \
   X(float, ggx_albedo)
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and

@@ -13,8 +13,9 @@
 // lies in (media_at_origin).
 //
 // Coefficients: sigma_t = sigma_a + sigma_s per RGB channel, times the grid's density for
-// MEDIUM_GRID; `emission` is emitted radiance per unit length (the lecture's L_e(z)), so a
-// ray crossing length d of a homogeneous medium gathers emission (1 - exp(-sigma_t d)) / sigma_t.
+// MEDIUM_GRID (dense) and MEDIUM_NANOVDB (nanovdb.cl); `emission` is emitted radiance per
+// unit length (the lecture's L_e(z)), so a ray crossing length d of a homogeneous medium
+// gathers emission (1 - exp(-sigma_t d)) / sigma_t.
 
 #ifndef CD_FEATURE_MEDIA
 #define CD_FEATURE_MEDIA 1
@@ -136,7 +137,40 @@ float media_density(const SceneData* sc, __global const Medium* m, float3 p) {
   return m->density_scale * mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
 }
 
-// The part [*t0, *t1] of the ray inside a grid medium's box, within [0, tmax]; false: none
+// A grid medium's lookups along one ray: the ray in the grid's lookup space (world space
+// for MEDIUM_GRID, the grid's index space for MEDIUM_NANOVDB; the map is affine, so a point
+// at ray parameter t is at parameter t in both) and, for NanoVDB, the grid and its accessor
+typedef struct {
+  Ray r;
+#if CD_FEATURE_NANOVDB
+  NanoVdbGrid vdb;
+#endif
+} MediaGridRay;
+
+MediaGridRay media_grid_ray(const SceneData* sc, __global const Medium* m, Ray r) {
+  MediaGridRay g;
+  g.r = r;
+#if CD_FEATURE_NANOVDB
+  if (m->type == MEDIUM_NANOVDB) {
+    g.vdb = nanovdb_grid(sc->nanovdb + m->grid_offset);
+    g.r.org = nanovdb_world_to_index(&g.vdb, r.org);
+    g.r.dir = nanovdb_world_to_index_dir(&g.vdb, r.dir);
+  }
+#endif
+  return g;
+}
+
+// Density (grid value x density_scale) at ray parameter t of the ray g was made for
+float media_grid_density(const SceneData* sc, __global const Medium* m, MediaGridRay* g, float t) {
+  float3 q = g->r.org + t * g->r.dir;
+#if CD_FEATURE_NANOVDB
+  if (m->type == MEDIUM_NANOVDB) return m->density_scale * fmax(nanovdb_trilinear(&g->vdb, q), 0.0f);
+#endif
+  return media_density(sc, m, q);
+}
+
+// The part [*t0, *t1] of the ray inside a grid medium's box (in its lookup space: r is the
+// ray there), within [0, tmax]; false: none
 bool media_grid_span(__global const Medium* m, Ray r, float tmax, float* t0, float* t1) {
   float3 inv = safe_inverse(r.dir);
   float3 a = (load3(m->grid_min) - r.org) * inv, b = (load3(m->grid_max) - r.org) * inv;
@@ -191,7 +225,8 @@ typedef struct {
   uint offset;  // the medium's first majorant cell in `densities`
 } MediaDda;
 
-// Starts the walk over the part of [0, tmax] inside the box; false: the ray misses it
+// Starts the walk over the part of [0, tmax] inside the box (r in the grid's lookup space,
+// MediaGridRay); false: the ray misses it
 bool media_dda_start(__global const Medium* m, Ray r, float tmax, MediaDda* it) {
   if (!(m->majorant > 0.0f) || !media_grid_span(m, r, tmax, &it->t, &it->t1)) return false;
   float3 lo = load3(m->grid_min), hi = load3(m->grid_max);
@@ -259,14 +294,14 @@ bool media_dda_collision(const SceneData* sc, MediaDda* it, Rng* rng, float* sig
 // T(t) emission(t) (tentative collisions happen at rate sigma_bar while the path goes on).
 int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, float tmax, Rng* rng,
                       float3* beta, float3* radiance, float3* p) {
+  MediaGridRay g = media_grid_ray(sc, m, r);
   MediaDda it;
-  if (!media_dda_start(m, r, tmax, &it)) return MEDIUM_PASSED;
+  if (!media_dda_start(m, g.r, tmax, &it)) return MEDIUM_PASSED;
   float3 sigma_a = media_sigma_a(m), sigma_s = media_sigma_s(m), emission = load3(m->emission);
   bool emits = max_component(emission) > 0.0f;
   float sigma_bar;
   while (media_dda_collision(sc, &it, rng, &sigma_bar)) {
-    float3 x = r.org + it.t * r.dir;
-    float d = media_density(sc, m, x);
+    float d = media_grid_density(sc, m, &g, it.t);
     if (emits) *radiance += *beta * emission * (d / sigma_bar);
     float3 sa = d * sigma_a, ss = d * sigma_s, sn = fmax((float3)(sigma_bar) - sa - ss, 0.0f);
     float pa = media_average(sa) / sigma_bar, ps = media_average(ss) / sigma_bar;
@@ -274,7 +309,7 @@ int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, floa
     if (u < pa) return MEDIUM_ABSORBED;
     if (u < pa + ps) {
       *beta *= ss / media_average(ss);
-      *p = x;
+      *p = r.org + it.t * r.dir;
       return MEDIUM_SCATTERED;
     }
     float an = media_average(sn);
@@ -298,7 +333,7 @@ float3 media_homogeneous_emission(__global const Medium* m, float tmax) {
 int media_sample_segment(const SceneData* sc, int medium, Ray r, float tmax, Rng* rng, float3* beta,
                          float3* radiance, float3* p) {
   __global const Medium* m = &sc->media[medium];
-  if (m->type == MEDIUM_GRID) return media_sample_grid(sc, m, r, tmax, rng, beta, radiance, p);
+  if (m->type != MEDIUM_HOMOGENEOUS) return media_sample_grid(sc, m, r, tmax, rng, beta, radiance, p);
   *radiance += *beta * media_homogeneous_emission(m, tmax);
   return media_sample_homogeneous(m, r, tmax, rng, beta, p);
 }
@@ -307,17 +342,18 @@ int media_sample_segment(const SceneData* sc, int medium, Ray r, float tmax, Rng
 // homogeneous media, ratio tracking against the majorant grid for grids
 float3 media_segment_transmittance(const SceneData* sc, int medium, Ray r, float tmax, Rng* rng) {
   __global const Medium* m = &sc->media[medium];
-  if (m->type != MEDIUM_GRID) {
+  if (m->type == MEDIUM_HOMOGENEOUS) {
     float3 sigma_t = media_sigma_t(m);
     return max_component(sigma_t) > 0.0f ? media_exp(-sigma_t * tmax) : (float3)(1.0f);
   }
   float3 tr = (float3)(1.0f);
+  MediaGridRay g = media_grid_ray(sc, m, r);
   MediaDda it;
-  if (!media_dda_start(m, r, tmax, &it)) return tr;
+  if (!media_dda_start(m, g.r, tmax, &it)) return tr;
   float3 sigma_t = media_sigma_t(m);
   float sigma_bar;
   while (media_dda_collision(sc, &it, rng, &sigma_bar)) {
-    float d = media_density(sc, m, r.org + it.t * r.dir);
+    float d = media_grid_density(sc, m, &g, it.t);
     tr *= fmax(1.0f - d * sigma_t / sigma_bar, 0.0f);
     if (max_component(tr) <= 0.0f) return tr;
   }

@@ -425,6 +425,15 @@ void check_sample_offset(const RenderArgs& a, uint32_t spp) {
 
 // ---- end of several devices and machines ----
 
+// --stats "grids": each density grid's device memory (a NanoVDB buffer or dense values, and
+// its majorant cells)
+nlohmann::json grids_json(const CompiledScene& scene) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const GridMemory& g : scene.grids)
+    list.push_back({{"source", g.source}, {"grid_bytes", g.grid_bytes}, {"majorant_bytes", g.majorant_bytes}});
+  return list;
+}
+
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
                  const RenderResult& r, double samples_per_second, const std::vector<DeviceEntry>& devices) {
   nlohmann::json j = {{"spp", r.spp},
@@ -435,6 +444,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"bvh_build_seconds", renderer.bvh_build_seconds()},
                       {"scene_compile_seconds", renderer.scene().compile_seconds},
                       {"scene_device_bytes", renderer.scene().buffers.bytes()},
+                      {"grids", grids_json(renderer.scene())},
                       {"triangles", renderer.triangles()},
                       {"lights", renderer.lights()},
                       {"device", joined_descriptions(devices)},

@@ -224,7 +224,8 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
 
 // A medium from candela's extras: {"sigma_a": [r, g, b], "sigma_s": [r, g, b], "g": g,
 // "emission": [r, g, b], "density_scale": s, "grid": {"size": [nx, ny, nz], "min": [x, y, z],
-// "max": [x, y, z], "density": [nx ny nz values, x fastest]}}; every entry optional
+// "max": [x, y, z], "density": [nx ny nz values, x fastest]} or {"nanovdb": "f.nvdb"} or
+// {"vdb": "f.vdb"} with an optional "name"}; every entry optional
 MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir) {
   if (!v.IsObject()) throw Error(where + " must be an object");
   MediumDesc m;
@@ -249,14 +250,20 @@ MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const
   if (!v.Has("grid")) return m;
   const tinygltf::Value& grid = v.Get("grid");
   std::string gw = where + ".grid";
-  if (grid.Has("nanovdb")) {  // {"nanovdb": "file.nvdb", "name": "density"}, relative to the glTF file
-    const tinygltf::Value& file = grid.Get("nanovdb");
-    if (!file.IsString() || file.Get<std::string>().empty()) throw Error(gw + ".nanovdb must name a file");
-    if (base_dir.empty()) throw Error(gw + ".nanovdb: a scene loaded from memory cannot name files");
-    std::string name = grid.Has("name") && grid.Get("name").IsString() ? grid.Get("name").Get<std::string>() : "";
+  // {"nanovdb": "file.nvdb"} or {"vdb": "file.vdb"}, relative to the glTF file, and "name": a grid
+  for (const char* key : {"nanovdb", "vdb"}) {
+    if (!grid.Has(key)) continue;
+    const tinygltf::Value& file = grid.Get(key);
+    if (!file.IsString() || file.Get<std::string>().empty()) throw Error(gw + "." + key + " must name a file");
+    if (base_dir.empty()) throw Error(gw + "." + key + ": a scene loaded from memory cannot name files");
+    if (grid.Has("name") && !grid.Get("name").IsString()) throw Error(gw + ".name must be a string");
+    std::string name = grid.Has("name") ? grid.Get("name").Get<std::string>() : "";
     std::filesystem::path path(file.Get<std::string>());
     if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
-    load_nanovdb_density(path.string(), name, &m);
+    if (std::string(key) == "vdb")
+      load_openvdb_density(path.string(), name, &m);
+    else
+      load_nanovdb_density(path.string(), name, &m);
     return m;
   }
   size_t count = 1;

@@ -11,7 +11,8 @@ std::string SceneFeatures::build_options() const {
   auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
   return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
          flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
-         flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media);
+         flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media) +
+         flag("CD_FEATURE_NANOVDB", nanovdb);
 }
 
 bool MaterialDesc::alpha_tested() const {
@@ -65,6 +66,7 @@ SceneFeatures Scene::features() const {
     f.media |= materials.at(m.material).medium >= 0;
   }
   f.media |= global_medium >= 0;
+  for (const auto& m : media) f.nanovdb |= f.media && m.is_nanovdb();
   return f;
 }
 

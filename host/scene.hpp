@@ -25,16 +25,25 @@ enum class AlphaMode { Opaque, Mask, Blend };
 
 // A participating medium (cl/media.cl): coefficients per unit length in linear RGB.
 // With a density grid the coefficients and the emission are scaled by the density at the
-// point (trilinear between the grid's nodes, which span [grid_min, grid_max] in world space).
+// point: trilinear between the nodes of a dense grid, which span [grid_min, grid_max] in world
+// space, or between the voxels of a NanoVDB grid (host/vdb_grid.hpp).
 struct MediumDesc {
   glm::vec3 sigma_a{0.0f}, sigma_s{0.0f};
   glm::vec3 emission{0.0f};  // radiance emitted per unit length (the lecture's L_e(z))
   float g = 0.0f;  // Henyey-Greenstein asymmetry, in (-1, 1)
   glm::ivec3 grid_size{0};  // nodes along x, y, z (each >= 2) when there is a grid
   std::vector<float> density;  // grid values, x fastest, then y, then z; empty: homogeneous
-  glm::vec3 grid_min{0.0f}, grid_max{0.0f};
+  glm::vec3 grid_min{0.0f}, grid_max{0.0f};  // a NanoVDB grid: its box in index space
   float density_scale = 1.0f;
-  bool is_grid() const { return !density.empty(); }
+  // A NanoVDB float grid (MEDIUM_NANOVDB) instead of `density`: its buffer as 32-bit words,
+  // what it came from (for --stats), and majorant cells splitting [grid_min, grid_max]
+  // evenly, each the largest value (>= 0, unscaled) that a trilinear lookup inside it reads
+  std::vector<uint32_t> nanovdb;
+  std::string grid_source;
+  glm::ivec3 majorant_size{0};
+  std::vector<float> majorant_density;  // x fastest
+  bool is_nanovdb() const { return !nanovdb.empty(); }
+  bool is_grid() const { return !density.empty() || is_nanovdb(); }
 };
 
 // A material as glTF describes it (defaults: the glTF specification's), or a measured
@@ -152,6 +161,7 @@ struct SceneFeatures {
   bool vertex_colors = false;  // some COLOR_0 is not white
   bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
   bool media = false;  // a global medium, or a mesh whose material has an interior medium
+  bool nanovdb = false;  // a medium with a NanoVDB grid (CD_FEATURE_NANOVDB)
   std::string build_options() const;
   // Every flag on: the generic kernel, correct for any scene (--generic)
   static SceneFeatures all() { return {true, true, true, true, true}; }

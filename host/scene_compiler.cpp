@@ -126,7 +126,27 @@ void compile_textures(const Scene& scene, dev::SceneBuffers* b) {
 // Majorant cells per axis of a density grid (fewer where the grid has fewer cells)
 constexpr int kMajorantCells = 16;
 
-dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
+// A NanoVDB grid (MEDIUM_NANOVDB): its buffer goes to `nanovdb` on a 32-byte boundary (8
+// words), and its majorant cells, scaled to bounds of sigma_t, to `densities`
+void compile_nanovdb_grid(const MediumDesc& m, float scale, dev::Medium* d, dev::SceneBuffers* b) {
+  d->type = MEDIUM_NANOVDB;
+  b->nanovdb.resize((b->nanovdb.size() + 7) / 8 * 8, 0u);
+  if (b->nanovdb.size() + m.nanovdb.size() > size_t(UINT32_MAX)) throw Error("the scene's NanoVDB grids hold more than 16 GiB");
+  d->grid_offset = uint32_t(b->nanovdb.size());
+  b->nanovdb.insert(b->nanovdb.end(), m.nanovdb.begin(), m.nanovdb.end());
+  float peak = *std::max_element(m.majorant_density.begin(), m.majorant_density.end());
+  d->majorant = scale * peak;
+  for (int k = 0; k < 3; ++k) {
+    d->grid_min[k] = m.grid_min[k];
+    d->grid_max[k] = m.grid_max[k];
+    d->majorant_size[k] = uint32_t(m.majorant_size[k]);
+  }
+  if (b->densities.size() + m.majorant_density.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+  d->majorant_offset = uint32_t(b->densities.size());
+  for (float v : m.majorant_density) b->densities.push_back(scale * v);
+}
+
+dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vector<GridMemory>* grids) {
   dev::Medium d{};
   for (int c = 0; c < 3; ++c) {
     d.sigma_a[c] = m.sigma_a[c];
@@ -136,7 +156,12 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
   d.g = m.g;
   d.type = MEDIUM_HOMOGENEOUS;
   d.density_scale = m.density_scale;
-  if (m.is_grid()) {
+  if (m.is_nanovdb()) {
+    glm::vec3 sigma_t = m.sigma_a + m.sigma_s;
+    // as for dense grids below: trilinear values never exceed the voxels they mix
+    compile_nanovdb_grid(m, m.density_scale * std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * 1.0001f, &d, b);
+    grids->push_back({m.grid_source, m.nanovdb.size() * sizeof(uint32_t), m.majorant_density.size() * sizeof(float)});
+  } else if (m.is_grid()) {
     d.type = MEDIUM_GRID;
     if (b->densities.size() + m.density.size() + kMajorantCells * kMajorantCells * kMajorantCells > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
     d.grid_offset = uint32_t(b->densities.size());
@@ -175,6 +200,7 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
                 peak = std::max(peak, m.density[(size_t(z) * m.grid_size.y + y) * m.grid_size.x + x]);
           b->densities.push_back(scale * peak);
         }
+    grids->push_back({"dense", m.density.size() * sizeof(float), size_t(cells.x) * cells.y * cells.z * sizeof(float)});
   }
   return d;
 }
@@ -183,11 +209,15 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b) {
 // then every MediumDesc; then, when needed, one vacuum record for the insides of clear solids
 // (so that fog does not fill a glass ball). Material.medium is set for closed surfaces that
 // rays cross: transmissive solids and null boundaries.
-void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b) {
+void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b, std::vector<GridMemory>* grids) {
   if (!f.media) return;  // the kernel reads neither buffer nor Material.medium
-  b->media.push_back(scene.global_medium >= 0 ? compile_medium(scene.media[size_t(scene.global_medium)], b)
-                                              : dev::Medium{});
-  for (const MediumDesc& m : scene.media) b->media.push_back(compile_medium(m, b));
+  for (const MediumDesc& m : scene.media)
+    if (m.is_nanovdb() && !f.nanovdb) throw Error("compile_scene: the kernel features leave out NanoVDB grids the scene has");
+  b->media.push_back(dev::Medium{});
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    b->media.push_back(compile_medium(scene.media[i], b, grids));
+    if (int(i) == scene.global_medium) b->media[GLOBAL_MEDIUM] = b->media.back();  // its grid stored once
+  }
   int vacuum = NO_MEDIUM;
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const MaterialDesc& m = scene.materials[i];
@@ -441,7 +471,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);
   compile_textures(scene, &c.buffers);
-  compile_media(scene, c.features, &c.buffers);
+  compile_media(scene, c.features, &c.buffers, &c.grids);
   c.environment_light = compile_lights(scene, &c.buffers);
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;

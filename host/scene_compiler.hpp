@@ -9,8 +9,16 @@
 
 namespace candela {
 
+// A density grid as the device holds it (--stats)
+struct GridMemory {
+  std::string source;  // "dense" (an inline grid) or the NanoVDB/OpenVDB file and grid
+  size_t grid_bytes = 0;  // the NanoVDB buffer, or the dense values
+  size_t majorant_bytes = 0;  // its majorant cells
+};
+
 struct CompiledScene {
   dev::SceneBuffers buffers;
+  std::vector<GridMemory> grids;  // one per grid medium, each grid stored once
   SceneFeatures features;
   CameraDesc camera;  // resolved: the scene's, or one framing it
   int environment_light = NO_LIGHT;  // index into buffers.lights

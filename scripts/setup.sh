@@ -9,7 +9,7 @@ CANDELA_PACKAGES=(
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
   mesa-opencl-icd
   libtinygltf-dev nlohmann-json3-dev
-  libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev
+  libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
   googletest libgtest-dev
   python3-numpy python3-openimageio python3-matplotlib
 )
