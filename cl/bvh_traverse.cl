@@ -21,7 +21,8 @@ CD_ALWAYS_INLINE bool bvh_leaf_triangle_hit(const WatertightRay* r, __global con
 }
 
 // Leaf position of a hit to its stable primitive index
-Hit bvh_hit_to_prim(Hit hit, __global const BvhTriangle* tris) {
+Hit bvh_hit_to_prim(Hit leaf_hit, __global const BvhTriangle* tris) {
+  Hit hit = leaf_hit;  // a copy: struct parameters are never assigned (README, Kernel portability)
   if (hit.prim >= 0) hit.prim = (int)tris[hit.prim].prim;
   return hit;
 }

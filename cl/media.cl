@@ -72,7 +72,8 @@ bool media_front_face(const SceneData* sc, uint prim, float3 dir) {
 // The interiors that ray.org lies in: walk the ray to infinity through every boundary.
 // A boundary left from the back face that was not entered on the way encloses the origin;
 // the farthest of them is the outermost.
-MediumStack media_at_origin(const SceneData* sc, Ray r) {
+MediumStack media_at_origin(const SceneData* sc, Ray ray) {
+  Ray r = ray;  // walked along: never assign to a struct parameter (README, Kernel portability)
   int inside[MEDIUM_STACK_SIZE];  // media enclosing the origin, innermost first
   uint n_inside = 0u;
   MediumStack passed = media_stack_empty();  // entered along the ray, not yet left
@@ -363,7 +364,9 @@ float3 media_segment_transmittance(const SceneData* sc, int medium, Ray r, float
 // Transmittance of a shadow ray from r.org (in the media of `start`) to distance tmax
 // (INFINITY: to infinity): it passes null boundaries, changing medium there, and any other
 // surface blocks it
-float3 media_shadow_transmittance(const SceneData* sc, Ray r, float tmax, MediumStack st, Rng* rng) {
+float3 media_shadow_transmittance(const SceneData* sc, Ray ray, float tmax, MediumStack start, Rng* rng) {
+  Ray r = ray;  // local copies: the walk changes both (see media_at_origin)
+  MediumStack st = start;
   float3 tr = (float3)(1.0f);
   float3 target = r.org + tmax * r.dir;
   for (int k = 0; k < MEDIA_WALK_MAX; ++k) {
