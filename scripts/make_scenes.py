@@ -1085,15 +1085,15 @@ def plume_density(size, lo, hi, seed=11):
                 x = lo[0] + (hi[0] - lo[0]) * i / (nx - 1)
                 h = lo[1] + (hi[1] - lo[1]) * j / (ny - 1)
                 z = lo[2] + (hi[2] - lo[2]) * k / (nz - 1)
-                radius = 0.2 + 0.17 * h
+                radius = 0.28 + 0.16 * h
                 cx = 0.05 * h * h + 0.04 * math.sin(2.3 * h)
                 cz = 0.03 * math.sin(1.7 * h + 1.0)
                 r2 = ((x - cx) ** 2 + (z - cz) ** 2) / (radius * radius)
                 radial = max(0.0, 1.0 - r2) ** 2
-                f = sum(value_noise(x * 3.0 * 2 ** o + 5.0, h * 1.6 * 2 ** o, z * 3.0 * 2 ** o, seed + o)
+                f = sum(value_noise(x * 4.0 * 2 ** o + 5.0, h * 2.2 * 2 ** o, z * 4.0 * 2 ** o, seed + o)
                         / 2 ** o for o in range(3)) / 1.75
-                wisps = max(0.0, 1.6 * f - 0.3)
-                rise = (0.2 / radius) ** 2
+                wisps = max(0.0, 2.2 * f - 0.7)
+                rise = (0.28 / radius) ** 3
                 ends = smoothstep(lo[1], lo[1] + 0.12, h) * (1.0 - smoothstep(hi[1] - 0.8, hi[1], h))
                 v = 2.5 * rise * radial * wisps * ends
                 values.append(round(v, 3) if v >= 5e-4 else 0)
@@ -1128,21 +1128,21 @@ def make_plume(path):
     plane = [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)]
     g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(plane, (0.0, 1.0, 0.0)))), floor_mat))
     stone = g.material("stone", (0.55, 0.55, 0.55, 1.0))
-    g.node("block", mesh=g.mesh("block", *flat_mesh(box_tris((-1.9, 0.0, -0.6), (-1.2, 0.7, 0.1))), stone))
+    g.node("block", mesh=g.mesh("block", *flat_mesh(box_tris((-1.7, 0.0, -0.5), (-1.05, 0.65, 0.15))), stone))
     ball = g.material("ball", (0.7, 0.7, 0.7, 1.0))
     g.node("sphere", mesh=g.mesh("sphere", *flat_mesh(icosphere(2, 0.35)), ball),
-           translation=[1.45, 0.35, 0.5])
+           translation=[1.25, 0.35, 0.45])
     lo, hi = (-0.9, 0.002, -0.9), (1.3, 3.4, 0.9)
     size = [28, 40, 24]
-    medium = {"sigma_a": [1.0, 1.0, 1.0], "sigma_s": [2.0, 2.0, 2.0], "g": 0.3,
-              "emission": [6.0, 2.0, 0.45],
+    medium = {"sigma_a": [0.5, 0.5, 0.5], "sigma_s": [1.0, 1.0, 1.0], "g": 0.3,
+              "emission": [10.0, 3.3, 0.7],
               "grid": {"size": size, "min": list(lo), "max": list(hi),
                        "density": plume_density(size, lo, hi)}}
     plume = null_medium_material(g, "plume", medium)
     g.node("plume", mesh=g.mesh("plume", *flat_mesh(box_tris(lo, hi)), plume))
-    eye = (0.4, 1.5, 6.0)
+    eye = (0.3, 1.3, 5.0)
     g.node("camera", camera=g.camera("camera", 0.75, 1.6), translation=list(eye),
-           rotation=look_at_rotation(eye, (0.1, 1.3, 0.0)))
+           rotation=look_at_rotation(eye, (0.1, 1.35, 0.0)))
     g.set_background([0.004, 0.006, 0.012])
     write_with_inline_list(g, path, ["materials", plume, "extras", "candela", "medium", "grid", "density"])
 
