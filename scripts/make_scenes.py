@@ -16,6 +16,10 @@ Outputs (deterministic, byte-identical on every run):
   scenes/lights/small-light.gltf        a small bright light over a diffuse floor
   scenes/lights/large-light-glossy.gltf a large light over smooth-ish metal
   scenes/lights/many-lights.gltf        4096 small emissive quads over a floor
+  scenes/volumes/god-rays.gltf          a dusty room lit through a window
+  scenes/volumes/liquid-glass.gltf      a glass of absorbing liquid
+  scenes/volumes/cloud.gltf             a procedural noise cloud (density grid)
+  scenes/volumes/plume.gltf             an emissive smoke plume (density grid) at night
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices

@@ -297,6 +297,7 @@ TEST(VolumeTracking, HostQuadratureIsConsistent) {
   for (float x : grid.v) zeros += x == 0.0f;
   EXPECT_GT(zeros, 100);
   EXPECT_GT(*std::max_element(grid.v.begin(), grid.v.end()), 1.0f);
+  std::printf("  %d of %zu nodes empty, largest %.3f\n", zeros, grid.v.size(), double(*std::max_element(grid.v.begin(), grid.v.end())));
   // Trilinear interpolation reproduces the nodes
   EXPECT_DOUBLE_EQ(grid.at(grid.node(3, 5, 7)), grid.value(3, 5, 7));
   EXPECT_DOUBLE_EQ(grid.at(grid.node(16, 12, 10)), grid.value(16, 12, 10));
