@@ -16,6 +16,10 @@ Outputs (deterministic, byte-identical on every run):
   scenes/lights/small-light.gltf        a small bright light over a diffuse floor
   scenes/lights/large-light-glossy.gltf a large light over smooth-ish metal
   scenes/lights/many-lights.gltf        4096 small emissive quads over a floor
+  scenes/volumes/god-rays.gltf          a dusty room lit through a window
+  scenes/volumes/liquid-glass.gltf      a glass of absorbing liquid
+  scenes/volumes/cloud.gltf             a procedural noise cloud (density grid)
+  scenes/volumes/plume.gltf             an emissive smoke plume (density grid) at night
 
 Every file (written with scripts/gltf_writer.py) embeds its binary buffer as
 a base64 data URI.  Meshes use flat (per-face) normals with vertices
@@ -1064,6 +1068,89 @@ def make_cloud(path):
     g.write(path)
 
 
+
+def smoothstep(a, b, x):
+    t = min(1.0, max(0.0, (x - a) / (b - a)))
+    return t * t * (3.0 - 2.0 * t)
+
+
+def plume_density(size, lo, hi, seed=11):
+    """A rising smoke column on a grid of `size` nodes spanning [lo, hi]: its
+    radius widens with height, its axis drifts along +x, the density falls as
+    the column widens (the same mass through a wider section: the base is the
+    densest, and so, with emission = emission x density, the hottest), and
+    three octaves of value noise stretched along the rise tear it into wisps.
+    0 outside the column and on every face of the box."""
+    nx, ny, nz = size
+    values = []
+    for k in range(nz):
+        for j in range(ny):
+            for i in range(nx):
+                x = lo[0] + (hi[0] - lo[0]) * i / (nx - 1)
+                h = lo[1] + (hi[1] - lo[1]) * j / (ny - 1)
+                z = lo[2] + (hi[2] - lo[2]) * k / (nz - 1)
+                radius = 0.28 + 0.16 * h
+                cx = 0.05 * h * h + 0.04 * math.sin(2.3 * h)
+                cz = 0.03 * math.sin(1.7 * h + 1.0)
+                r2 = ((x - cx) ** 2 + (z - cz) ** 2) / (radius * radius)
+                radial = max(0.0, 1.0 - r2) ** 2
+                f = sum(value_noise(x * 4.0 * 2 ** o + 5.0, h * 2.2 * 2 ** o, z * 4.0 * 2 ** o, seed + o)
+                        / 2 ** o for o in range(3)) / 1.75
+                wisps = max(0.0, 2.2 * f - 0.7)
+                rise = (0.28 / radius) ** 3
+                ends = smoothstep(lo[1], lo[1] + 0.12, h) * (1.0 - smoothstep(hi[1] - 0.8, hi[1], h))
+                v = 2.5 * rise * radial * wisps * ends
+                values.append(round(v, 3) if v >= 5e-4 else 0)
+    return values
+
+
+def write_with_inline_list(g, path, key_path):
+    """g.write(path), then rewrite the file with the long number list at
+    key_path (keys from the document root) on one line: a density grid one
+    number per line would be several times the size."""
+    g.write(path)
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    parent = doc
+    for key in key_path[:-1]:
+        parent = parent[key]
+    values = parent[key_path[-1]]
+    parent[key_path[-1]] = "@INLINE@"
+    text = json.dumps(doc, indent=2).replace('"@INLINE@"', json.dumps(values, separators=(",", ":")))
+    with open(path, "w", encoding="utf-8", newline="\n") as f:
+        f.write(text)
+        f.write("\n")
+
+
+def make_plume(path):
+    """An emissive smoke plume (a density grid whose emission scales with the
+    density, so the dense base glows hottest) over a floor at night: the plume
+    is the main light of the scene; a faint blue sky is the only other."""
+    g = GltfWriter(GENERATOR)
+    floor_mat = g.material("floor", (0.4, 0.38, 0.36, 1.0))
+    s = 8.0
+    plane = [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)]
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(plane, (0.0, 1.0, 0.0)))), floor_mat))
+    stone = g.material("stone", (0.55, 0.55, 0.55, 1.0))
+    g.node("block", mesh=g.mesh("block", *flat_mesh(box_tris((-1.7, 0.0, -0.5), (-1.05, 0.65, 0.15))), stone))
+    ball = g.material("ball", (0.7, 0.7, 0.7, 1.0))
+    g.node("sphere", mesh=g.mesh("sphere", *flat_mesh(icosphere(2, 0.35)), ball),
+           translation=[1.25, 0.35, 0.45])
+    lo, hi = (-0.9, 0.002, -0.9), (1.3, 3.4, 0.9)
+    size = [28, 40, 24]
+    medium = {"sigma_a": [0.5, 0.5, 0.5], "sigma_s": [1.0, 1.0, 1.0], "g": 0.3,
+              "emission": [10.0, 3.3, 0.7],
+              "grid": {"size": size, "min": list(lo), "max": list(hi),
+                       "density": plume_density(size, lo, hi)}}
+    plume = null_medium_material(g, "plume", medium)
+    g.node("plume", mesh=g.mesh("plume", *flat_mesh(box_tris(lo, hi)), plume))
+    eye = (0.3, 1.3, 5.0)
+    g.node("camera", camera=g.camera("camera", 0.75, 1.6), translation=list(eye),
+           rotation=look_at_rotation(eye, (0.1, 1.35, 0.0)))
+    g.set_background([0.004, 0.006, 0.012])
+    write_with_inline_list(g, path, ["materials", plume, "extras", "candela", "medium", "grid", "density"])
+
+
 # ---------------------------------------------------------------------------
 
 MAPS = [
@@ -1085,6 +1172,7 @@ SCENES = [
     ("scenes/volumes/god-rays.gltf", make_god_rays),
     ("scenes/volumes/liquid-glass.gltf", make_liquid_glass),
     ("scenes/volumes/cloud.gltf", make_cloud),
+    ("scenes/volumes/plume.gltf", make_plume),
 ]
 
 

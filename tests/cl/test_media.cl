@@ -30,3 +30,22 @@ __kernel void test_media_transmittance(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global
   float3 tr = media_shadow_transmittance(&sc, r, tmax, st, &rng);
   out[i] = (float4)(tr, (float)st.count);
 }
+
+// Delta tracking's free flight as the integrator runs it (path_medium_step): from org along
+// dir, in the medium org lies in (media_at_origin), up to the first surface or tmax,
+// whichever is nearer, media_sample_segment samples where the path scatters next.
+// out[i] = (beta, event): event MEDIUM_PASSED (0) means the flight reached the end, and
+// beta is the weight it carries there (1 for grey media).
+__kernel void test_media_free_flight(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
+                                     float4 org, float4 dir, float tmax, uint seed, __global float4* out) {
+  uint i = get_global_id(0);
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  Rng rng = rng_init(i, 0u, seed);
+  Ray r = {org.xyz, dir.xyz};
+  MediumStack st = media_at_origin(&sc, r);
+  Hit hit = scene_intersect(&sc, r, INFINITY);
+  float t = hit.prim < 0 ? tmax : fmin(hit.t, tmax);
+  float3 beta = (float3)(1.0f), radiance = (float3)(0.0f), p = (float3)(0.0f);
+  int event = media_sample_segment(&sc, media_current(&st), r, t, &rng, &beta, &radiance, &p);
+  out[i] = (float4)(beta, (float)event);
+}
