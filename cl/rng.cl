@@ -20,10 +20,14 @@
 //     become a permutation of one block j 2^m .. (j + 1) 2^m - 1 of the sequence, and
 //     every block of a (0,2)-sequence is a (0,m,2)-net: any prefix of 2^m samples of a
 //     pair is stratified, and the order stays progressive;
-//   - the second coordinate is then Owen-scrambled with its own seed, which keeps every
-//     net a net and makes each point uniformly distributed. The first needs no scramble
-//     of its own: van der Corput at the shuffled index is already the van der Corput
-//     point of the sample index Owen-scrambled (Burley scrambles it a second time).
+//   - each coordinate is then Owen-scrambled with its own seed, which keeps every net a
+//     net and makes each point uniformly distributed. The first needs it too, as in
+//     Burley's paper: shuffling the index flips index bit q by the bits *above* q, which
+//     are the *less* significant digits of its van der Corput point, so the unscrambled
+//     point of the first 2^m samples keeps the same 32 - m low digits in every sample (one
+//     offset shared by all strata: a shifted lattice, not a jittered one). A pixel then
+//     picks, e.g., the same light in every stratum of the light table, and the many-lights
+//     scene disagreed between seeds by z^2 = 9.4 (the 1D stream: light selection).
 //   The pairs form two streams. 1D draws (rng_next, rng_next_uint) take consecutive
 //   dimensions of the even pairs 0, 2, 4, ...: each is stratified on its own, and two
 //   rng_next starting at an even 1D dimension (the pixel position and the lens sample,
@@ -33,7 +37,7 @@
 //   vertex's light or BSDF sample takes depends only on the 2D draws before it.
 //   The three seeds of pair k are a pcg4d hash of (pixel, k, seed), so pixels and pairs are
 //   decorrelated. Every dimension costs the same (no table, no cap): a pcg4d hash per
-//   pair, two hashes, three bit reversals and a few bit operations for the Sobol matrix.
+//   pair, three hashes, four bit reversals and a few bit operations for the Sobol matrix.
 //   Owen scrambling is done with a Laine-Karras style hash on the bit-reversed value:
 //   adding the seed, multiplying by odd numbers and x ^= x * even flip each bit by a
 //   function of the bits below it only, which is exactly a nested scramble of the
@@ -145,12 +149,11 @@ uint rng_sobol_dim1_reversed(uint i) {
 uint2 rng_sobol_pair(uint pixel, uint sample_reversed, uint hashed_seed, uint pair) {
   uint4 h = rng_pcg4d((uint4)(pixel, pair, hashed_seed, 0x736f626cu));
   // The shuffled index is the sample index Owen-scrambled (a permutation of each 2^m
-  // block). The first coordinate, van der Corput, is the reversed index: lk_hash of the
-  // reversed sample index, the van der Corput point of the sample Owen-scrambled, so it
-  // needs no scramble of its own. The second is Owen-scrambled, reverse(lk_hash(reverse
-  // (y))), and comes out of rng_sobol_dim1_reversed already reversed.
-  uint x = rng_lk_hash(sample_reversed, h.x);
-  uint index = rng_reverse_bits(x);
+  // block). The first coordinate, van der Corput, is the reversed index, Owen-scrambled as
+  // reverse(lk_hash(reverse(x))) = reverse(lk_hash(index)); the second is Owen-scrambled
+  // the same way, and comes out of rng_sobol_dim1_reversed already reversed.
+  uint index = rng_reverse_bits(rng_lk_hash(sample_reversed, h.x));
+  uint x = rng_reverse_bits(rng_lk_hash(index, h.y));
   uint y = rng_reverse_bits(rng_lk_hash(rng_sobol_dim1_reversed(index), h.z));
   return (uint2)(x, y);
 }

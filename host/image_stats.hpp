@@ -67,7 +67,8 @@ struct ZTest {
 //     correlated, so about values / 3 independent terms),
 //  3. the count of |z| > 4 is at most expected + 4 sqrt(expected) + 3, where expected is
 //     tail_allowance x values x P(|z| > 4 | normal) (the allowance again for heavy tails),
-//  4. every zero-variance pixel-channel agrees to float rounding.
+//  4. every zero-variance pixel-channel agrees to float rounding (a variance below
+//     (1e-6 x the value)^2 counts as zero: it is rounding noise, not Monte Carlo noise).
 struct ZTestRule {
   double z2_slack = 0.25;
   double tail_allowance = 10.0;

@@ -164,7 +164,11 @@ struct SceneFeatures {
   bool nanovdb = false;  // a medium with a NanoVDB grid (CD_FEATURE_NANOVDB)
   std::string build_options() const;
   // Every flag on: the generic kernel, correct for any scene (--generic)
-  static SceneFeatures all() { return {true, true, true, true, true}; }
+  static SceneFeatures all() {
+    SceneFeatures f;
+    f.textures = f.uvs = f.tangents = f.vertex_colors = f.alpha = f.media = f.nanovdb = true;
+    return f;
+  }
 };
 
 struct Scene {
