@@ -427,6 +427,12 @@ std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::
 
 CompiledScene compile_scene(const Scene& scene) { return compile_scene(scene, scene.features()); }
 
+void CompiledScene::release_host_arrays() {
+  auto lights = std::move(buffers.lights);
+  buffers = dev::SceneBuffers();
+  buffers.lights = std::move(lights);
+}
+
 CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   auto start = Clock::now();
   CompiledScene c;
@@ -448,11 +454,13 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());
   Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims, alpha_tested);
   c.bvh_build_seconds = seconds_since(bvh_start);
+  c.bvh_sah_cost = sah_cost(bvh);
   c.bvh_depth = bvh.depth;
   c.buffers.bvh_nodes = std::move(bvh.nodes);
   c.buffers.bvh_tris = std::move(bvh.tris);
   c.triangles = c.buffers.prims.size();
   c.vertices = c.buffers.positions.size() / 3;
+  c.device_bytes = c.buffers.bytes();
   c.compile_seconds = seconds_since(start);
   return c;
 }
