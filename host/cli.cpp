@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "device.hpp"
@@ -18,6 +19,7 @@
 #include "gltf_loader.hpp"
 #include "kernel_sources.hpp"
 #include "renderer.hpp"
+#include "bvh_builder.hpp"
 #include "compare.hpp"
 #include "image_stats.hpp"
 #include "merge.hpp"
@@ -269,9 +271,9 @@ void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
 
 // The compiled scene: for --generic, with every kernel feature on (and the vertex arrays
 // those features read)
-std::shared_ptr<const CompiledScene> compile_for_render(const RenderArgs& a, const Scene& scene) {
-  return std::make_shared<const CompiledScene>(a.generic ? compile_scene(scene, SceneFeatures::all())
-                                                         : compile_scene(scene));
+std::shared_ptr<CompiledScene> compile_for_render(const RenderArgs& a, const Scene& scene) {
+  return std::make_shared<CompiledScene>(a.generic ? compile_scene(scene, SceneFeatures::all())
+                                                   : compile_scene(scene));
 }
 
 // ---- end of --variance and --generic ----
@@ -434,6 +436,13 @@ nlohmann::json grids_json(const CompiledScene& scene) {
   return list;
 }
 
+// Peak resident set of this process so far (getrusage: kilobytes on Linux)
+size_t peak_rss_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return size_t(u.ru_maxrss) * 1024;
+}
+
 void write_stats(const RenderArgs& a, const RenderSettings& settings, const Renderer& renderer,
                  const RenderResult& r, double samples_per_second, const std::vector<DeviceEntry>& devices) {
   nlohmann::json j = {{"spp", r.spp},
@@ -443,8 +452,13 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"kernel_from_cache", renderer.kernel_from_cache()},
                       {"bvh_build_seconds", renderer.bvh_build_seconds()},
                       {"scene_compile_seconds", renderer.scene().compile_seconds},
-                      {"scene_device_bytes", renderer.scene().buffers.bytes()},
+                      {"scene_device_bytes", renderer.scene().device_bytes},
                       {"grids", grids_json(renderer.scene())},
+                      {"device_bytes_per_triangle", double(renderer.scene().device_bytes) / double(std::max<size_t>(1, renderer.triangles()))},
+                      {"peak_rss_bytes", peak_rss_bytes()},
+                      {"peak_rss_bytes_per_triangle", double(peak_rss_bytes()) / double(std::max<size_t>(1, renderer.triangles()))},
+                      {"bvh_sah_cost", renderer.scene().bvh_sah_cost},
+                      {"bvh_threads", bvh_build_threads()},
                       {"triangles", renderer.triangles()},
                       {"lights", renderer.lights()},
                       {"device", joined_descriptions(devices)},
@@ -487,7 +501,11 @@ int run_render(RenderArgs a) {
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   std::string device_text = joined_descriptions(devices);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", device_text.c_str());
-  Renderer renderer(devices, compile_for_render(a, scene), settings);
+  // Host memory: the loaded scene's arrays go once compiled, the compiled scene's as the
+  // devices take their copies (README, Performance: Memory)
+  std::shared_ptr<CompiledScene> compiled = compile_for_render(a, scene);
+  scene = Scene();
+  Renderer renderer(devices, std::move(compiled), settings, true);
   if (!a.quiet) print_render_summary(renderer, devices);
 
   std::signal(SIGINT, on_sigint);

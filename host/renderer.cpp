@@ -58,7 +58,7 @@ void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
 }  // namespace
 
 DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene,
-                               const RenderSettings& settings)
+                               const RenderSettings& settings, CompiledScene* release)
     : device_(device), settings_(settings) {
   check_settings(device, settings);
   try {
@@ -80,7 +80,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
                 " (CD_SCENE_BUFFERS out of step with the kernel)");
   local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
 
-#define CD_UPLOAD(type, name) scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));
+#define CD_UPLOAD(type, name)                                                  \
+  scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name)); \
+  if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
   if (settings.energy_compensation)
@@ -94,7 +96,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.max_depth = settings.max_depth;
   params_host_.rr_depth = settings.rr_depth;
   params_host_.strategy = uint32_t(settings.strategy);
-  params_host_.num_lights = uint32_t(scene.buffers.lights.size());
+  params_host_.num_lights = uint32_t(scene.buffers.lights.size());  // kept by release
   params_host_.environment_light = scene.environment_light;
   params_host_.energy_compensation = settings.energy_compensation ? 1u : 0u;
   params_host_.filter = uint32_t(settings.filter);
@@ -308,6 +310,16 @@ Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<cons
     : scene_(std::move(scene)) {
   if (devices.empty()) throw Error("a render needs at least one device");
   for (const auto& d : devices) workers_.push_back(std::make_unique<DeviceRenderer>(d, *scene_, settings));
+}
+
+Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
+                   const RenderSettings& settings, bool release_host_arrays)
+    : scene_(scene) {
+  if (devices.empty()) throw Error("a render needs at least one device");
+  for (size_t i = 0; i < devices.size(); ++i)
+    workers_.push_back(std::make_unique<DeviceRenderer>(
+        devices[i], *scene_, settings, release_host_arrays && i + 1 == devices.size() ? scene.get() : nullptr));
+  if (release_host_arrays) scene->release_host_arrays();
 }
 
 double Renderer::kernel_build_seconds() const {

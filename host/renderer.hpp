@@ -65,7 +65,10 @@ class DeviceRenderer {
  public:
   // Builds the kernel program for the scene's features, uploads the scene buffers and,
   // with energy compensation, the GGX albedo table (host/energy.hpp)
-  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings);
+  // `release`: the same scene, whose host arrays are freed one by one once uploaded (for
+  // the last device that uploads them; CompiledScene::release_host_arrays)
+  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings,
+                 CompiledScene* release = nullptr);
 
   // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
   // of about settings.launch_seconds over ranges of pixels. `stop` is polled between
@@ -124,6 +127,10 @@ class Renderer {
   // kernels one device after the other. Throws Error when `devices` is empty.
   Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
            const RenderSettings& settings);
+  // The same, and then the scene's host arrays are freed as the last device uploads them
+  // (CompiledScene::release_host_arrays): for a caller that needs them no more (the CLI)
+  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
+           const RenderSettings& settings, bool release_host_arrays);
 
   RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
                       const std::function<void(const RenderProgress&)>& progress = {},

@@ -457,6 +457,12 @@ std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::
 
 CompiledScene compile_scene(const Scene& scene) { return compile_scene(scene, scene.features()); }
 
+void CompiledScene::release_host_arrays() {
+  auto lights = std::move(buffers.lights);
+  buffers = dev::SceneBuffers();
+  buffers.lights = std::move(lights);
+}
+
 CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   auto start = Clock::now();
   CompiledScene c;
@@ -464,7 +470,8 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   const SceneFeatures needed = scene.features();
   if ((needed.textures && !features.textures) || (needed.uvs && !features.uvs) ||
       (needed.tangents && !features.tangents) || (needed.vertex_colors && !features.vertex_colors) ||
-      (needed.alpha && !features.alpha))
+      (needed.alpha && !features.alpha) || (needed.media && !features.media) ||
+      (needed.nanovdb && !features.nanovdb))
     throw Error("compile_scene: the kernel features leave out some the scene needs");
   c.camera = resolve_camera(scene);
   check_extent(scene, c.camera);
@@ -478,11 +485,13 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());
   Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims, alpha_tested);
   c.bvh_build_seconds = seconds_since(bvh_start);
+  c.bvh_sah_cost = sah_cost(bvh);
   c.bvh_depth = bvh.depth;
   c.buffers.bvh_nodes = std::move(bvh.nodes);
   c.buffers.bvh_tris = std::move(bvh.tris);
   c.triangles = c.buffers.prims.size();
   c.vertices = c.buffers.positions.size() / 3;
+  c.device_bytes = c.buffers.bytes();
   c.compile_seconds = seconds_since(start);
   return c;
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <algorithm>
 #include <random>
 
@@ -214,6 +215,37 @@ TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
   Bvh bvh = Soup(tris).bvh;
   EXPECT_GT(bvh.depth, 30);
   check_bvh(bvh, tris);
+}
+
+// The parallel builder gives the same tree, byte for byte, on any number of threads: the
+// top of the tree is built with parallel binning and subtrees on threads of their own,
+// the rest as jobs on a pool, joined in a fixed order. 150k triangles are enough for
+// both (parallel binning from 32768 refs, jobs of at most max(4096, refs / 128)).
+TEST(BvhBuilder, SameTreeOnAnyThreadCount) {
+  std::vector<Tri> tris = icosphere(6, glm::vec3(0.0f), 1.0f);  // 81920 triangles
+  std::vector<Tri> more = icosphere(5, glm::vec3(3.0f, 0.5f, 0.0f), 0.5f);  // 20480, apart
+  tris.insert(tris.end(), more.begin(), more.end());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+  for (int i = 0; i < 50000; ++i) {  // and a cloud of small triangles
+    glm::vec3 c(u(rng), u(rng), u(rng));
+    tris.push_back(make_tri(c, c + 0.02f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.02f * glm::vec3(u(rng), u(rng), u(rng))));
+  }
+  Soup soup(tris);  // default thread count
+  check_bvh(soup.bvh, tris);
+  double cost = sah_cost(soup.bvh);
+  EXPECT_GT(cost, 1.0);
+  for (int threads : {1, 2, 3, 8}) {
+    Bvh bvh = build_bvh(soup.positions, soup.prims, {}, threads);
+    ASSERT_EQ(bvh.nodes.size(), soup.bvh.nodes.size()) << threads << " threads";
+    ASSERT_EQ(bvh.tris.size(), soup.bvh.tris.size());
+    EXPECT_EQ(0, std::memcmp(bvh.nodes.data(), soup.bvh.nodes.data(), bvh.nodes.size() * sizeof(bvh.nodes[0])))
+        << threads << " threads";
+    EXPECT_EQ(0, std::memcmp(bvh.tris.data(), soup.bvh.tris.data(), bvh.tris.size() * sizeof(bvh.tris[0])))
+        << threads << " threads";
+    EXPECT_EQ(bvh.depth, soup.bvh.depth);
+    EXPECT_EQ(sah_cost(bvh), cost);
+  }
 }
 
 TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
