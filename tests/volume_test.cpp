@@ -422,7 +422,7 @@ TEST_P(VolumeFurnace, InvisibleUnderUniformBackground) {
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
   g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
   g.set_background(glm::vec3(1.0f));
-  Film f = render(load(g, "furnace"), s, 16, 128, 1000, 11);
+  Film f = render(load(g, "furnace"), s, 16, 256, 1000, 11);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << name(s) << " g " << g_value << " SE " << e.standard_error;
