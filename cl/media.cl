@@ -14,8 +14,9 @@
 //
 // Coefficients: sigma_t = sigma_a + sigma_s per RGB channel, times the grid's density for
 // MEDIUM_GRID (dense) and MEDIUM_NANOVDB (nanovdb.cl); `emission` is emitted radiance per
-// unit length (the lecture's L_e(z)), times the density or an emission grid's value, so a ray crossing length d of a homogeneous medium
-// gathers emission (1 - exp(-sigma_t d)) / sigma_t.
+// unit length (the lecture's L_e(z); for grids times the density, or the value of the
+// emission grid Medium.emission_grid names), so a ray crossing length d of a homogeneous
+// medium gathers emission (1 - exp(-sigma_t d)) / sigma_t.
 
 #ifndef CD_FEATURE_MEDIA
 #define CD_FEATURE_MEDIA 1
