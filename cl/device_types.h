@@ -215,7 +215,10 @@ typedef struct {
 typedef struct {
   float sigma_a[4];  // absorption, rgb (w unused)
   float sigma_s[4];  // scattering, rgb
-  float emission[4];  // emitted radiance per unit length, rgb
+  float emission[3];  // emitted radiance per unit length, rgb
+  unsigned int emission_grid;  // 0: emission x density; else the media record (a MEDIUM_GRID,
+                               // density_scale = emission_scale, no majorant) whose grid
+                               // scales emission in place of the density
   float g;  // Henyey-Greenstein asymmetry, in (-1, 1)
   unsigned int type;  // MEDIUM_*
   float density_scale;  // MEDIUM_GRID: density = scale x grid value
@@ -321,6 +324,7 @@ typedef struct {
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
   FIELD(Light, params, 32)                                                                  \
   SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
+  FIELD(Medium, emission_grid, 44)                                                          \
   FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68) FIELD(Medium, grid_min, 80)       \
   FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)                           \
   FIELD(Medium, majorant_size, 116)                                                         \

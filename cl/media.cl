@@ -14,8 +14,9 @@
 //
 // Coefficients: sigma_t = sigma_a + sigma_s per RGB channel, times the grid's density for
 // MEDIUM_GRID (dense) and MEDIUM_NANOVDB (nanovdb.cl); `emission` is emitted radiance per
-// unit length (the lecture's L_e(z)), so a ray crossing length d of a homogeneous medium
-// gathers emission (1 - exp(-sigma_t d)) / sigma_t.
+// unit length (the lecture's L_e(z); for grids times the density, or the value of the
+// emission grid Medium.emission_grid names), so a ray crossing length d of a homogeneous
+// medium gathers emission (1 - exp(-sigma_t d)) / sigma_t.
 
 #ifndef CD_FEATURE_MEDIA
 #define CD_FEATURE_MEDIA 1
@@ -291,8 +292,9 @@ bool media_dda_collision(const SceneData* sc, MediaDda* it, Rng* rng, float* sig
 // absorption, scattering or a null collision with probabilities avg(sigma_a),
 // avg(sigma_s), avg(sigma_bar - sigma_t) over sigma_bar, weighted by sigma / (sigma_bar
 // P(event)) per channel (1 for grey media: analog delta tracking). Emission: each tentative
-// collision adds beta x emission / sigma_bar, an unbiased estimate of the integral of
-// T(t) emission(t) (tentative collisions happen at rate sigma_bar while the path goes on).
+// collision adds beta x emission(t) / sigma_bar, an unbiased estimate of the integral of
+// T(t) emission(t) (tentative collisions happen at rate sigma_bar while the path goes on);
+// emission(t) is emission x density, or emission x the emission grid (Medium.emission_grid).
 int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, float tmax, Rng* rng,
                       float3* beta, float3* radiance, float3* p) {
   MediaGridRay g = media_grid_ray(sc, m, r);
@@ -300,10 +302,16 @@ int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, floa
   if (!media_dda_start(m, g.r, tmax, &it)) return MEDIUM_PASSED;
   float3 sigma_a = media_sigma_a(m), sigma_s = media_sigma_s(m), emission = load3(m->emission);
   bool emits = max_component(emission) > 0.0f;
+  // An emission grid (a MEDIUM_GRID record in world space) scales the emission in place of
+  // the density; the host made the majorant positive wherever it is
+  __global const Medium* em = m->emission_grid != 0u ? &sc->media[m->emission_grid] : 0;
   float sigma_bar;
   while (media_dda_collision(sc, &it, rng, &sigma_bar)) {
     float d = media_grid_density(sc, m, &g, it.t);
-    if (emits) *radiance += *beta * emission * (d / sigma_bar);
+    if (emits) {
+      float e = em ? media_density(sc, em, r.org + it.t * r.dir) : d;
+      *radiance += *beta * emission * (e / sigma_bar);
+    }
     float3 sa = d * sigma_a, ss = d * sigma_s, sn = fmax((float3)(sigma_bar) - sa - ss, 0.0f);
     float pa = media_average(sa) / sigma_bar, ps = media_average(ss) / sigma_bar;
     float u = rng_next(rng);

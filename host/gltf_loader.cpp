@@ -222,10 +222,52 @@ double number_or(const tinygltf::Value& obj, const char* key, int index, double 
   return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// A dense grid {"size": [nx, ny, nz], "min": [x, y, z], "max": [x, y, z], key: [nx ny nz
+// values, x fastest]} (gw names it in errors)
+void read_dense_grid(const tinygltf::Value& grid, const std::string& gw, const char* key, glm::ivec3* size,
+                     glm::vec3* lo, glm::vec3* hi, std::vector<float>* values) {
+  if (!grid.IsObject()) throw Error(gw + " must be an object");
+  size_t count = 1;
+  for (int k = 0; k < 3; ++k) {
+    double n = number_or(grid, "size", k, 0.0);
+    if (!(n >= 2.0 && n <= 1024.0) || n != std::floor(n)) throw Error(gw + ".size must hold 3 integers in [2, 1024]");
+    (*size)[k] = int(n);
+    count *= size_t(n);
+    (*lo)[k] = float(number_or(grid, "min", k, NAN));
+    (*hi)[k] = float(number_or(grid, "max", k, NAN));
+    if (!((*lo)[k] < (*hi)[k]) || !std::isfinite((*lo)[k]) || !std::isfinite((*hi)[k]))
+      throw Error(gw + ": min and max must be finite with min < max on every axis");
+  }
+  if (!grid.Has(key) || !grid.Get(key).IsArray() || grid.Get(key).ArrayLen() != count)
+    throw Error(gw + "." + key + " must be an array of size[0] x size[1] x size[2] numbers");
+  const tinygltf::Value& d = grid.Get(key);
+  values->resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    const tinygltf::Value& x = d.Get(int(i));
+    (*values)[i] = x.IsNumber() ? float(x.GetNumberAsDouble()) : -1.0f;
+    if (!((*values)[i] >= 0.0f) || !std::isfinite((*values)[i]))
+      throw Error(gw + "." + key + " must hold finite non-negative numbers");
+  }
+}
+
+// "emission_grid": a dense grid ("values" in place of "density") scaling the emission, its
+// box inside the density grid's (where the majorant cells are)
+void read_emission_grid(const tinygltf::Value& v, const std::string& where, MediumDesc* m) {
+  if (!v.Has("emission_grid")) return;
+  std::string ew = where + ".emission_grid";
+  read_dense_grid(v.Get("emission_grid"), ew, "values", &m->emission_grid_size, &m->emission_grid_min,
+                  &m->emission_grid_max, &m->emission_grid);
+  for (int k = 0; k < 3; ++k)
+    if (m->emission_grid_min[k] < m->grid_min[k] || m->emission_grid_max[k] > m->grid_max[k])
+      throw Error(ew + ": its box must lie inside the density grid's box (min " + std::to_string(m->grid_min[k]) +
+                  ", max " + std::to_string(m->grid_max[k]) + " on axis " + std::to_string(k) + ")");
+}
+
 // A medium from candela's extras: {"sigma_a": [r, g, b], "sigma_s": [r, g, b], "g": g,
 // "emission": [r, g, b], "density_scale": s, "grid": {"size": [nx, ny, nz], "min": [x, y, z],
 // "max": [x, y, z], "density": [nx ny nz values, x fastest]} or {"nanovdb": "f.nvdb"} or
-// {"vdb": "f.vdb"} with an optional "name"}; every entry optional
+// {"vdb": "f.vdb"} with an optional "name"}, "emission_grid": {"size", "min", "max", "values"}
+// (with a dense grid) and "emission_scale": s; every entry optional
 MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir) {
   if (!v.IsObject()) throw Error(where + " must be an object");
   MediumDesc m;
@@ -247,6 +289,14 @@ MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const
   m.density_scale = float(number_or(v, "density_scale", -1, 1.0));
   if (!(m.density_scale >= 0.0f) || !std::isfinite(m.density_scale))
     throw Error(where + ".density_scale must be finite and non-negative");
+  if (v.Has("emission_scale")) {
+    m.emission_scale = float(number_or(v, "emission_scale", -1, -1.0));
+    if (!(m.emission_scale >= 0.0f) || !std::isfinite(m.emission_scale))
+      throw Error(where + ".emission_scale must be finite and non-negative");
+    if (!v.Has("emission_grid")) throw Error(where + ".emission_scale needs an emission_grid");
+  }
+  if (v.Has("emission_grid") && (!v.Has("grid") || !v.Get("grid").IsObject() || !v.Get("grid").Has("size")))
+    throw Error(where + ".emission_grid needs an inline dense grid (size, min, max, density) beside it");
   if (!v.Has("grid")) return m;
   const tinygltf::Value& grid = v.Get("grid");
   std::string gw = where + ".grid";
@@ -266,27 +316,8 @@ MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const
       load_nanovdb_density(path.string(), name, &m);
     return m;
   }
-  size_t count = 1;
-  for (int k = 0; k < 3; ++k) {
-    double n = number_or(grid, "size", k, 0.0);
-    if (!(n >= 2.0 && n <= 1024.0) || n != std::floor(n)) throw Error(gw + ".size must hold 3 integers in [2, 1024]");
-    m.grid_size[k] = int(n);
-    count *= size_t(n);
-    m.grid_min[k] = float(number_or(grid, "min", k, NAN));
-    m.grid_max[k] = float(number_or(grid, "max", k, NAN));
-    if (!(m.grid_min[k] < m.grid_max[k]) || !std::isfinite(m.grid_min[k]) || !std::isfinite(m.grid_max[k]))
-      throw Error(gw + ": min and max must be finite with min < max on every axis");
-  }
-  if (!grid.Has("density") || !grid.Get("density").IsArray() || grid.Get("density").ArrayLen() != count)
-    throw Error(gw + ".density must be an array of size[0] x size[1] x size[2] numbers");
-  const tinygltf::Value& d = grid.Get("density");
-  m.density.resize(count);
-  for (size_t i = 0; i < count; ++i) {
-    const tinygltf::Value& x = d.Get(int(i));
-    m.density[i] = x.IsNumber() ? float(x.GetNumberAsDouble()) : -1.0f;
-    if (!(m.density[i] >= 0.0f) || !std::isfinite(m.density[i]))
-      throw Error(gw + ".density must hold finite non-negative numbers");
-  }
+  read_dense_grid(grid, gw, "density", &m.grid_size, &m.grid_min, &m.grid_max, &m.density);
+  read_emission_grid(v, where, &m);
   return m;
 }
 

@@ -42,7 +42,16 @@ struct MediumDesc {
   std::string grid_source;
   glm::ivec3 majorant_size{0};
   std::vector<float> majorant_density;  // x fastest
+  // An optional emission grid (inline dense, with a dense density grid): emission at p is
+  // emission x emission_scale x the trilinear value of these nodes, which span
+  // [emission_grid_min, emission_grid_max] (inside the density grid's box), instead of
+  // emission x density
+  glm::ivec3 emission_grid_size{0};
+  glm::vec3 emission_grid_min{0.0f}, emission_grid_max{0.0f};
+  std::vector<float> emission_grid;  // x fastest; empty: emission scales with the density
+  float emission_scale = 1.0f;
   bool is_nanovdb() const { return !nanovdb.empty(); }
+  bool has_emission_grid() const { return !emission_grid.empty(); }
   bool is_grid() const { return !density.empty() || is_nanovdb(); }
 };
 

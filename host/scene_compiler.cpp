@@ -146,6 +146,41 @@ void compile_nanovdb_grid(const MediumDesc& m, float scale, dev::Medium* d, dev:
   for (float v : m.majorant_density) b->densities.push_back(scale * v);
 }
 
+// A medium's emission grid: a MEDIUM_GRID record of its own (density_scale =
+// emission_scale, no majorant), which the medium names by Medium.emission_grid
+dev::Medium compile_emission_grid(const MediumDesc& m, dev::SceneBuffers* b, std::vector<GridMemory>* grids) {
+  dev::Medium e{};
+  e.type = MEDIUM_GRID;
+  e.density_scale = m.emission_scale;
+  if (b->densities.size() + m.emission_grid.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+  e.grid_offset = uint32_t(b->densities.size());
+  b->densities.insert(b->densities.end(), m.emission_grid.begin(), m.emission_grid.end());
+  for (int k = 0; k < 3; ++k) {
+    e.grid_size[k] = uint32_t(m.emission_grid_size[k]);
+    e.grid_min[k] = m.emission_grid_min[k];
+    e.grid_max[k] = m.emission_grid_max[k];
+  }
+  grids->push_back({"dense emission", m.emission_grid.size() * sizeof(float), 0});
+  return e;
+}
+
+// Does a trilinear lookup of m's emission grid inside the world box [lo, hi] read a
+// positive node?
+bool emission_grid_positive_in(const MediumDesc& m, glm::dvec3 lo, glm::dvec3 hi) {
+  int n0[3], n1[3];
+  for (int k = 0; k < 3; ++k) {
+    double lo_k = m.emission_grid_min[k], w = (double(m.emission_grid_max[k]) - lo_k) / (m.emission_grid_size[k] - 1);
+    n0[k] = int(std::clamp(std::floor((lo[k] - lo_k) / w), 0.0, double(m.emission_grid_size[k] - 1)));
+    n1[k] = int(std::clamp(std::ceil((hi[k] - lo_k) / w), 0.0, double(m.emission_grid_size[k] - 1)));
+    if (hi[k] < lo_k || lo[k] > m.emission_grid_max[k]) return false;
+  }
+  for (int z = n0[2]; z <= n1[2]; ++z)
+    for (int y = n0[1]; y <= n1[1]; ++y)
+      for (int x = n0[0]; x <= n1[0]; ++x)
+        if (m.emission_grid[(size_t(z) * m.emission_grid_size.y + y) * m.emission_grid_size.x + x] > 0.0f) return true;
+  return false;
+}
+
 dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vector<GridMemory>* grids) {
   dev::Medium d{};
   for (int c = 0; c < 3; ++c) {
@@ -186,6 +221,10 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vecto
       *lo = int(std::floor(double(c) / cells[axis] * n));
       *hi = std::min(int(std::ceil(double(c + 1) / cells[axis] * n)), m.grid_size[axis] - 1);
     };
+    glm::dvec3 cell_size = (glm::dvec3(m.grid_max) - glm::dvec3(m.grid_min)) / glm::dvec3(cells);
+    bool emits_by_grid = m.has_emission_grid() && std::max({m.emission.x, m.emission.y, m.emission.z}) > 0.0f &&
+                         m.emission_scale > 0.0f;
+    float emission_rate = float(1.0 / std::min({cell_size.x, cell_size.y, cell_size.z}));
     for (int cz = 0; cz < cells.z; ++cz)
       for (int cy = 0; cy < cells.y; ++cy)
         for (int cx = 0; cx < cells.x; ++cx) {
@@ -198,7 +237,16 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vecto
             for (int y = y0; y <= y1; ++y)
               for (int x = x0; x <= x1; ++x)
                 peak = std::max(peak, m.density[(size_t(z) * m.grid_size.y + y) * m.grid_size.x + x]);
-          b->densities.push_back(scale * peak);
+          float sigma_bar = scale * peak;
+          // Emission is gathered at tentative collisions only: where the emission grid is
+          // positive the cell needs a positive rate even where the density is 0 (about one
+          // tentative collision per cell crossed; the extra ones are null collisions)
+          if (emits_by_grid && scale * peak < emission_rate) {
+            glm::dvec3 lo = glm::dvec3(m.grid_min) + glm::dvec3(cx, cy, cz) * cell_size;
+            if (emission_grid_positive_in(m, lo, lo + cell_size)) sigma_bar = emission_rate;
+          }
+          d.majorant = std::max(d.majorant, sigma_bar);
+          b->densities.push_back(sigma_bar);
         }
     grids->push_back({"dense", m.density.size() * sizeof(float), size_t(cells.x) * cells.y * cells.z * sizeof(float)});
   }
@@ -214,8 +262,15 @@ void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers
   for (const MediumDesc& m : scene.media)
     if (m.is_nanovdb() && !f.nanovdb) throw Error("compile_scene: the kernel features leave out NanoVDB grids the scene has");
   b->media.push_back(dev::Medium{});
+  std::vector<dev::Medium> emission_grids;  // after every other record; Medium.emission_grid
   for (size_t i = 0; i < scene.media.size(); ++i) {
     b->media.push_back(compile_medium(scene.media[i], b, grids));
+    if (scene.media[i].has_emission_grid()) {
+      if (!scene.media[i].is_grid() || scene.media[i].is_nanovdb())
+        throw Error("compile_scene: an emission grid needs a dense density grid beside it");
+      emission_grids.push_back(compile_emission_grid(scene.media[i], b, grids));
+      b->media.back().emission_grid = uint32_t(scene.media.size() + emission_grids.size());  // placeholder rank
+    }
     if (int(i) == scene.global_medium) b->media[GLOBAL_MEDIUM] = b->media.back();  // its grid stored once
   }
   int vacuum = NO_MEDIUM;
@@ -233,6 +288,12 @@ void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers
     }
     b->materials[i].medium = vacuum;
   }
+  // The emission grids' records go last: the placeholder N + k (N media) becomes the index
+  // of the k-th one
+  uint32_t first = uint32_t(b->media.size());
+  for (dev::Medium& d : b->media)
+    if (d.emission_grid != 0u) d.emission_grid = first + (d.emission_grid - uint32_t(scene.media.size()) - 1u);
+  b->media.insert(b->media.end(), emission_grids.begin(), emission_grids.end());
 }
 
 glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {

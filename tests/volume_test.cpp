@@ -375,6 +375,45 @@ TEST_P(VolumeRender, EmissiveSlab) {
   }
 }
 
+// An emission grid: a non-scattering slab z in [0, d] whose emission grid ramps linearly
+// along the view axis, E(z) = e x scale x (c0 + c1 z / d), under a density grid that is 0
+// everywhere (nothing attenuates: the majorant cells must still be positive where the
+// emission grid is, or nothing is gathered) or 1 with absorption kSigmaA. The camera looks
+// down -z from z = 3: L = integral over s in [0, d] of exp(-sigma_a density s) E(d - s) ds.
+json emission_slab(float d, glm::vec3 e, float density, float scale, float c0, float c1) {
+  json medium = medium_json(kSigmaA, glm::vec3(0.0f), 0.0, e);
+  medium["grid"] = {{"size", {2, 2, 9}}, {"min", {-1, -1, 0}}, {"max", {1, 1, d}}, {"density", std::vector<float>(2 * 2 * 9, density)}};
+  std::vector<float> ramp;
+  const int nz = 5;
+  for (int z = 0; z < nz; ++z)
+    for (int i = 0; i < 4; ++i) ramp.push_back(c0 + c1 * float(z) / float(nz - 1));
+  medium["emission_grid"] = {{"size", {2, 2, nz}}, {"min", {-1, -1, 0}}, {"max", {1, 1, d}}, {"values", ramp}};
+  medium["emission_scale"] = scale;
+  return medium;
+}
+
+TEST_P(VolumeRender, EmissionGridRamp) {
+  const float d = 1.5f, scale = 0.5f, c0 = 0.25f, c1 = 1.5f;
+  const glm::vec3 e(0.4f, 0.8f, 1.2f);
+  for (float density : {0.0f, 1.0f}) {
+    GltfBuilder g;  // no light: only the medium emits
+    int slab = g.add("materials", null_material(emission_slab(d, e, density, scale, c0, c1)));
+    g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
+    glm::dvec3 want(0.0);
+    const int steps = 20000;  // midpoint rule, converged far below the tolerance
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < steps; ++i) {
+        double s = (i + 0.5) * d / steps, z = d - s;
+        want[c] += std::exp(-double(kSigmaA[c]) * density * s) * e[c] * scale * (c0 + c1 * z / d) * d / steps;
+      }
+    for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
+      std::string label = "emission-grid-" + std::to_string(int(density)) + "-" + name(s);
+      Film f = render_view(g, label, 256, s);
+      expect_image(f, want, label);
+    }
+  }
+}
+
 // A glass slab (KHR_materials_volume, ior 1.5) of thickness d at normal incidence:
 // L (1 - F)^2 T / (1 - F^2 T^2), F = 0.04, T = exp(-sigma_a d), sigma_a = -ln(c) / distance
 TEST_P(VolumeRender, AbsorbingGlassSlab) {
@@ -608,6 +647,52 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
   }
 }
 
+// An emission grid leaves transmittance alone: its positive majorant cells over a thin
+// medium only add null collisions to ratio tracking. The compiled records: the emission
+// grid's own MEDIUM_GRID record, last, named by Medium.emission_grid.
+TEST(VolumeGrid, EmissionGridKeepsTransmittance) {
+  GltfBuilder g;
+  const float d = 1.5f, density = 0.1f;  // sigma_t bound 0.2 < 1 / cell size = 16 / 1.5
+  int slab = g.add("materials", null_material(emission_slab(d, glm::vec3(1.0f), density, 1.0f, 0.0f, 1.0f)));
+  g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
+  Scene scene = load(g, "emission-grid-transmittance");
+  CompiledScene compiled = compile_scene(scene);
+  const auto& media = compiled.buffers.media;
+  ASSERT_EQ(media.size(), 3u);  // vacuum global, the slab, its emission grid
+  EXPECT_EQ(media[1].emission_grid, 2u);
+  EXPECT_EQ(media[2].type, MEDIUM_GRID);
+  EXPECT_EQ(media[2].emission_grid, 0u);
+  EXPECT_EQ(media[2].grid_size[2], 5u);
+  EXPECT_FLOAT_EQ(media[2].density_scale, 1.0f);
+  // The majorant cells: raised to 1 / cell size except the first layer along z (the ramp is
+  // 0 at z = 0 but rises within that cell's trilinear reach, so it is raised too)
+  EXPECT_FLOAT_EQ(media[1].majorant, 8.0f / d);
+  KernelRig& rig = rig_for("pocl");
+  SceneOnDevice sod(rig, compiled);
+  const size_t n = 1 << 16;
+  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+  cl::Kernel k(rig.program, "test_media_transmittance");
+  cl_uint arg = sod.bind(k, 0);
+  k.setArg(arg++, cl_float4{{0.1f, 0.2f, d + 1.0f, 0.0f}});
+  k.setArg(arg++, cl_float4{{0.0f, 0.0f, -1.0f, 0.0f}});
+  k.setArg(arg++, float(INFINITY));
+  k.setArg(arg++, cl_uint(11));
+  k.setArg(arg++, out);
+  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
+  std::vector<cl_float4> v(n);
+  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
+  for (int ch = 0; ch < 3; ++ch) {
+    double sum = 0.0, sum2 = 0.0;
+    for (const cl_float4& x : v) {
+      sum += x.s[ch];
+      sum2 += double(x.s[ch]) * x.s[ch];
+    }
+    double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+    double want = std::exp(-double(kSigmaA[ch]) * density * d);
+    EXPECT_NEAR(mean, want, 5.0 * se + 1e-6) << "channel " << ch << " SE " << se;
+  }
+}
+
 // Where media come from: KHR_materials_volume, extras, the scene; the compiled records
 TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
   GltfBuilder g;
@@ -679,6 +764,35 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
       {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(7, 1.0f)}}}},
       {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(8, -1.0f)}}}},
   };
+  // Emission grids: without a dense density grid, the wrong number of values, a negative
+  // value, a box outside the density grid's, a bad scale, a scale without a grid
+  json dense = {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(8, 1.0f)}};
+  json eg = {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"values", std::vector<float>(8, 1.0f)}};
+  auto with = [&](json grid, const char* key, json value) {
+    grid[key] = value;
+    return grid;
+  };
+  const std::vector<std::pair<json, std::string>> bad_emission = {
+      {{{"emission_grid", eg}}, "needs an inline dense grid"},
+      {{{"grid", {{"vdb", "smoke.vdb"}}}, {"emission_grid", eg}}, "needs an inline dense grid"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(7, 1.0f))}}, "emission_grid.values must be an array"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(8, -1.0f))}}, "emission_grid.values must hold finite non-negative"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "max", {1, 1.5, 1})}}, "inside the density grid's box"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "size", {2, 1, 2})}}, "emission_grid.size must hold"},
+      {{{"grid", dense}, {"emission_grid", eg}, {"emission_scale", -1}}, "emission_scale must be finite"},
+      {{{"grid", dense}, {"emission_scale", 2}}, "emission_scale needs an emission_grid"},
+  };
+  int k = 0;
+  for (const auto& [medium, message] : bad_emission) {
+    GltfBuilder g;
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", null_material(medium))))}});
+    try {
+      load(g, "bad-emission-" + std::to_string(k++));
+      ADD_FAILURE() << "no error for " << medium.dump();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
   int i = 0;
   for (const json& medium : bad) {
     GltfBuilder g;
