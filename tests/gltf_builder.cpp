@@ -1,6 +1,7 @@
 #include "gltf_builder.hpp"
 
 #include <fstream>
+#include <utility>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <map>
@@ -112,6 +113,26 @@ GltfBuilder::Primitive quad_primitive(const float (&p)[4][3], int material) {
   q.indices = {0, 1, 2, 0, 2, 3};
   q.material = material;
   return q;
+}
+
+std::vector<GltfBuilder::Primitive> box_primitives(glm::vec3 lo, glm::vec3 hi, int material) {
+  std::vector<GltfBuilder::Primitive> out;
+  glm::vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+  for (int axis = 0; axis < 3; ++axis)
+    for (float s : {-1.0f, 1.0f}) {
+      glm::vec3 n(0.0f), a(0.0f), b(0.0f);
+      n[axis] = s;
+      a[(axis + 1) % 3] = h[(axis + 1) % 3];
+      b[(axis + 2) % 3] = h[(axis + 2) % 3];
+      if (s < 0.0f) std::swap(a, b);  // a x b along n
+      glm::vec3 fc = c + n * h[axis];
+      glm::vec3 p[4] = {fc - a - b, fc + a - b, fc + a + b, fc - a + b};
+      float q[4][3];
+      for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 3; ++j) q[k][j] = p[k][j];
+      out.push_back(quad_primitive(q, material));
+    }
+  return out;
 }
 
 GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions,

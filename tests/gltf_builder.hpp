@@ -49,6 +49,10 @@ class GltfBuilder {
 // TEXCOORD_0 (0,1) (1,1) (1,0) (0,0) at p0..p3
 GltfBuilder::Primitive quad_primitive(const float (&p)[4][3], int material);
 
+// An axis-aligned box from lo to hi: six quads, counter-clockwise seen from outside
+// (outward normals)
+std::vector<GltfBuilder::Primitive> box_primitives(glm::vec3 lo, glm::vec3 hi, int material);
+
 // A closed icosphere (flat-shaded, shared vertices, outward winding)
 GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions,
                                         int material);

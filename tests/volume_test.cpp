@@ -230,26 +230,6 @@ INSTANTIATE_TEST_SUITE_P(Devices, PhaseTest,
 
 // --- Scenes ---
 
-// An axis-aligned box of six quads, counter-clockwise seen from outside (outward normals)
-std::vector<GltfBuilder::Primitive> box_primitives(glm::vec3 lo, glm::vec3 hi, int material) {
-  std::vector<GltfBuilder::Primitive> out;
-  glm::vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
-  for (int axis = 0; axis < 3; ++axis)
-    for (float s : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), a(0.0f), b(0.0f);
-      n[axis] = s;
-      a[(axis + 1) % 3] = h[(axis + 1) % 3];
-      b[(axis + 2) % 3] = h[(axis + 2) % 3];
-      if (s < 0.0f) std::swap(a, b);  // a x b along n
-      glm::vec3 fc = c + n * h[axis];
-      glm::vec3 p[4] = {fc - a - b, fc + a - b, fc + a + b, fc - a + b};
-      float q[4][3];
-      for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 3; ++j) q[k][j] = p[k][j];
-      out.push_back(quad_primitive(q, material));
-    }
-  return out;
-}
 
 json medium_json(glm::vec3 sigma_a, glm::vec3 sigma_s, double g = 0.0, glm::vec3 emission = glm::vec3(0.0f)) {
   return {{"sigma_a", {sigma_a.x, sigma_a.y, sigma_a.z}},

@@ -37,26 +37,6 @@ KernelRig& pocl_rig() {
   return rig;
 }
 
-// Six quads of an axis-aligned box, counter-clockwise seen from outside
-std::vector<GltfBuilder::Primitive> box_faces(glm::vec3 lo, glm::vec3 hi, int material) {
-  std::vector<GltfBuilder::Primitive> out;
-  glm::vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
-  for (int axis = 0; axis < 3; ++axis)
-    for (float s : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), a(0.0f), b(0.0f);
-      n[axis] = s;
-      a[(axis + 1) % 3] = h[(axis + 1) % 3];
-      b[(axis + 2) % 3] = h[(axis + 2) % 3];
-      if (s < 0.0f) std::swap(a, b);
-      glm::vec3 fc = c + n * h[axis];
-      glm::vec3 p[4] = {fc - a - b, fc + a - b, fc + a + b, fc - a + b};
-      float q[4][3];
-      for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 3; ++j) q[k][j] = p[k][j];
-      out.push_back(quad_primitive(q, material));
-    }
-  return out;
-}
 
 json scattering_medium(glm::vec3 sigma_s, double g) {
   return {{"sigma_a", {0, 0, 0}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"g", g}};
@@ -233,7 +213,7 @@ struct TrackingScene {
                       {"density", grid.v}};
     medium["density_scale"] = density_scale;
     int box = g.add("materials", null_boundary(medium));
-    g.add_node({{"mesh", g.add_mesh(box_faces(glm::vec3(grid.lo), glm::vec3(grid.hi), box))}});
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(grid.lo), glm::vec3(grid.hi), box))}});
     return load_scene(g, name);
   }
 };
