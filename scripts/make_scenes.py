@@ -733,12 +733,7 @@ def make_environment(path):
     s = 6.0
     floor_pos = [f32v(p) for p in ((-s, 0, s), (s, 0, s), (s, 0, -s), (-s, 0, -s))]
     g.node("floor", mesh=g.mesh("floor", floor_pos, [(0.0, 1.0, 0.0)] * 4, [0, 1, 2, 0, 2, 3], floor_mat))
-    eye, target = (0.0, 1.3, 4.2), (0.0, 0.4, 0.0)
-    f = normalize(sub(target, eye))
-    right = normalize(cross(f, (0.0, 1.0, 0.0)))
-    up = cross(right, f)
-    g.node("camera", camera=g.camera("camera", 0.6, 1.6), translation=list(eye),
-           rotation=quat_from_basis(right, up, scale(f, -1.0)))
+    look_camera(g, (0.0, 1.3, 4.2), (0.0, 0.4, 0.0), 0.6, 1.6)
     g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
                                                                 "rotation": 0.0}}}
     g.write(path)
