@@ -6,6 +6,15 @@
 // geometric-normal side test, once, for every lobe: a direction on wo's side of the
 // surface can only be reflected into, one on the other side only transmitted into.
 
+// Material types a scene has none of are compiled out (SceneFeatures; glTF materials that
+// are exactly Lambertian arrive as MATERIAL_DIFFUSE, MaterialDesc::kernel_type)
+#ifndef CD_FEATURE_GLTF_BSDF
+#define CD_FEATURE_GLTF_BSDF 1
+#endif
+#ifndef CD_FEATURE_CONDUCTOR
+#define CD_FEATURE_CONDUCTOR 1
+#endif
+
 float4 bsdf_texture(const SceneData* sc, __global const Material* m, int slot, const SurfaceHit* s) {
   return textures_lookup(sc, &m->textures[slot], s->uvs);
 }
@@ -92,26 +101,35 @@ Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   b.cond_eta = load3(m->conductor_eta);
   b.cond_k = load3(m->conductor_k);
   b.ggx_albedo = sc->ggx_albedo;
+#if CD_FEATURE_CONDUCTOR
   if (m->type == MATERIAL_CONDUCTOR) {
     bsdf_roughness_params(sc, m, s, &b);
     bsdf_conductor_params(&b);
   }
+#endif
+#if CD_FEATURE_GLTF_BSDF
   if (m->type == MATERIAL_GLTF) {
     bsdf_gltf_params(sc, m, s, &b);
-    // No specular layer, metal, glass or coat: exactly Lambertian, so take the short path
+    // No specular layer, metal, glass or coat where the textures put none: exactly
+    // Lambertian here, so take the short path
     if (b.metallic == 0.0f && b.spec_f90 == 0.0f && b.transmission == 0.0f && b.coat == 0.0f)
       b.type = MATERIAL_DIFFUSE;
   }
+#endif
   return b;
 }
 
 // The kinds of lobe this BSDF has (BSDF_* flags); light sampling and the integrator ask
 uint bsdf_flags(const Bsdf* b) {
   switch (b->type) {
+#if CD_FEATURE_GLTF_BSDF
     case MATERIAL_GLTF:
       return bsdf_gltf_flags(b);
+#endif
+#if CD_FEATURE_CONDUCTOR
     case MATERIAL_CONDUCTOR:
       return BSDF_REFLECTION | (ggx_is_delta(b->ggx) ? BSDF_DELTA : BSDF_GLOSSY);
+#endif
     case MATERIAL_DIFFUSE:
     default:
       return BSDF_REFLECTION | BSDF_DIFFUSE;
@@ -167,10 +185,14 @@ float3 bsdf_eval_pdf(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   // The local side must agree with the geometric one
   if (bsdf_is_reflection(b, wi) != (wi_l.z > 0.0f)) return (float3)(0.0f);
   switch (b->type) {
+#if CD_FEATURE_GLTF_BSDF
     case MATERIAL_GLTF:
       return bsdf_gltf_eval(b, wo_l, wi_l, pdf);
+#endif
+#if CD_FEATURE_CONDUCTOR
     case MATERIAL_CONDUCTOR:
       return bsdf_conductor_eval(b, wo_l, wi_l, pdf);
+#endif
     case MATERIAL_DIFFUSE:
     default:
       *pdf = bsdf_diffuse_pdf(wo_l, wi_l);
@@ -194,12 +216,16 @@ bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   float3 wo_l = frame_to_local(&b->frame, wo);
   bool ok;
   switch (b->type) {
+#if CD_FEATURE_GLTF_BSDF
     case MATERIAL_GLTF:
       ok = bsdf_gltf_sample(b, wo_l, uc, u, bs);
       break;
+#endif
+#if CD_FEATURE_CONDUCTOR
     case MATERIAL_CONDUCTOR:
       ok = bsdf_conductor_sample(b, wo_l, uc, u, bs);
       break;
+#endif
     case MATERIAL_DIFFUSE:
     default:
       ok = bsdf_diffuse_sample(b->base_color, wo_l, u, bs);

@@ -1,3 +1,12 @@
+// Light types a scene has none of are compiled out (SceneFeatures: punctual lights,
+// the environment); emissive triangles are always in
+#ifndef CD_FEATURE_PUNCTUAL
+#define CD_FEATURE_PUNCTUAL 1
+#endif
+#ifndef CD_FEATURE_ENVIRONMENT
+#define CD_FEATURE_ENVIRONMENT 1
+#endif
+
 // Light sampling from a context (a surface point, or a point in a medium), through one
 // light-selection alias table with probabilities proportional to power. Directions and pdfs
 // are measured from ctx.p; a finite light's shadow ray ends at `target`, just off the
@@ -36,10 +45,14 @@ __global const Light* lights_environment(const SceneData* sc) {
 
 // Radiance arriving along -dir from infinitely far away
 float3 lights_environment_radiance(const SceneData* sc, float3 dir) {
+#if CD_FEATURE_ENVIRONMENT
   __global const Light* env = lights_environment(sc);
   if (!env) return (float3)(0.0f);
   if (environment_map(env) != NO_TEXTURE) return environment_radiance(sc, env, dir);
   return load3(env->radiance);
+#else
+  return (float3)(0.0f);
+#endif
 }
 
 // Reflection-only surfaces see the environment over the hemisphere of n (sampled by the
@@ -282,9 +295,12 @@ bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_se
     case LIGHT_TRIANGLE:
       ok = lights_sample_triangle(sc, light, ctx, u, ls);
       break;
+#if CD_FEATURE_ENVIRONMENT
     case LIGHT_ENVIRONMENT:
       ok = lights_sample_environment(sc, ctx, u, ls);
       break;
+#endif
+#if CD_FEATURE_PUNCTUAL
     case LIGHT_POINT:
     case LIGHT_SPOT:
       ok = lights_sample_point(light, ctx, ls);
@@ -292,6 +308,7 @@ bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_se
     case LIGHT_DIRECTIONAL:
       ok = lights_sample_directional(light, ls);
       break;
+#endif
     default:
       ok = false;
   }
@@ -305,8 +322,10 @@ float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index,
   switch (light->type) {
     case LIGHT_TRIANGLE:
       return light->pmf * lights_pdf_triangle(sc, light, ctx, wi);
+#if CD_FEATURE_ENVIRONMENT
     case LIGHT_ENVIRONMENT:
       return light->pmf * lights_pdf_environment(sc, ctx, wi);
+#endif
     case LIGHT_POINT:
     case LIGHT_SPOT:
     case LIGHT_DIRECTIONAL:

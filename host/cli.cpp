@@ -450,6 +450,7 @@ void write_stats(const RenderArgs& a, const RenderSettings& settings, const Rend
                       {"samples_per_second", samples_per_second},
                       {"kernel_build_seconds", renderer.kernel_build_seconds()},
                       {"kernel_from_cache", renderer.kernel_from_cache()},
+                      {"kernel_features", renderer.scene().features.build_options()},
                       {"bvh_build_seconds", renderer.bvh_build_seconds()},
                       {"scene_compile_seconds", renderer.scene().compile_seconds},
                       {"scene_device_bytes", renderer.scene().device_bytes},

@@ -12,7 +12,22 @@ std::string SceneFeatures::build_options() const {
   return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
          flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
          flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media) +
-         flag("CD_FEATURE_NANOVDB", nanovdb);
+         flag("CD_FEATURE_NANOVDB", nanovdb) + flag("CD_FEATURE_GLTF_BSDF", gltf_bsdf) +
+         flag("CD_FEATURE_CONDUCTOR", conductor) + flag("CD_FEATURE_PUNCTUAL", punctual) +
+         flag("CD_FEATURE_ENVIRONMENT", environment);
+}
+
+bool SceneFeatures::covers(const SceneFeatures& n) const {
+  auto has = [](bool kernel, bool needed) { return kernel || !needed; };
+  return has(textures, n.textures) && has(uvs, n.uvs) && has(tangents, n.tangents) &&
+         has(vertex_colors, n.vertex_colors) && has(alpha, n.alpha) && has(media, n.media) &&
+         has(nanovdb, n.nanovdb) && has(gltf_bsdf, n.gltf_bsdf) && has(conductor, n.conductor) &&
+         has(punctual, n.punctual) && has(environment, n.environment);
+}
+
+uint32_t MaterialDesc::kernel_type() const {
+  bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f;
+  return type == MATERIAL_GLTF && lambertian ? MATERIAL_DIFFUSE : type;
 }
 
 bool MaterialDesc::alpha_tested() const {
@@ -64,9 +79,16 @@ SceneFeatures Scene::features() const {
     for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
     f.alpha |= materials.at(m.material).alpha_tested();
     f.media |= materials.at(m.material).medium >= 0;
+    // BSDFs of the materials meshes use (the loader's default material may go unused)
+    f.gltf_bsdf |= materials.at(m.material).kernel_type() == MATERIAL_GLTF;
+    f.conductor |= materials.at(m.material).kernel_type() == MATERIAL_CONDUCTOR;
   }
   f.media |= global_medium >= 0;
   for (const auto& m : media) f.nanovdb |= f.media && m.is_nanovdb();
+  // The lights compile_lights makes: emitting punctual lights; the map, else a background
+  f.punctual = punctual_light_count() > 0;
+  f.environment = environment.has_value() ||
+                  dev::luminance_rgb(background.x, background.y, background.z) > 0.0f;
   return f;
 }
 

@@ -82,6 +82,10 @@ struct MaterialDesc {
   const TextureSlot& texture(int slot) const { return textures[slot]; }
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
   bool alpha_tested() const;
+  // The BSDF the kernel shades it with: MATERIAL_DIFFUSE for a glTF material that is exactly
+  // Lambertian whatever its textures (metallic, specular, transmission and clearcoat factors
+  // all 0, each of which multiplies its texture), else `type`
+  uint32_t kernel_type() const;
 };
 
 struct TextureDesc {
@@ -171,11 +175,18 @@ struct SceneFeatures {
   bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
   bool media = false;  // a global medium, or a mesh whose material has an interior medium
   bool nanovdb = false;  // a medium with a NanoVDB grid (CD_FEATURE_NANOVDB)
+  bool gltf_bsdf = false;  // a material the kernel shades as MATERIAL_GLTF (MaterialDesc::kernel_type)
+  bool conductor = false;  // a MATERIAL_CONDUCTOR material
+  bool punctual = false;  // an emitting KHR_lights_punctual light
+  bool environment = false;  // an environment map or a constant background
   std::string build_options() const;
+  // Does this kernel have every feature `needed` names?
+  bool covers(const SceneFeatures& needed) const;
   // Every flag on: the generic kernel, correct for any scene (--generic)
   static SceneFeatures all() {
     SceneFeatures f;
     f.textures = f.uvs = f.tangents = f.vertex_colors = f.alpha = f.media = f.nanovdb = true;
+    f.gltf_bsdf = f.conductor = f.punctual = f.environment = true;
     return f;
   }
 };

@@ -72,7 +72,7 @@ dev::TextureRef compile_texture_ref(const TextureSlot& r) {
 void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
   for (const MaterialDesc& m : scene.materials) {
     dev::Material d{};
-    d.type = m.type;
+    d.type = m.kernel_type();
     d.flags = (m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.thin_walled ? MATERIAL_THIN_WALLED : 0u) |
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
@@ -529,10 +529,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   CompiledScene c;
   c.features = features;
   const SceneFeatures needed = scene.features();
-  if ((needed.textures && !features.textures) || (needed.uvs && !features.uvs) ||
-      (needed.tangents && !features.tangents) || (needed.vertex_colors && !features.vertex_colors) ||
-      (needed.alpha && !features.alpha) || (needed.media && !features.media) ||
-      (needed.nanovdb && !features.nanovdb))
+  if (!features.covers(needed))
     throw Error("compile_scene: the kernel features leave out some the scene needs");
   c.camera = resolve_camera(scene);
   check_extent(scene, c.camera);

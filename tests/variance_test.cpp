@@ -267,3 +267,51 @@ TEST(Specialization, GenericAndSpecializedKernelsAgreeOnEveryShippedScene) {
 }
 
 }  // namespace candela::test
+
+namespace candela::test {
+namespace {
+
+SceneFeatures features_of(const std::string& relative) { return load_gltf(scene_path(relative)).features(); }
+
+}  // namespace
+
+// The material and light types a scene has decide which BSDF and light code its kernel
+// compiles (CD_FEATURE_GLTF_BSDF, _CONDUCTOR, _PUNCTUAL, _ENVIRONMENT): the Cornell box's
+// glTF materials are exactly Lambertian (metallic, specular, transmission and clearcoat
+// 0), so its kernel has neither glTF nor conductor BSDF code, and lights of emissive
+// triangles only
+TEST(Specialization, FeaturesNameTheMaterialAndLightTypesInUse) {
+  Scene cornell = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  for (const MeshDesc& m : cornell.meshes) EXPECT_EQ(cornell.materials.at(m.material).kernel_type(), MATERIAL_DIFFUSE);
+  SceneFeatures c = cornell.features();
+  EXPECT_FALSE(c.gltf_bsdf || c.conductor || c.punctual || c.environment);
+
+  SceneFeatures materials = features_of("materials/materials.gltf");
+  EXPECT_TRUE(materials.gltf_bsdf);
+  EXPECT_TRUE(materials.conductor);
+  EXPECT_TRUE(features_of("lights/punctual.gltf").punctual);
+  EXPECT_TRUE(features_of("lights/environment.gltf").environment);
+  EXPECT_FALSE(features_of("lights/many-lights.gltf").punctual);
+
+  // One factor off 0 makes the material glTF again, whatever its textures
+  MaterialDesc m = cornell.materials.at(cornell.meshes.at(0).material);
+  m.specular = 0.5f;
+  EXPECT_EQ(m.kernel_type(), MATERIAL_GLTF);
+  m.specular = 0.0f;
+  m.metallic = 1e-3f;
+  EXPECT_EQ(m.kernel_type(), MATERIAL_GLTF);
+
+  // A kernel without a feature the scene needs is refused, flag by flag
+  Scene mats = load_gltf(scene_path("materials/materials.gltf"));
+  for (bool SceneFeatures::*flag : {&SceneFeatures::gltf_bsdf, &SceneFeatures::conductor}) {
+    SceneFeatures lacking = mats.features();
+    lacking.*flag = false;
+    EXPECT_THROW(compile_scene(mats, lacking), Error);
+    EXPECT_FALSE(lacking.covers(mats.features()));
+  }
+  EXPECT_TRUE(SceneFeatures::all().covers(mats.features()));
+  EXPECT_NE(c.build_options().find("-DCD_FEATURE_GLTF_BSDF=0"), std::string::npos);
+  EXPECT_NE(c.build_options().find("-DCD_FEATURE_ENVIRONMENT=0"), std::string::npos);
+}
+
+}  // namespace candela::test
