@@ -16,7 +16,7 @@ float2 filter_sample(uint filter, float u, float v) {
     // and a uniform angle give two independent normal offsets. 1 - u > 0 keeps the log
     // finite; 24-bit uniforms reach at most 5.8 sigma (2.9 pixels), so no truncation.
     float r = 0.5f * sqrt(-2.0f * log(1.0f - u));
-    float cos_phi, sin_phi = sincos(2.0f * PI_F * v, &cos_phi);
+    float cos_phi, sin_phi = sincos_turn(v, &cos_phi);
     return (float2)(0.5f + r * cos_phi, 0.5f + r * sin_phi);
   }
   return (float2)(u, v);  // FILTER_BOX: today's uniform jitter, bit for bit

@@ -105,10 +105,10 @@ bool lights_sample_environment(const SceneData* sc, const LightSampleContext* ct
 #endif
 
 // Solid angle of the spherical triangle of unit vectors (a, b, c) (Van Oosterom and
-// Strackee 1983): tan(omega / 2) = |a.(b x c)| / (1 + a.b + b.c + c.a)
-float lights_spherical_triangle_area(float3 a, float3 b, float3 c) {
-  float num = fabs(dot(a, cross(b, c)));
-  float den = 1.0f + dot(a, b) + dot(b, c) + dot(c, a);
+// Strackee 1983): tan(omega / 2) = num / den with num = |a.(b x c)|, den = 1 + a.b + b.c + c.a
+float lights_spherical_triangle_num(float3 a, float3 b, float3 c) { return fabs(dot(a, cross(b, c))); }
+float lights_spherical_triangle_den(float3 a, float3 b, float3 c) { return 1.0f + dot(a, b) + dot(b, c) + dot(c, a); }
+float lights_spherical_triangle_angle(float num, float den) {
   float omega = 2.0f * atan2(num, den);
   return omega >= 0.0f ? omega : omega + 2.0f * PI_F;
 }
@@ -122,7 +122,12 @@ bool lights_triangle_spherical(float3 p, float3 v0, float3 v1, float3 v2, float3
   *a = normalize(v0 - p);
   *b = normalize(v1 - p);
   *c = normalize(v2 - p);
-  *omega = lights_spherical_triangle_area(*a, *b, *c);
+  float num = lights_spherical_triangle_num(*a, *b, *c), den = lights_spherical_triangle_den(*a, *b, *c);
+  // Small triangles are the common case (area sampling) and need no atan2: tan(x) > x, so
+  // num < (MIN / 2) den (den > 0) means omega < MIN with room to spare for rounding; the
+  // others take the exact test, so the choice is the same as with omega alone
+  if (den > 0.0f && !(num >= 0.5f * LIGHTS_SPHERICAL_MIN_SOLID_ANGLE * den)) return false;
+  *omega = lights_spherical_triangle_angle(num, den);
   return *omega >= LIGHTS_SPHERICAL_MIN_SOLID_ANGLE && isfinite(*omega);
 #endif
 }

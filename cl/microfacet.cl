@@ -49,7 +49,7 @@ float3 ggx_sample_visible(Ggx g, float3 w, float2 u) {
   float3 t1 = len2 > 0.0f ? (float3)(-wh.y, wh.x, 0.0f) * rsqrt(len2) : (float3)(1.0f, 0.0f, 0.0f);
   float3 t2 = cross(wh, t1);
   float r = sqrt(u.x);
-  float cos_phi, sin_phi = sincos(2.0f * PI_F * u.y, &cos_phi);
+  float cos_phi, sin_phi = sincos_turn(u.y, &cos_phi);
   float p1 = r * cos_phi, p2 = r * sin_phi;
   float s = 0.5f * (1.0f + wh.z);
   p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * p2;

@@ -64,7 +64,7 @@ float3 phase_sample(float g, float3 wo, float2 u, float* pdf) {
   // relative to wo: cos = -mu, so 1 + cos = 1 - mu and 1 - cos = 1 + mu
   float cos_theta = g > 0.0f ? one_minus_mu - 1.0f : 1.0f - one_plus_mu;
   float sin_theta = sqrt(fmax(0.0f, one_minus_mu * one_plus_mu));
-  float cos_phi, sin_phi = sincos(2.0f * PI_F * u.y, &cos_phi);
+  float cos_phi, sin_phi = sincos_turn(u.y, &cos_phi);
   Frame f = frame_from_z(wo);
   float3 wi = frame_from_local(&f, (float3)(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta));
   *pdf = phase_hg_from(g, one_minus_mu, one_plus_mu);

@@ -3,11 +3,19 @@
 #define PI_F 3.14159265358979323846f
 #define INV_PI_F 0.31830988618379067154f
 
+// sin(2 pi u) and, in *cos_phi, cos(2 pi u): sinpi/cospi reduce their argument exactly and
+// cheaply (PoCL's sincos of 2 pi u calls a general argument reduction: 2.4 % more render
+// kernel instructions on the Cornell box)
+float sincos_turn(float u, float* cos_phi) {
+  *cos_phi = cospi(2.0f * u);
+  return sinpi(2.0f * u);
+}
+
 // Cosine-weighted hemisphere around +z: theta = acos(sqrt(v)), phi = 2 pi u
 float3 sample_cosine_hemisphere(float u, float v) {
   float cos_theta = sqrt(v);
   float sin_theta = sqrt(1.0f - v);
-  float cos_phi, sin_phi = sincos(2.0f * PI_F * u, &cos_phi);
+  float cos_phi, sin_phi = sincos_turn(u, &cos_phi);
   return (float3)(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
 }
 
@@ -17,7 +25,7 @@ float sample_cosine_hemisphere_pdf(float cos_theta) { return fmax(cos_theta, 0.0
 float3 sample_uniform_sphere(float u, float v) {
   float z = 1.0f - 2.0f * v;
   float r = sqrt(fmax(0.0f, 1.0f - z * z));
-  float cos_phi, sin_phi = sincos(2.0f * PI_F * u, &cos_phi);
+  float cos_phi, sin_phi = sincos_turn(u, &cos_phi);
   return (float3)(r * cos_phi, r * sin_phi, z);
 }
 

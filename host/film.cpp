@@ -65,10 +65,6 @@ void write_image(const std::string& path, const Film& film,
   check_output_path(path);
   bool exr = lower_extension(path) == ".exr";
 
-  OIIO::ImageSpec spec(film.width, film.height, 3, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
-  spec.attribute("Software", "candela " CANDELA_VERSION);
-
   std::vector<float> rgb(film.pixels() * 3);
   float scale = std::exp2(exposure);
   for (size_t i = 0; i < film.pixels(); ++i)
@@ -76,7 +72,14 @@ void write_image(const std::string& path, const Film& film,
       float v = film.mean[4 * i + c];
       rgb[3 * i + c] = exr ? v : linear_to_srgb(v * scale);
     }
+  write_rgb_pixels(path, film.width, film.height, rgb, exr, metadata);
+}
 
+void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,
+                      bool float_channels, const std::map<std::string, std::string>& metadata) {
+  OIIO::ImageSpec spec(width, height, 3, float_channels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
+  spec.attribute("Software", "candela " CANDELA_VERSION);
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw Error("cannot write " + path + ": " + OIIO::geterror());
   if (!out->open(path, spec)) throw Error("cannot write " + path + ": " + out->geterror());

@@ -31,6 +31,12 @@ Film merge_films(const Film& a, const Film& b);
 // Throws Error unless the path ends in .exr or .png (case-insensitive)
 void check_output_path(const std::string& path);
 
+// Writes width x height RGB pixels (3 floats each) to path: float channels (.exr) or 8-bit
+// ones (.png, the values already encoded), with each metadata entry as attribute candela:KEY
+// and Software = candela VERSION; throws Error naming the path when it cannot
+void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,
+                      bool float_channels, const std::map<std::string, std::string>& metadata);
+
 // Writes OUT.exr (linear float RGB + metadata) or OUT.png (exposure-scaled, clamped,
 // sRGB, 8 bit). Other extensions throw Error.
 void write_image(const std::string& path, const Film& film,

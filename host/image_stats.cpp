@@ -16,21 +16,14 @@ void write_variance_image(const std::string& path, const Film& film,
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext != ".exr") throw Error("--variance must name an .exr file (the variance is linear float data): " + path);
-  OIIO::ImageSpec spec(film.width, film.height, 3, OIIO::TypeDesc::FLOAT);
-  for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
-  spec.attribute("candela:image", "variance_of_mean");
-  spec.attribute("Software", "candela " CANDELA_VERSION);
   std::vector<float> rgb(film.pixels() * 3);
   for (size_t i = 0; i < film.pixels(); ++i) {
     glm::vec3 v = film.variance_of_mean(i);
     for (int c = 0; c < 3; ++c) rgb[3 * i + c] = v[c];
   }
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error("cannot write " + path + ": " + OIIO::geterror());
-  if (!out->open(path, spec)) throw Error("cannot write " + path + ": " + out->geterror());
-  bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
-  ok = out->close() && ok;
-  if (!ok) throw Error("cannot write " + path + ": " + out->geterror());
+  std::map<std::string, std::string> meta = metadata;
+  meta["image"] = "variance_of_mean";
+  write_rgb_pixels(path, film.width, film.height, rgb, true, meta);
 }
 
 RgbImage read_rgb_image(const std::string& path, const std::string& what) {

@@ -22,11 +22,8 @@ RenderResult render_scene(const DeviceEntry& device, const std::string& scene_fi
   settings.strategy = s;
   settings.max_depth = max_depth;
   settings.seed = seed;
-  Renderer r(device, scene, settings);
-  return r.render(0, spp);
+  return render_result(scene, settings, spp, device);
 }
-
-const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : "bsdf"; }
 
 using DeviceStrategy = std::tuple<std::string, Strategy>;
 
@@ -37,7 +34,7 @@ void expect_unit_radiance(const RenderResult& r, Strategy s) {
   Estimate e = image_mean(r.film);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   // (plus float rounding: albedo-1 paths have no variance left to hide it)
-  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-6) << name(s) << " SE " << e.standard_error;
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-6) << strategy_name(s) << " SE " << e.standard_error;
   EXPECT_EQ(r.film.dropped_samples(), 0u);
 }
 
@@ -70,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(Devices, FurnaceTest,
                          ::testing::Combine(::testing::Values("pocl", "rusticl"),
                                             ::testing::Values(Strategy::Nee, Strategy::Bsdf)),
                          [](const auto& info) {
-                           return std::get<0>(info.param) + "_" + name(std::get<1>(info.param));
+                           return std::get<0>(info.param) + "_" + strategy_name(std::get<1>(info.param));
                          });
 
 class CornellTest : public ::testing::TestWithParam<std::string> {};

@@ -110,7 +110,12 @@ Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t s
   settings.strategy = strategy;
   settings.max_depth = max_depth;
   settings.seed = seed;
-  return Renderer(device, scene, settings).render(0, spp).film;
+  return render_result(scene, settings, spp, device).film;
+}
+
+RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp,
+                           const DeviceEntry& device) {
+  return Renderer(device, scene, settings).render(0, spp);
 }
 
 Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,

@@ -65,6 +65,10 @@ Estimate image_mean(const Film& f);  // all pixels, channels averaged
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
 
+// A render of `scene` with `settings`, `spp` samples per pixel (sample indices [0, spp))
+RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp,
+                           const DeviceEntry& device);
+
 // A w x h render of `scene` with `spp` samples per pixel (sample indices [0, spp)) on
 // `device`; every other setting is RenderSettings' default
 Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,

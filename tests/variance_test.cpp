@@ -44,8 +44,7 @@ RenderResult render(const DeviceEntry& device, const Scene& scene, int size, uin
   s.seed = seed;
   s.max_depth = max_depth;
   s.sampler = sampler;
-  Renderer r(device, scene, s);
-  return r.render(0, spp);
+  return render_result(scene, s, spp, device);
 }
 
 // A camera facing a large emissive quad that fills its view: every sample of every pixel
