@@ -195,13 +195,8 @@ struct EnergyRig {
     std::vector<cl_float4> w = per_sample("test_energy_albedo", m, with_table, wo, seed, n, 1);
     std::array<Mean, 3> a;
     for (int c = 0; c < 3; ++c) {
-      double sum = 0.0, sum2 = 0.0;
-      for (const cl_float4& v : w) {
-        sum += v.s[c];
-        sum2 += double(v.s[c]) * v.s[c];
-      }
-      double mean = sum / double(n);
-      a[c] = {mean, std::sqrt(std::max(sum2 / double(n) - mean * mean, 0.0) / double(n))};
+      Estimate e = sample_mean(w, c);
+      a[c] = {e.mean, e.standard_error};
     }
     return a;
   }

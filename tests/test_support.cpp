@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -73,6 +74,17 @@ Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1) {
       ++n;
     }
   return {sum / n, std::sqrt(var) / n};
+}
+
+Estimate sample_mean(const std::vector<cl_float4>& samples, int c) {
+  double sum = 0.0, sum2 = 0.0;
+  for (const cl_float4& x : samples) {
+    sum += x.s[c];
+    sum2 += double(x.s[c]) * x.s[c];
+  }
+  double n = double(samples.size());
+  double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
 }
 
 Estimate image_mean(const Film& f) {

@@ -62,6 +62,8 @@ struct Estimate {
 };
 Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1);  // channel c
 Estimate image_mean(const Film& f);  // all pixels, channels averaged
+// The mean of component c of a kernel's samples, with its standard error
+Estimate sample_mean(const std::vector<cl_float4>& samples, int c);
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
 

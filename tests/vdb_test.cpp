@@ -142,13 +142,8 @@ std::vector<std::pair<double, double>> transmittance(KernelRig& rig, const Scene
   rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
   std::vector<std::pair<double, double>> r;
   for (int ch = 0; ch < 3; ++ch) {
-    double sum = 0.0, sum2 = 0.0;
-    for (const cl_float4& x : v) {
-      sum += x.s[ch];
-      sum2 += double(x.s[ch]) * x.s[ch];
-    }
-    double mean = sum / n;
-    r.push_back({mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)});
+    Estimate e = sample_mean(v, ch);
+    r.push_back({e.mean, e.standard_error});
   }
   EXPECT_EQ(v[0].s[3], 1.0f) << "the origin lies inside the box's medium";
   return r;

@@ -614,12 +614,7 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
     // integral of density along the ray (linear in t): trapezoid is exact
     double integral = 0.5 * (density_at(c.org.x) + density_at(c.org.x + t1 * c.dir.x)) * t1;
     for (int ch = 0; ch < 3; ++ch) {
-      double sum = 0.0, sum2 = 0.0;
-      for (const cl_float4& x : v) {
-        sum += x.s[ch];
-        sum2 += double(x.s[ch]) * x.s[ch];
-      }
-      double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+      auto [mean, se] = sample_mean(v, ch);
       double want = std::exp(-double(sigma_t[ch]) * integral);
       EXPECT_NEAR(mean, want, 5.0 * se + 1e-6) << "channel " << ch << " SE " << se;
     }
@@ -662,12 +657,7 @@ TEST(VolumeGrid, EmissionGridKeepsTransmittance) {
   std::vector<cl_float4> v(n);
   rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
   for (int ch = 0; ch < 3; ++ch) {
-    double sum = 0.0, sum2 = 0.0;
-    for (const cl_float4& x : v) {
-      sum += x.s[ch];
-      sum2 += double(x.s[ch]) * x.s[ch];
-    }
-    double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+    auto [mean, se] = sample_mean(v, ch);
     double want = std::exp(-double(kSigmaA[ch]) * density * d);
     EXPECT_NEAR(mean, want, 5.0 * se + 1e-6) << "channel " << ch << " SE " << se;
   }
