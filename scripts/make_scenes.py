@@ -659,7 +659,7 @@ def read_hdr(path):
 
 
 def env_direction(u, v):
-    """Direction of map coordinates (u, v) at rotation 0 (cl/environment.cl): theta
+    """Direction of map coordinates (u, v) at rotation 0 (cl/lights/environment.cl): theta
     from +Y down the rows, the image centre along -Z, u = 3/4 along +X."""
     theta, phi = math.pi * v, 2.0 * math.pi * u
     return (-math.sin(theta) * math.sin(phi), math.cos(theta), math.sin(theta) * math.cos(phi))

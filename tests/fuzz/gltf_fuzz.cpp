@@ -10,10 +10,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "bvh_builder.hpp"
-#include "error.hpp"
-#include "gltf_loader.hpp"
-#include "scene_compiler.hpp"
+#include "compile/bvh_builder.hpp"
+#include "base/error.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "compile/scene_compiler.hpp"
 
 namespace {
 

@@ -1,0 +1,261 @@
+// Megakernel path tracer: one work-item per pixel traces `sample_count` whole paths, each
+// from a point drawn with the pixel filter's density (filter.cl), and folds them into the
+// film with Welford's running mean and squared deviations.
+// Strategies (no MIS, each light path counted exactly once):
+//   STRATEGY_NEE:  emission counted on camera rays and after delta lobes; all other light
+//                  arrives through shadow rays to sampled lights (skipped at delta lobes)
+//   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
+//                  punctual lights, which no ray can hit, contribute nothing)
+//   STRATEGY_AUTO: per vertex. A BSDF without a diffuse lobe whose every microfacet lobe
+//                  has alpha <= AUTO_BSDF_ALPHA gathers direct light by its sampled ray
+//                  (emission counted at the next hit, like bsdf); every other vertex by
+//                  a light sample (like nee). Delta lights, which no sampled ray can
+//                  find, are light-sampled at every vertex under nee and auto.
+// A vertex's choice decides, for the ray it samples, whether the emission that ray finds
+// counts: it counts exactly when the vertex did not take that light by a light sample.
+// Participating media (CD_FEATURE_MEDIA, cl/media/media.cl): a medium step after each closest
+// hit adds the medium's emission along the segment (under both strategies: media are not
+// lights) and may scatter the path there, a vertex like a surface one with the phase
+// function as its BSDF; null boundaries are passed without a bounce; shadow rays carry the
+// transmittance of the media they cross.
+
+// Near-specular threshold of STRATEGY_AUTO (alpha = glTF roughness^2): below it BSDF
+// sampling has the lower error on area and environment lights (measured on
+// scenes/lights/veach.gltf, see README "Strategies")
+#ifndef AUTO_BSDF_ALPHA
+#define AUTO_BSDF_ALPHA 0.01f
+#endif
+
+// Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
+typedef struct {
+  Ray ray;
+  float3 beta;  // throughput
+  float3 radiance;  // light gathered so far
+  uint depth;  // scattering events so far
+  bool specular_bounce;  // emission the ray finds counts: the camera ray, a delta lobe's
+                         // ray, or one from a vertex that took no light sample
+  float eta_scale;  // product of eta^2 over transmissions, so roulette sees radiance scale
+  int medium;  // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
+  MediumStack media;  // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+} PathState;
+
+PathState path_start(const SceneData* sc, Ray ray) {
+  PathState ps;
+  ps.ray = ray;
+  ps.beta = (float3)(1.0f);
+  ps.radiance = (float3)(0.0f);
+  ps.depth = 0u;
+  ps.specular_bounce = true;  // the camera sees emitters directly
+  ps.eta_scale = 1.0f;
+  ps.medium = NO_MEDIUM;
+#if CD_FEATURE_MEDIA
+  ps.media = media_at_origin(sc, ray);
+  ps.medium = media_current(&ps.media);
+#endif
+  return ps;
+}
+
+// Fraction of a light sample's radiance that reaches ctx.p: 0 or 1 (blocked or not), and with
+// CD_FEATURE_MEDIA the transmittance of the media on the way (starting in `media`). The
+// shadow ray leaves from the side of the surface that wi leaves from.
+float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const LightSample* ls,
+                       const MediumStack* media, Rng* rng) {
+  Ray shadow;
+  shadow.org = offset_ray_origin(ctx->p, dot(ls->wi, ctx->n) >= 0.0f ? ctx->n : -ctx->n);
+  float tmax = INFINITY;
+  shadow.dir = ls->wi;
+  if (!ls->at_infinity) {
+    float3 d = ls->target - shadow.org;
+    tmax = length(d);
+    if (!(tmax > 0.0f)) return (float3)(0.0f);
+    shadow.dir = d / tmax;
+  }
+#if CD_FEATURE_MEDIA
+  return media_shadow_transmittance(sc, shadow, tmax, *media, rng);
+#else
+  return scene_occluded(sc, shadow, tmax) ? (float3)(0.0f) : (float3)(1.0f);
+#endif
+}
+
+// Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
+// `delta_only`, of the delta lights alone (the others then count when a sampled ray finds
+// them: a sample of another light contributes nothing here). `media`: the media on wo's
+// side; a shadow ray through the surface enters (or leaves) `interior`, the medium inside
+// the surface.
+float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
+                         float3 wo, bool delta_only, const MediumStack* media, int interior, Rng* rng) {
+  uint x_select = rng_next_uint(rng);
+  float2 u = rng_next_2d(rng);
+  LightSample ls;
+  if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
+  if (delta_only && !ls.is_delta) return (float3)(0.0f);
+  float3 f = bsdf_eval(bsdf, wo, ls.wi);
+  float cos_i = fabs(dot(ls.wi, ctx->ns));
+  float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
+  if (max_component(contrib) <= 0.0f) return (float3)(0.0f);
+#if CD_FEATURE_MEDIA
+  MediumStack st = *media;
+  if (dot(ls.wi, ctx->n) < 0.0f) media_cross(&st, interior, bsdf->entering);
+  return contrib * path_shadow_ray(sc, ctx, &ls, &st, rng);
+#else
+  return contrib * path_shadow_ray(sc, ctx, &ls, media, rng);
+#endif
+}
+
+// Russian roulette on throughput x eta_scale (pbrt-v4's rule): a path whose throughput
+// is below 1 survives with that probability; one at or above 1 always survives, so paths
+// that carry all their energy (white walls, glass) are not cut short. False: path ends.
+bool path_survives_roulette(PathState* ps, uint rr_depth, Rng* rng) {
+  if (ps->depth + 1u < rr_depth) return true;
+  float q = max_component(ps->beta) * ps->eta_scale;
+  if (q >= 1.0f) return true;
+  if (rng_next(rng) >= q) return false;
+  ps->beta /= q;
+  return true;
+}
+
+#if CD_FEATURE_MEDIA
+// Next-event estimate at a point p in a medium of phase asymmetry g, toward wo
+float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 wo, const MediumStack* media,
+                                Rng* rng) {
+  LightSampleContext ctx;
+  ctx.p = p;
+  ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
+  ctx.transmits = true;
+  uint x_select = rng_next_uint(rng);
+  float2 u = rng_next_2d(rng);
+  LightSample ls;
+  if (!lights_sample(sc, &ctx, x_select, u, &ls)) return (float3)(0.0f);
+  float3 contrib = ls.radiance * (phase_eval(g, wo, ls.wi) / ls.pdf);
+  if (max_component(contrib) <= 0.0f) return (float3)(0.0f);
+  return contrib * path_shadow_ray(sc, &ctx, &ls, media, rng);
+}
+
+// The medium step of a path segment that ends at a surface at tmax (INFINITY: it escapes):
+// the medium's emission along it, then the free flight (cl/media/media.cl). MEDIUM_PASSED: the
+// path goes on to the surface. MEDIUM_SCATTERED: it scattered in the medium, and this did
+// that vertex's work (light sampling with the phase function unless `nee` is false, a new
+// direction sampled from it, Russian roulette). MEDIUM_ABSORBED: the path ends.
+int path_medium_step(const SceneData* sc, PathState* ps, float tmax, bool nee, Rng* rng) {
+  float3 p;
+  int event = media_sample_segment(sc, ps->medium, ps->ray, tmax, rng, &ps->beta, &ps->radiance, &p);
+  if (event != MEDIUM_SCATTERED) return event;
+  if (ps->depth >= sc->params->max_depth) return MEDIUM_ABSORBED;
+  float g = sc->media[ps->medium].g;
+  float3 wo = -ps->ray.dir;
+  if (nee) ps->radiance += ps->beta * path_medium_direct_light(sc, p, g, wo, &ps->media, rng);
+  float2 u = rng_next_2d(rng);
+  float pdf;
+  float3 wi = phase_sample(g, wo, u, &pdf);  // exact sampling: the weight f / pdf is 1
+  ps->specular_bounce = !nee;  // emission found next counts unless light sampling took it
+  if (!path_survives_roulette(ps, sc->params->rr_depth, rng)) return MEDIUM_ABSORBED;
+  ps->ray.org = p;
+  ps->ray.dir = wi;
+  return MEDIUM_SCATTERED;
+}
+
+// The ray crosses the boundary of `material` at s (by transmission or a null boundary)
+void path_cross_boundary(const SceneData* sc, PathState* ps, const SurfaceHit* s) {
+  media_cross(&ps->media, sc->materials[s->material].medium, s->front);
+  ps->medium = media_current(&ps->media);
+}
+#endif
+
+// Radiance along one camera ray
+float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
+  __global const RenderParams* params = sc->params;
+  const uint strategy = params->strategy;
+  PathState ps = path_start(sc, camera_ray);
+  for (;; ++ps.depth) {
+    Hit hit = scene_intersect(sc, ps.ray, INFINITY);
+#if CD_FEATURE_MEDIA
+    // Medium step: emission and free flight up to the surface; scattering in the medium
+    // (the phase function is never near-specular: auto light-samples there, like nee)
+    int event = path_medium_step(sc, &ps, hit.prim < 0 ? INFINITY : hit.t, strategy != STRATEGY_BSDF, rng);
+    if (event == MEDIUM_ABSORBED) break;
+    if (event == MEDIUM_SCATTERED) continue;
+#endif
+    bool counts_emission = ps.specular_bounce;
+    if (hit.prim < 0) {
+      if (counts_emission) ps.radiance += ps.beta * lights_environment_radiance(sc, ps.ray.dir);
+      break;
+    }
+    SurfaceHit s = surface_at(sc, (uint)hit.prim, hit.b1, hit.b2, ps.ray.dir);
+#if CD_FEATURE_MEDIA
+    // A null boundary only changes the medium: the ray goes straight on, and no bounce counts
+    if (media_is_null_boundary(sc, s.material)) {
+      path_cross_boundary(sc, &ps, &s);
+      ps.ray.org = offset_ray_origin(s.p, -s.ng);
+      --ps.depth;  // the loop's ++ undoes it
+      continue;
+    }
+#endif
+    if (counts_emission)
+      ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
+    if (ps.depth >= params->max_depth) break;
+
+    float3 wo = -ps.ray.dir;
+    Bsdf bsdf = bsdf_at(sc, &s);
+    bsdf_face_wo(&bsdf, wo);  // no black fringes where shading normals tilt away from wo
+    uint flags = bsdf_flags(&bsdf);
+    // Light sampling, except at lobes that are all delta (no light sample can find them)
+    // and where the strategy leaves area and environment lights to the sampled ray
+    bool samples_lights = strategy != STRATEGY_BSDF && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u;
+    bool near_specular = strategy == STRATEGY_AUTO && (flags & BSDF_DIFFUSE) == 0u &&
+                         bsdf_widest_alpha(&bsdf) <= AUTO_BSDF_ALPHA;
+    if (samples_lights) {
+      LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, near_specular, &ps.media,
+                                                 sc->materials[s.material].medium, rng);
+    }
+
+    // Continue the path by sampling the BSDF
+    float uc = rng_next(rng);
+    float2 u = rng_next_2d(rng);
+    BsdfSample bs;
+    if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
+    ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
+    ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u || !samples_lights || near_specular;
+    if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
+    if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
+    ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);
+    ps.ray.dir = bs.wi;
+#if CD_FEATURE_MEDIA
+    if (bs.flags & BSDF_TRANSMISSION) path_cross_boundary(sc, &ps, &s);
+#endif
+  }
+  return ps.radiance;
+}
+
+__kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
+                           __global float4* film_mean, __global float4* film_m2) {
+  uint pixel = params->pixel_begin + (uint)get_global_id(0);
+  if (pixel >= params->pixel_end) return;
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
+  uint px = pixel % params->width, py = pixel / params->width;
+
+  // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones
+  float4 mean = film_mean[pixel];
+  float4 m2 = film_m2[pixel];
+  for (uint k = 0u; k < params->sample_count; ++k) {
+    Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
+    float jx = rng_next(&rng), jy = rng_next(&rng);
+    float2 film = filter_sample(params->filter, jx, jy);
+    float2 lens = (float2)(0.0f);
+    if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(&rng), rng_next(&rng));
+    Ray ray = camera_ray(params, (float)px + film.x, (float)py + film.y, lens);
+    float3 l = path_trace(&sc, ray, &rng);
+    if (!all_finite(l)) {
+      m2.w += 1.0f;
+      continue;
+    }
+    float n = mean.w + 1.0f;
+    float3 delta = l - mean.xyz;
+    float3 new_mean = mean.xyz + delta / n;
+    m2.xyz += delta * (l - new_mean);
+    mean = (float4)(new_mean, n);
+  }
+  film_mean[pixel] = mean;
+  film_m2[pixel] = m2;
+}

@@ -1,0 +1,32 @@
+# The renderer's OpenCL program: every kernel source in program order (each file may use
+# what the files before it define; shared/device_types.h comes first). A new .cl file is
+# added here, in the folder of its subsystem.
+set(CANDELA_CL_SOURCES
+  cl/shared/device_types.h
+  cl/shared/color.h
+  cl/core/rng.cl
+  cl/core/sampling.cl
+  cl/core/geometry.cl
+  cl/accel/intersect.cl
+  cl/accel/bvh_traverse.cl
+  cl/scene/scene_data.cl
+  cl/scene/textures.cl
+  cl/camera/filter.cl
+  cl/camera/camera.cl
+  cl/scene/surface.cl
+  cl/scene/alpha.cl
+  cl/bsdf/fresnel.cl
+  cl/bsdf/microfacet.cl
+  cl/bsdf/energy.cl
+  cl/bsdf/bsdf_common.cl
+  cl/bsdf/bsdf_diffuse.cl
+  cl/bsdf/bsdf_conductor.cl
+  cl/bsdf/bsdf_dielectric.cl
+  cl/bsdf/bsdf_gltf.cl
+  cl/bsdf/bsdf.cl
+  cl/lights/environment.cl
+  cl/lights/lights.cl
+  cl/media/phase.cl
+  cl/media/nanovdb.cl
+  cl/media/media.cl
+  cl/integrator/integrator_path.cl)

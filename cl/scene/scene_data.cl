@@ -1,0 +1,29 @@
+// The scene as kernel code sees it: every buffer of CD_SCENE_BUFFERS (device_types.h) in
+// one struct, and geometry looked up by stable primitive index.
+
+#define CD_SCENE_FIELD(type, name) __global const type* name;
+#define CD_SCENE_PARAM(type, name) __global const type* name,
+#define CD_SCENE_INIT(type, name) name,
+
+typedef struct SceneData {
+  CD_SCENE_BUFFERS(CD_SCENE_FIELD)
+  __global const RenderParams* params;
+} SceneData;
+
+// Closest hit along the ray in (0, tmax), by stable primitive index, skipping hits that
+// alpha lets through (cut-outs, BLEND's stochastic passes: cl/scene/alpha.cl)
+Hit scene_intersect(const SceneData* sc, Ray ray, float tmax) {
+  return bvh_intersect(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax, false);
+}
+
+// Anything in (0, tmax) along the ray, by the same alpha tests?
+bool scene_occluded(const SceneData* sc, Ray ray, float tmax) {
+  return bvh_occluded(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax);
+}
+
+void scene_prim_positions(const SceneData* sc, uint prim, float3* p0, float3* p1, float3* p2) {
+  __global const Prim* pr = &sc->prims[prim];
+  *p0 = vload3(pr->v[0], sc->positions);
+  *p1 = vload3(pr->v[1], sc->positions);
+  *p2 = vload3(pr->v[2], sc->positions);
+}

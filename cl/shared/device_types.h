@@ -1,0 +1,339 @@
+// Structs that cross between host and device, defined once.
+// Included by the OpenCL program (first in the source list) and by the host inside
+// namespace candela::dev (host/device_types.hpp), which static_asserts every layout from
+// CD_LAYOUT below; the device-side layout test checks the same list on each device.
+// Only 4-byte scalars and arrays of them: no float3, no vector types, explicit padding.
+
+#ifndef CANDELA_DEVICE_TYPES_H
+#define CANDELA_DEVICE_TYPES_H
+
+// Material types (switch-dispatched in bsdf.cl)
+#define MATERIAL_DIFFUSE 0u  // Lambertian, albedo = base color
+#define MATERIAL_GLTF 1u  // glTF metallic-roughness with its KHR_materials_* extensions
+#define MATERIAL_CONDUCTOR 2u  // measured conductor: complex index eta + i k, GGX roughness
+
+// Material flags
+#define MATERIAL_DOUBLE_SIDED 1u
+#define MATERIAL_THIN_WALLED 2u  // transmission through a sheet (no KHR_materials_volume)
+#define MATERIAL_ALPHA_MASK 4u  // alphaMode MASK: cut out below alpha_cutoff
+#define MATERIAL_ALPHA_BLEND 8u  // alphaMode BLEND: stochastic opacity
+#define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
+
+// Texture slots of a material (Material.textures)
+#define TEX_BASE_COLOR 0
+#define TEX_METALLIC_ROUGHNESS 1  // B metallic, G roughness
+#define TEX_NORMAL 2
+#define TEX_EMISSION 3
+#define TEX_TRANSMISSION 4  // R
+#define TEX_SPECULAR 5  // A
+#define TEX_SPECULAR_COLOR 6  // RGB
+#define TEX_CLEARCOAT 7  // R
+#define TEX_CLEARCOAT_ROUGHNESS 8  // G
+#define TEX_ANISOTROPY 9  // RG direction in tangent space, B strength
+#define TEX_SLOTS 10
+
+// Light types (lights.cl)
+#define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
+#define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away: constant or a map
+#define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
+#define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
+#define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
+
+// Integration strategies (no MIS: each light path is counted by exactly one of them)
+#define STRATEGY_NEE 0u
+#define STRATEGY_BSDF 1u
+#define STRATEGY_AUTO 2u  // per vertex: nee at rough or diffuse BSDFs, bsdf at near-specular ones
+
+// Camera projections (camera.cl)
+#define CAMERA_PERSPECTIVE 0u  // pinhole, or a thin lens when lens_radius > 0
+#define CAMERA_ORTHOGRAPHIC 1u  // parallel rays along forward
+
+// Pixel filters (filter.cl), importance-sampled: film samples are offset from the pixel
+// centre with the filter's density, so each pixel stays an unweighted mean
+#define FILTER_BOX 0u  // uniform over the pixel (|dx|, |dy| < 1/2)
+#define FILTER_TENT 1u  // separable tent of radius 1 pixel
+#define FILTER_GAUSSIAN 2u  // isotropic Gaussian, sigma 1/2 pixel, not truncated
+
+// Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
+// colour encoding, texel storage and filter
+#define WRAP_REPEAT 0u
+#define WRAP_CLAMP 1u
+#define WRAP_MIRROR 2u
+#define TEXTURE_SRGB 0x10000u  // RGBA8 texels hold sRGB-encoded colour (alpha linear)
+#define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
+#define TEXTURE_NEAREST 0x40000u  // nearest-texel lookup (glTF magFilter NEAREST), else bilinear
+
+// GGX albedo table (cl/bsdf/energy.cl): two halves of GGX_ALBEDO_HALF floats, E (F = 1) then E5
+// (Fresnel weight (1 - wo.h)^5, for Schlick's term); each holds the albedo at
+// GGX_ALBEDO_N x GGX_ALBEDO_N nodes (y, roughness), y fastest (y: energy.cl's coordinate
+// for mu), then its hemispherical average at GGX_ALBEDO_N roughnesses
+#define GGX_ALBEDO_N 32
+#define GGX_ALBEDO_HALF (GGX_ALBEDO_N * (GGX_ALBEDO_N + 1))
+#define GGX_ALBEDO_SIZE (2 * GGX_ALBEDO_HALF)
+#define GGX_ALBEDO_QUADRATURE 64  // quadrature points per side of each entry
+
+#define NO_TEXTURE (-1)
+#define NO_LIGHT (-1)
+#define NO_MEDIUM (-1)
+#define GLOBAL_MEDIUM 0  // media[0] fills the scene (a vacuum record when none is declared)
+
+// Medium types (media.cl)
+#define MEDIUM_HOMOGENEOUS 0u
+#define MEDIUM_GRID 1u  // coefficients scaled by a dense density grid (trilinear), delta tracking
+#define MEDIUM_NANOVDB 2u  // as MEDIUM_GRID, the density from a NanoVDB float grid (nanovdb.cl)
+
+// 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
+// bvh_traverse.cl. The four child boxes are stored by coordinate (structure of arrays) so
+// that one float4 operation tests a slab of all four: lo_x[i] .. hi_z[i] bound child i.
+// child[i]: >= 0 an inner node's index; < 0 a leaf, ~child[i] its first BvhTriangle (the
+// leaf runs to the triangle flagged BVH_TRI_LAST). Unused slots have lo = +1e30 > hi =
+// -1e30, which no ray enters, and child 0.
+typedef struct {
+  float lo_x[4];
+  float hi_x[4];  // must follow lo_x (and hi_y lo_y, hi_z lo_z): traversal picks by offset
+  float lo_y[4];
+  float hi_y[4];
+  float lo_z[4];
+  float hi_z[4];
+  int child[4];
+  int pad[4];
+} BvhNode;
+
+// Traversal stack entries: at most 3 per node on the way down (the builder's
+// depth limit keeps the tree within it)
+#define BVH_STACK_SIZE 96
+
+// A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
+#define BVH_TRI_ALPHA_TEST 1u  // hits must pass scene_alpha_passes (alphaMode MASK / BLEND)
+#define BVH_TRI_LAST 2u  // the last triangle of its leaf
+typedef struct {
+  float v0[3];
+  unsigned int prim;  // stable primitive index (Prim array)
+  float v1[3];
+  unsigned int flags;  // BVH_TRI_*
+  float v2[3];
+  unsigned int pad1;
+} BvhTriangle;
+
+// A triangle of the scene in its stable primitive order, 16 bytes: vertex indices into
+// the per-vertex arrays (positions, normals, uv0, uv1, tangents, colors) and a material.
+typedef struct {
+  unsigned int v[3];
+  unsigned int material;
+} Prim;
+
+// One texture slot of a material, 32 bytes: which texture, which TEXCOORD_n, and the
+// KHR_texture_transform applied in the kernel: uv' = (m[0] u + m[1] v + m[2],
+// m[3] u + m[4] v + m[5]).
+typedef struct {
+  int index;  // into TextureInfo, or NO_TEXTURE
+  unsigned int texcoord;  // 0 or 1
+  float m[6];
+} TextureRef;
+
+// Material, 464 bytes. Colours are linear RGB; factors multiply their texture slots.
+typedef struct {
+  unsigned int type;  // MATERIAL_*
+  unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
+  float alpha_cutoff;  // alphaMode MASK
+  float ior;  // KHR_materials_ior (1.5)
+  float base_color[4];  // rgba factor
+  float emission[4];  // rgb radiance (factor x strength), w unused
+  float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
+  float conductor_eta[4];  // MATERIAL_CONDUCTOR: eta per channel
+  float conductor_k[4];  // MATERIAL_CONDUCTOR: k per channel
+  float metallic, roughness, transmission, normal_scale;
+  float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
+  TextureRef textures[TEX_SLOTS];  // TEX_* slots
+  int medium;  // the medium inside a closed surface (into `media`), or NO_MEDIUM
+  unsigned int pad[3];
+} Material;
+
+// A texture inside one of the shared texel arrays, 16 bytes.
+typedef struct {
+  unsigned int offset;  // first texel
+  unsigned int width;
+  unsigned int height;
+  unsigned int flags;  // wrap_s | wrap_t << 8 | TEXTURE_SRGB | TEXTURE_FLOAT | TEXTURE_NEAREST
+} TextureInfo;
+
+// RGBA8 texel, 4 bytes
+typedef struct {
+  unsigned char r, g, b, a;
+} Texel8;
+
+// Float RGBA texel (HDR images, later grids), 16 bytes
+typedef struct {
+  float rgba[4];
+} TexelF;
+
+// One bin of the light-selection alias table, 8 bytes (sample_discrete_alias in
+// sampling.cl): a uniform 32-bit x picks bin b = floor(x n / 2^32); the low 32 bits of
+// x n then keep b when below `threshold`, else select `alias`.
+typedef struct {
+  unsigned int threshold;
+  unsigned int alias;
+} AliasBin;
+
+// A light, 64 bytes: a type, its selection probability, and the type's parameters.
+// Lights are selected through the alias table (light_alias, one bin per light, O(1));
+// `pmf` is exactly the probability it realizes, counted over all 2^32 integers, so the
+// estimator divides by what the kernel does.
+//   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
+//                      radiance comes from the primitive's material.
+//   LIGHT_ENVIRONMENT: without a map (params[0] = NO_TEXTURE): radiance = constant radiance.
+//                      With an equirectangular map (cl/lights/environment.cl): params[0] = its
+//                      TextureInfo index (an integer stored as float), params[1] = strength
+//                      (radiance = strength x texel), params[2] = rotation about +Y in
+//                      radians; its sampling distribution is the env_distribution buffer.
+//   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
+//                      radiance[3] = range (0: infinite), params[0..2] = position.
+//   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,
+//                      params[6] = angle scale 1 / max(0.001, cos(inner) - cos(outer)),
+//                      params[7] = angle offset -cos(outer) x scale; the intensity toward
+//                      a direction at cosine c to the axis is scaled by
+//                      clamp(c x scale + offset, 0, 1)^2 (KHR_lights_punctual).
+//   LIGHT_DIRECTIONAL: radiance = colour x intensity (irradiance at normal incidence),
+//                      params[3..5] = unit direction the light travels.
+typedef struct {
+  unsigned int type;  // LIGHT_*
+  float pmf;
+  unsigned int index;
+  unsigned int pad0;
+  float radiance[4];  // rgb
+  float params[8];  // per-type parameters, see above
+} Light;
+
+// A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
+// RGB at density 1; MEDIUM_GRID and MEDIUM_NANOVDB multiply them by the density at the point
+// (grid value x density_scale). `emission` is radiance emitted per unit length (the
+// lecture's L_e(z)). MEDIUM_NANOVDB uses the grid fields differently: grid_offset is the
+// grid's first word in `nanovdb`, grid_size is unused, and grid_min/grid_max are the box in
+// the grid's index space that the majorant cells split (the active voxels and one voxel
+// around them); rays are mapped to index space once per segment (the map is affine, so the
+// ray parameter t is the same in both spaces).
+typedef struct {
+  float sigma_a[4];  // absorption, rgb (w unused)
+  float sigma_s[4];  // scattering, rgb
+  float emission[3];  // emitted radiance per unit length, rgb
+  unsigned int emission_grid;  // 0: emission x density; else the media record (a MEDIUM_GRID,
+                               // density_scale = emission_scale, no majorant) whose grid
+                               // scales emission in place of the density
+  float g;  // Henyey-Greenstein asymmetry, in (-1, 1)
+  unsigned int type;  // MEDIUM_*
+  float density_scale;  // MEDIUM_GRID: density = scale x grid value
+  float majorant;  // MEDIUM_GRID: bound of density x max channel of sigma_t over the box
+  unsigned int grid_offset;  // MEDIUM_GRID: first value in `densities`, x fastest, then y, z
+  unsigned int grid_size[3];  // MEDIUM_GRID: nodes along x, y, z (each >= 2)
+  float grid_min[4];  // MEDIUM_GRID: the box the nodes span (w unused); density 0 outside
+  float grid_max[4];
+  unsigned int majorant_offset;  // MEDIUM_GRID: first majorant cell in `densities`
+  unsigned int majorant_size[3];  // MEDIUM_GRID: cells along x, y, z splitting the box evenly;
+                                  // each holds a bound of sigma_t over its part of the box
+} Medium;
+
+// Camera, 64 bytes. Pixel (x, y) in [-1, 1]^2 (x right, y up) maps to
+//   CAMERA_PERSPECTIVE:  direction forward + x right + y up from origin, with right and
+//                        up scaled by tan(xfov/2) and tan(yfov/2). A thin lens
+//                        (lens_radius > 0) starts the ray at a uniform point of the lens
+//                        disk around origin and aims it at the point where the pinhole ray
+//                        crosses the focus plane, focus_distance along forward.
+//   CAMERA_ORTHOGRAPHIC: direction forward from origin + x right + y up, with right and
+//                        up scaled by the half-width and half-height of the view (xmag, ymag).
+typedef struct {
+  float origin[3];
+  unsigned int type;  // CAMERA_*
+  float forward[3];  // unit
+  float lens_radius;  // thin-lens aperture radius in scene units; 0 = pinhole
+  float right[3];
+  float focus_distance;  // thin lens: distance of the sharp plane along forward
+  float up[3];
+  float pad0;
+} Camera;
+
+// Everything one launch needs besides buffers, 120 bytes.
+typedef struct {
+  Camera camera;
+  unsigned int width;
+  unsigned int height;
+  unsigned int seed;
+  unsigned int max_depth;  // scattering events; 0 = emission seen directly only
+  unsigned int strategy;  // STRATEGY_*
+  unsigned int num_lights;
+  int environment_light;  // index of the LIGHT_ENVIRONMENT light, or NO_LIGHT
+  unsigned int rr_depth;  // Russian roulette starts after this many bounces
+  unsigned int sample_begin;  // first sample index of this launch
+  unsigned int sample_count;  // samples per pixel in this launch
+  unsigned int pixel_begin;  // first pixel of this launch (row-major)
+  unsigned int pixel_end;  // one past the last pixel of this launch
+  unsigned int energy_compensation;  // 1: multiple-scattering compensation of GGX lobes (energy.cl)
+  unsigned int filter;  // FILTER_*: the density of film sample offsets (filter.cl)
+} RenderParams;
+
+// Every scene buffer, in kernel-argument order: X(element type, name). This one list
+// generates the kernel's parameters and SceneData (cl/scene/scene_data.cl) and the host's
+// SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
+// Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
+// vertex; an array the scene does not need holds one dummy element. nanovdb holds the NanoVDB
+// grids of MEDIUM_NANOVDB media, each a NanoVDB buffer starting on a 32-byte boundary. env_distribution holds
+// the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. ggx_albedo is no part
+// of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
+#define CD_SCENE_BUFFERS(X)  \
+  X(BvhNode, bvh_nodes)      \
+  X(BvhTriangle, bvh_tris)   \
+  X(Prim, prims)             \
+  X(float, positions)        \
+  X(float, normals)          \
+  X(float, uv0)              \
+  X(float, uv1)              \
+  X(float, tangents)         \
+  X(float, colors)           \
+  X(Material, materials)     \
+  X(TextureInfo, textures)   \
+  X(Texel8, texels8)         \
+  X(TexelF, texelsf)         \
+  X(float, srgb_to_linear)   \
+  X(Light, lights)           \
+  X(AliasBin, light_alias)  \
+  X(float, env_distribution) \
+  X(Medium, media)           \
+  X(float, densities)        \
+  X(unsigned int, nanovdb)   \
+  X(float, ggx_albedo)
+
+// Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
+// FIELD(type, field, offset). The host static_asserts these; tests/cl checks them on
+// each device.
+#define CD_LAYOUT(SIZE, FIELD)                                                              \
+  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32)                      \
+  FIELD(BvhNode, hi_y, 48) FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80)                \
+  FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)                                        \
+  SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16)             \
+  FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
+  SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
+  SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
+  SIZE(Material, 464) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \
+  FIELD(Material, emission, 32) FIELD(Material, specular_color, 48)                         \
+  FIELD(Material, conductor_k, 80) FIELD(Material, metallic, 96)                            \
+  FIELD(Material, clearcoat, 112) FIELD(Material, anisotropy_rotation, 124)                 \
+  FIELD(Material, textures, 128) FIELD(Material, medium, 448)                               \
+  SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
+  SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
+  SIZE(TexelF, 16)                                                                          \
+  SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
+  SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
+  FIELD(Light, params, 32)                                                                  \
+  SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
+  FIELD(Medium, emission_grid, 44)                                                          \
+  FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68) FIELD(Medium, grid_min, 80)       \
+  FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)                           \
+  FIELD(Medium, majorant_size, 116)                                                         \
+  SIZE(Camera, 64) FIELD(Camera, type, 12) FIELD(Camera, forward, 16)                      \
+  FIELD(Camera, lens_radius, 28) FIELD(Camera, right, 32) FIELD(Camera, focus_distance, 44) \
+  FIELD(Camera, up, 48) FIELD(Camera, pad0, 60)                                             \
+  SIZE(RenderParams, 120) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
+  FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \
+  FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)                 \
+  FIELD(RenderParams, energy_compensation, 112) FIELD(RenderParams, filter, 116)
+
+#endif  // CANDELA_DEVICE_TYPES_H

@@ -1,0 +1,183 @@
+#include "app/merge.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "base/error.hpp"
+#include "render/film.hpp"
+#include "render/image_stats.hpp"
+
+namespace candela {
+
+namespace {
+
+// Metadata that must agree: the inputs are then samples of the same estimator. (Camera
+// and lighting overrides on the command line are not recorded: keep them the same.)
+const char* const kMustMatch[] = {"scene", "seed", "strategy", "max_depth", "energy_compensation", "filter"};
+
+bool ends_with_exr(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".exr";
+}
+
+uint64_t parse_count(const std::string& path, const std::string& key, const std::string& text) {
+  size_t used = 0;
+  unsigned long long v = 0;
+  try {
+    v = std::stoull(text, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || text[0] == '-')
+    throw Error("cannot merge: " + path + " has a malformed candela:" + key + " '" + text + "'");
+  return v;
+}
+
+SampleRanges ranges_of(const RgbImage& img, const std::string& path, uint64_t spp) {
+  SampleRanges out;
+  auto it = img.metadata.find("sample_ranges");
+  if (it != img.metadata.end()) {
+    std::string text = it->second;
+    size_t pos = 0;
+    uint64_t total = 0;
+    while (pos <= text.size()) {
+      size_t comma = text.find(',', pos);
+      std::string item = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+      size_t colon = item.find(':');
+      if (colon == std::string::npos)
+        throw Error("cannot merge: " + path + " has a malformed candela:sample_ranges '" + text + "'");
+      uint64_t b = parse_count(path, "sample_ranges", item.substr(0, colon));
+      uint64_t e = parse_count(path, "sample_ranges", item.substr(colon + 1));
+      if (e <= b) throw Error("cannot merge: " + path + " has a malformed candela:sample_ranges '" + text + "'");
+      out.emplace_back(b, e);
+      total += e - b;
+      if (comma == std::string::npos) break;
+      pos = comma + 1;
+    }
+    if (total != spp)
+      throw Error("cannot merge: " + path + ": candela:sample_ranges holds " + std::to_string(total) +
+                  " samples, candela:spp says " + std::to_string(spp));
+    return out;
+  }
+  uint64_t offset = 0;
+  if (auto o = img.metadata.find("sample_offset"); o != img.metadata.end())
+    offset = parse_count(path, "sample_offset", o->second);
+  out.emplace_back(offset, offset + spp);
+  return out;
+}
+
+std::string format_range(const std::pair<uint64_t, uint64_t>& r) {
+  return "[" + std::to_string(r.first) + ", " + std::to_string(r.second) + ")";
+}
+
+}  // namespace
+
+int run_merge(const MergeArgs& args) {
+  if (args.inputs.size() < 2) throw Error("merge needs at least two input images");
+  if (!ends_with_exr(args.output)) throw Error("merge writes an .exr (linear float with metadata): " + args.output);
+
+  struct Input {
+    std::string path;
+    RgbImage img;
+    uint64_t spp;
+    SampleRanges ranges;
+  };
+  std::vector<Input> in;
+  for (const auto& path : args.inputs) {
+    if (!ends_with_exr(path)) throw Error("cannot merge " + path + ": merge reads .exr images written by candela render");
+    Input x{path, read_rgb_image(path, "image"), 0, {}};
+    if (!x.img.metadata.count("spp"))
+      throw Error("cannot merge " + path + ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
+    if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
+      throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
+    x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
+    if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no samples (candela:spp 0)");
+    x.ranges = ranges_of(x.img, path, x.spp);
+    in.push_back(std::move(x));
+  }
+
+  const Input& first = in.front();
+  for (size_t i = 1; i < in.size(); ++i) {
+    const Input& x = in[i];
+    if (x.img.width != first.img.width || x.img.height != first.img.height)
+      throw Error("cannot merge: " + x.path + " is " + std::to_string(x.img.width) + "x" + std::to_string(x.img.height) +
+                  ", " + first.path + " is " + std::to_string(first.img.width) + "x" + std::to_string(first.img.height));
+    for (const char* key : kMustMatch) {
+      auto a = first.img.metadata.find(key), b = x.img.metadata.find(key);
+      std::string va = a == first.img.metadata.end() ? "(none)" : a->second;
+      std::string vb = b == x.img.metadata.end() ? "(none)" : b->second;
+      if (va != vb)
+        throw Error("cannot merge: different " + std::string(key) + ": " + first.path + " has '" + va + "', " + x.path +
+                    " has '" + vb + "'");
+    }
+  }
+
+  // Disjoint sample ranges: sort all of them and compare neighbours
+  std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>> all;
+  for (size_t i = 0; i < in.size(); ++i)
+    for (const auto& r : in[i].ranges) all.push_back({r, i});
+  std::sort(all.begin(), all.end());
+  for (size_t k = 1; k < all.size(); ++k)
+    if (all[k].first.first < all[k - 1].first.second)
+      throw Error("cannot merge: overlapping sample ranges: " + in[all[k - 1].second].path + " holds " +
+                  format_range(all[k - 1].first) + ", " + in[all[k].second].path + " holds " + format_range(all[k].first) +
+                  " (give each shard its own --sample-offset)");
+
+  // Weighted mean per pixel, in double
+  uint64_t total = 0;
+  for (const auto& x : in) total += x.spp;
+  if (total > (uint64_t(1) << 32)) throw Error("cannot merge: more than 2^32 samples per pixel");
+  Film film(first.img.width, first.img.height);
+  for (size_t p = 0; p < film.pixels(); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (const auto& x : in) sum += double(x.spp) * x.img.rgb[3 * p + c];
+      film.mean[4 * p + c] = float(sum / double(total));
+    }
+    film.mean[4 * p + 3] = float(total);
+  }
+
+  // Metadata: the first input's, with the merged counts and ranges (coalesced)
+  std::map<std::string, std::string> meta = first.img.metadata;
+  SampleRanges merged;
+  for (const auto& [r, i] : all) {
+    if (!merged.empty() && merged.back().second == r.first)
+      merged.back().second = r.second;
+    else
+      merged.push_back(r);
+  }
+  std::string ranges_text;
+  for (const auto& r : merged) ranges_text += (ranges_text.empty() ? "" : ",") + std::to_string(r.first) + ":" + std::to_string(r.second);
+  double seconds = 0.0;
+  uint64_t dropped = 0;
+  std::vector<std::string> devices;
+  for (const auto& x : in) {
+    if (auto it = x.img.metadata.find("seconds"); it != x.img.metadata.end()) seconds += std::atof(it->second.c_str());
+    if (auto it = x.img.metadata.find("dropped_samples"); it != x.img.metadata.end())
+      dropped += std::strtoull(it->second.c_str(), nullptr, 10);
+    if (auto it = x.img.metadata.find("device"); it != x.img.metadata.end() &&
+                                                 std::find(devices.begin(), devices.end(), it->second) == devices.end())
+      devices.push_back(it->second);
+  }
+  std::string device_text;
+  for (const auto& d : devices) device_text += (device_text.empty() ? "" : " + ") + d;
+  meta["spp"] = std::to_string(total);
+  meta["sample_offset"] = std::to_string(merged.front().first);
+  meta["sample_ranges"] = ranges_text;
+  meta["seconds"] = std::to_string(seconds);
+  meta["dropped_samples"] = std::to_string(dropped);
+  meta["device"] = device_text;
+  meta["merged_from"] = std::to_string(in.size());
+  write_image(args.output, film, meta);
+  std::printf("wrote %s\n", args.output.c_str());
+  if (!args.quiet)
+    std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total,
+                ranges_text.c_str());
+  return 0;
+}
+
+}  // namespace candela

@@ -1,0 +1,83 @@
+#include "app/mpi_render.hpp"
+
+#include <cstdlib>
+
+#include "base/error.hpp"
+
+#ifdef CANDELA_WITH_MPI
+#include <mpi.h>
+#endif
+
+namespace candela {
+
+void mpi_block(uint32_t spp, int rank, int size, uint32_t* begin, uint32_t* count) {
+  uint32_t n = uint32_t(size), r = uint32_t(rank);
+  uint32_t base = spp / n, extra = spp % n;
+  *count = base + (r < extra ? 1 : 0);
+  *begin = r * base + (r < extra ? r : extra);
+}
+
+#ifdef CANDELA_WITH_MPI
+
+bool mpi_built_in() { return true; }
+
+MpiSession::MpiSession() {
+  int provided = 0;
+  // Render threads never call MPI: only the main thread does
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+Film mpi_gather_films(const MpiSession& s, const Film& film, uint32_t* spp, double* seconds, bool* interrupted,
+                      bool* partial) {
+  const int n = int(film.mean.size());
+  std::vector<float> mine(2 * size_t(n));
+  std::copy(film.mean.begin(), film.mean.end(), mine.begin());
+  std::copy(film.m2.begin(), film.m2.end(), mine.begin() + n);
+  std::vector<float> all(s.rank() == 0 ? mine.size() * size_t(s.size()) : 0);
+  MPI_Gather(mine.data(), 2 * n, MPI_FLOAT, all.data(), 2 * n, MPI_FLOAT, 0, MPI_COMM_WORLD);
+  unsigned long long my_spp = *spp, total_spp = 0;
+  MPI_Reduce(&my_spp, &total_spp, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+  double longest = 0.0;
+  MPI_Reduce(seconds, &longest, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  int flags[2] = {*interrupted ? 1 : 0, *partial ? 1 : 0}, any[2] = {0, 0};
+  MPI_Reduce(flags, any, 2, MPI_INT, MPI_LOR, 0, MPI_COMM_WORLD);
+  if (s.rank() != 0) return film;
+  *spp = uint32_t(total_spp);
+  *seconds = longest;
+  *interrupted = any[0];
+  *partial = any[1];
+  Film out;
+  for (int r = 0; r < s.size(); ++r) {
+    Film f(film.width, film.height);
+    const float* src = all.data() + size_t(r) * 2 * n;
+    std::copy(src, src + n, f.mean.begin());
+    std::copy(src + n, src + 2 * n, f.m2.begin());
+    out = r == 0 ? std::move(f) : merge_films(out, f);
+  }
+  return out;
+}
+
+void mpi_abort(int code) {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::_Exit(code);
+}
+
+#else
+
+namespace {
+[[noreturn]] void no_mpi() { throw Error("--mpi: this candela was built without MPI (configure with -DCANDELA_MPI=ON)"); }
+}  // namespace
+
+bool mpi_built_in() { return false; }
+MpiSession::MpiSession() { no_mpi(); }
+MpiSession::~MpiSession() = default;
+Film mpi_gather_films(const MpiSession&, const Film&, uint32_t*, double*, bool*, bool*) { no_mpi(); }
+void mpi_abort(int code) { std::_Exit(code); }
+
+#endif
+
+}  // namespace candela

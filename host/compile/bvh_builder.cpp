@@ -1,0 +1,621 @@
+#include "compile/bvh_builder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+
+#include "scene/scene.hpp"
+
+namespace candela {
+namespace {
+
+constexpr int kBins = 16;
+constexpr int kMaxLeafSize = 8;
+constexpr float kTraversalCost = 1.0f;  // relative to one triangle test
+constexpr float kEmptyLo = 1e30f, kEmptyHi = -1e30f;  // an unused child slot's box
+// Ranges of at least this many refs bin on every thread during the serial top phase
+constexpr uint32_t kParallelBinning = 32768;
+// The top phase hands subtrees of at most max(kMinJobRefs, refs / kJobsPerTree) refs to
+// the workers: independent of the thread count, so that the tree (node order included) is
+constexpr uint32_t kMinJobRefs = 4096;
+constexpr size_t kJobsPerTree = 128;
+
+// Each 4-wide node on a path down pushes at most 3 entries, and the nodes sit two
+// binary levels apart, at binary depths 1, 3, ..., below kMaxBvhDepth
+static_assert(3 * (kMaxBvhDepth / 2) <= BVH_STACK_SIZE, "traversal stack too small for the depth limit");
+
+// Four floats in one SSE/NEON register (GCC and Clang vector extensions); lane 3 unused
+typedef float v4f __attribute__((vector_size(16)));
+typedef int32_t v4i __attribute__((vector_size(16)));
+
+inline v4f vmin(v4f a, v4f b) { return a < b ? a : b; }
+inline v4f vmax(v4f a, v4f b) { return a > b ? a : b; }
+inline v4f vec(const glm::vec3& p) { return v4f{p.x, p.y, p.z, 0.0f}; }
+inline glm::vec3 glm3(v4f v) { return glm::vec3(v[0], v[1], v[2]); }
+
+float surface_area(const Bounds& b) {
+  if (b.empty()) return 0.0f;
+  glm::vec3 d = b.hi - b.lo;
+  return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+float surface_area(v4f lo, v4f hi) {
+  if (lo[0] > hi[0]) return 0.0f;
+  v4f d = hi - lo;
+  return 2.0f * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+}
+
+// A primitive during the build, 32 bytes: its box, with the stable primitive index in the
+// low box's lane 3 (masked off before any arithmetic: as a float it is a denormal) and 0
+// in the high box's. Partitioned in place, so that binning reads memory in order.
+struct Ref {
+  v4f lo, hi;
+  uint32_t prim() const {
+    uint32_t p;
+    std::memcpy(&p, reinterpret_cast<const char*>(&lo) + 12, 4);
+    return p;
+  }
+  v4f box_lo() const { return v4f((v4i)lo & v4i{-1, -1, -1, 0}); }
+  // Twice the centroid, in lane 3 zero
+  v4f centroid2() const { return box_lo() + hi; }
+};
+
+// A range of refs with its bounds and its centroids' bounds (twice the centroids, as
+// Ref::centroid2); leaf once the SAH says so
+struct Range {
+  uint32_t begin = 0, end = 0;
+  int depth = 1;  // of the binary SAH tree
+  Bounds box, cbox;
+  bool leaf = false;
+};
+
+// 4-wide nodes of one subtree (the top of the tree, or one worker's job): child
+// references inside it are indices into `nodes`, relocated when the subtrees are joined
+struct Subtree {
+  std::vector<dev::BvhNode> nodes;
+  int depth = 1;
+};
+
+// A subtree the top phase leaves to the workers: range r (not a leaf), which becomes the
+// child in `slot` of top node `node`
+struct Job {
+  Range r;
+  uint32_t node = 0;
+  int slot = 0;
+  Subtree out;
+  int ref = 0;  // the job's root reference within out
+};
+
+struct Bins {
+  v4f lo[3][kBins], hi[3][kBins];
+  uint32_t count[3][kBins];
+  void clear(int nbins) {
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < nbins; ++i) {
+        lo[a][i] = v4f{kEmptyLo, kEmptyLo, kEmptyLo, 0.0f};
+        hi[a][i] = v4f{kEmptyHi, kEmptyHi, kEmptyHi, 0.0f};
+        count[a][i] = 0;
+      }
+  }
+  void merge(const Bins& o, int nbins) {
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < nbins; ++i) {
+        lo[a][i] = vmin(lo[a][i], o.lo[a][i]);
+        hi[a][i] = vmax(hi[a][i], o.hi[a][i]);
+        count[a][i] += o.count[a][i];
+      }
+  }
+};
+
+// The bin of each axis for a ref's doubled centroid c2 (binning and partition share it,
+// so that the bins' bounds are exactly the sides' bounds)
+struct Binner {
+  v4f lo2, scale2;
+  v4i top;
+  v4i index(v4f c2) const {
+    v4i i = __builtin_convertvector((c2 - lo2) * scale2, v4i);
+    i = i < top ? i : top;
+    return i > 0 ? i : v4i{0, 0, 0, 0};
+  }
+};
+
+class Builder {
+ public:
+  Builder(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
+          const std::vector<bool>& alpha_tested, int threads)
+      : positions_(positions), prims_(prims), alpha_tested_(alpha_tested), threads_(std::max(1, threads)) {
+    refs_.resize(prims.size());
+    parallel_for(prims.size(), [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const dev::Prim& p = prims[i];
+        v4f a = vertex(p.v[0]), b = vertex(p.v[1]), c = vertex(p.v[2]);
+        Ref& r = refs_[i];
+        r.lo = vmin(vmin(a, b), c);
+        r.hi = vmax(vmax(a, b), c);
+        uint32_t prim = uint32_t(i);
+        std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &prim, 4);
+      }
+    });
+  }
+
+  // The binary binned-SAH tree, collapsed as it is built: a 4-wide node's children are
+  // its binary node's grandchildren (or a child that is a leaf). The top of the tree is
+  // built first, down to subtrees small enough to share out; the workers build those,
+  // and their nodes follow the top's, in the top's depth-first order. The result does
+  // not depend on the thread count.
+  Bvh build() {
+    Range root;
+    root.end = uint32_t(refs_.size());
+    {
+      std::vector<std::array<v4f, 4>> part(size_t(threads_),
+                                           {vec(Bounds().lo), vec(Bounds().hi), vec(Bounds().lo), vec(Bounds().hi)});
+      parallel_for_indexed(refs_.size(), [&](int t, size_t begin, size_t end) {
+        std::array<v4f, 4>& b = part[size_t(t)];
+        for (size_t i = begin; i < end; ++i) {
+          const Ref& r = refs_[i];
+          b[0] = vmin(b[0], r.box_lo());
+          b[1] = vmax(b[1], r.hi);
+          v4f c = r.centroid2();
+          b[2] = vmin(b[2], c);
+          b[3] = vmax(b[3], c);
+        }
+      });
+      for (const auto& b : part) {
+        root.box.grow(Bounds{glm3(b[0]), glm3(b[1])});
+        root.cbox.grow(Bounds{glm3(b[2]), glm3(b[3])});
+      }
+    }
+    bvh_.tris.resize(refs_.size());
+    job_refs_ = std::max<uint32_t>(kMinJobRefs, uint32_t(refs_.size() / kJobsPerTree));
+    Top top;
+    // The root is always a 4-wide node, with one leaf child when the root range is a leaf
+    Range halves[2];
+    if (root.end == 0) {
+      top.sub.nodes.push_back(empty_node());
+    } else if (!split(root, &halves[0], &halves[1], true)) {
+      root.leaf = true;
+      top.sub.nodes.push_back(empty_node());
+      set_child(top.sub, 0, 0, root, leaf_ref(top.sub, root));
+    } else {
+      top_node(top, root, halves);
+    }
+    std::vector<Job>& jobs = top.jobs;
+    run_jobs(jobs);
+    std::vector<Ref>().swap(refs_);  // the leaves hold the triangles now
+    // Join: the jobs' nodes after the top's, in job order, their child references
+    // relocated; each job's nodes freed once copied (host memory: README, Performance)
+    size_t total = top.sub.nodes.size();
+    for (const Job& j : jobs) total += j.out.nodes.size();
+    bvh_.nodes = std::move(top.sub.nodes);
+    bvh_.nodes.reserve(total);
+    bvh_.depth = top.sub.depth;
+    for (Job& j : jobs) {
+      int offset = int(bvh_.nodes.size());
+      append(bvh_.nodes, j.out.nodes, offset);
+      std::vector<dev::BvhNode>().swap(j.out.nodes);
+      bvh_.nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
+      bvh_.depth = std::max(bvh_.depth, j.out.depth);
+    }
+    return std::move(bvh_);
+  }
+
+ private:
+  v4f vertex(uint32_t v) const {
+    const float* p = &positions_[3 * size_t(v)];
+    return v4f{p[0], p[1], p[2], 0.0f};
+  }
+
+  // fn(begin, end) over [0, n) in up to threads_ contiguous chunks of at least `grain`
+  template <class Fn>
+  void parallel_for(size_t n, Fn fn, size_t grain = 4096) {
+    parallel_for_indexed(n, [&](int, size_t b, size_t e) { fn(b, e); }, grain);
+  }
+  template <class Fn>
+  void parallel_for_indexed(size_t n, Fn fn, size_t grain = 4096) {
+    int t = int(std::min<size_t>(size_t(threads_), std::max<size_t>(1, n / grain)));
+    if (t <= 1) {
+      fn(0, 0, n);
+      return;
+    }
+    std::vector<std::thread> pool;
+    for (int i = 1; i < t; ++i) pool.emplace_back([&, i] { fn(i, n * size_t(i) / size_t(t), n * size_t(i + 1) / size_t(t)); });
+    fn(0, 0, n / size_t(t));
+    for (std::thread& th : pool) th.join();
+  }
+
+  // The workers take the jobs largest first
+  void run_jobs(std::vector<Job>& jobs) {
+    std::vector<size_t> order(jobs.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return jobs[a].r.end - jobs[a].r.begin > jobs[b].r.end - jobs[b].r.begin;
+    });
+    std::atomic<size_t> next{0};
+    auto worker = [&] {
+      for (size_t k; (k = next.fetch_add(1)) < order.size();) {
+        Job& j = jobs[order[k]];
+        Range sub[2];
+        if (split(j.r, &sub[0], &sub[1], false)) {
+          j.ref = int(inner_node(j.out, j.r, sub));
+        } else {
+          j.ref = leaf_ref(j.out, j.r);
+        }
+      }
+    };
+    int t = int(std::min<size_t>(size_t(threads_), jobs.size()));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < t; ++i) pool.emplace_back(worker);
+    worker();
+    for (std::thread& th : pool) th.join();
+  }
+
+  static dev::BvhNode empty_node() {
+    dev::BvhNode n{};
+    for (int i = 0; i < 4; ++i) {
+      n.lo_x[i] = n.lo_y[i] = n.lo_z[i] = kEmptyLo;
+      n.hi_x[i] = n.hi_y[i] = n.hi_z[i] = kEmptyHi;
+      n.child[i] = 0;  // the root: never anyone's child, never read
+    }
+    return n;
+  }
+
+  static void set_child(Subtree& out, uint32_t node, int slot, const Range& r, int ref) {
+    dev::BvhNode& n = out.nodes[node];
+    n.lo_x[slot] = r.box.lo.x;
+    n.lo_y[slot] = r.box.lo.y;
+    n.lo_z[slot] = r.box.lo.z;
+    n.hi_x[slot] = r.box.hi.x;
+    n.hi_y[slot] = r.box.hi.y;
+    n.hi_z[slot] = r.box.hi.z;
+    n.child[slot] = ref;
+  }
+
+  // A leaf's triangles are final once it is made: write them, the last one flagged
+  // (ranges are disjoint, so workers write bvh_.tris concurrently)
+  int leaf_ref(Subtree& out, const Range& r) {
+    out.depth = std::max(out.depth, r.depth);
+    for (uint32_t i = r.begin; i < r.end; ++i) {
+      uint32_t prim = refs_[i].prim();
+      const dev::Prim& p = prims_[prim];
+      dev::BvhTriangle& d = bvh_.tris[i];
+      d = dev::BvhTriangle{};
+      for (int a = 0; a < 3; ++a) {
+        d.v0[a] = positions_[3 * size_t(p.v[0]) + a];
+        d.v1[a] = positions_[3 * size_t(p.v[1]) + a];
+        d.v2[a] = positions_[3 * size_t(p.v[2]) + a];
+      }
+      d.prim = prim;
+      if (p.material < alpha_tested_.size() && alpha_tested_[p.material]) d.flags |= BVH_TRI_ALPHA_TEST;
+      if (i + 1 == r.end) d.flags |= BVH_TRI_LAST;
+    }
+    return ~int(r.begin);
+  }
+
+  // A 4-wide node for range r, already split into `halves`; returns its index in out
+  uint32_t inner_node(Subtree& out, const Range& r, Range halves[2]) {
+    out.depth = std::max(out.depth, r.depth);
+    std::array<Range, 4> kids;
+    int n = 0;
+    for (int h = 0; h < 2; ++h) {
+      Range a, b;
+      if (split(halves[h], &a, &b, false)) {
+        kids[n++] = a;
+        kids[n++] = b;
+      } else {
+        halves[h].leaf = true;
+        kids[n++] = halves[h];
+      }
+    }
+    uint32_t node = uint32_t(out.nodes.size());
+    out.nodes.push_back(empty_node());
+    for (int i = 0; i < n; ++i) {
+      int ref = 0;
+      Range sub[2];
+      if (kids[i].leaf || !split(kids[i], &sub[0], &sub[1], false)) {
+        ref = leaf_ref(out, kids[i]);
+      } else {
+        ref = int(inner_node(out, kids[i], sub));
+      }
+      set_child(out, node, i, kids[i], ref);  // out.nodes may have grown: index, not a reference
+    }
+    return node;
+  }
+
+  // The top of the tree: like inner_node, but children of at most job_refs_ refs become
+  // jobs (child reference patched when the jobs are joined), and the larger children's
+  // subtrees are built on threads of their own while threads are free, each into a Top of
+  // its own that is appended in child order, so the node order is inner_node's
+  struct Top {
+    Subtree sub;
+    std::vector<Job> jobs;
+  };
+
+  // fn(i) for i < n, on new threads while fewer than threads_ are busy, else inline
+  template <class Fn>
+  void fork(int n, Fn fn) {
+    std::vector<std::thread> pool;
+    for (int i = 0; i < n; ++i) {
+      if (i + 1 < n && busy_.fetch_add(1) < threads_) {
+        pool.emplace_back([&fn, this, i] {
+          fn(i);
+          busy_.fetch_sub(1);
+        });
+      } else {
+        if (i + 1 < n) busy_.fetch_sub(1);
+        fn(i);
+      }
+    }
+    for (std::thread& t : pool) t.join();
+  }
+
+  uint32_t top_node(Top& out, const Range& r, Range halves[2]) {
+    out.sub.depth = std::max(out.sub.depth, r.depth);
+    Range split_halves[2][2];
+    bool split_ok[2];
+    fork(2, [&](int h) { split_ok[h] = split(halves[h], &split_halves[h][0], &split_halves[h][1], true); });
+    std::array<Range, 4> kids;
+    int n = 0;
+    for (int h = 0; h < 2; ++h) {
+      if (split_ok[h]) {
+        kids[n++] = split_halves[h][0];
+        kids[n++] = split_halves[h][1];
+      } else {
+        halves[h].leaf = true;
+        kids[n++] = halves[h];
+      }
+    }
+    uint32_t node = uint32_t(out.sub.nodes.size());
+    out.sub.nodes.push_back(empty_node());
+    std::array<Top, 4> below;
+    std::array<int, 4> ref{};
+    std::array<int, 4> big{};
+    int nbig = 0;
+    for (int i = 0; i < n; ++i) {
+      if (kids[i].leaf) {
+        ref[i] = leaf_ref(out.sub, kids[i]);
+      } else if (kids[i].end - kids[i].begin <= job_refs_) {
+        Job j;
+        j.r = kids[i];
+        j.node = node;
+        j.slot = i;
+        out.jobs.push_back(std::move(j));
+      } else {
+        big[nbig++] = i;
+      }
+    }
+    fork(nbig, [&](int k) {
+      int i = big[k];
+      Range sub[2];
+      if (!split(kids[i], &sub[0], &sub[1], true)) {
+        ref[i] = leaf_ref(below[i].sub, kids[i]);
+      } else {
+        ref[i] = int(top_node(below[i], kids[i], sub));
+      }
+    });
+    // Children in slot order: jobs and leaves were recorded above, big subtrees now
+    for (int k = 0; k < nbig; ++k) {
+      int i = big[k];
+      int offset = int(out.sub.nodes.size());
+      append(out.sub.nodes, below[i].sub.nodes, offset);
+      out.sub.depth = std::max(out.sub.depth, below[i].sub.depth);
+      if (ref[i] >= 0) ref[i] += offset;
+      for (Job& j : below[i].jobs) {
+        j.node += uint32_t(offset);
+        out.jobs.push_back(std::move(j));
+      }
+    }
+    for (int i = 0; i < n; ++i) set_child(out.sub, node, i, kids[i], ref[i]);
+    return node;
+  }
+
+  // Appends `from` to `to`, inner-child references (into `from`) moved by offset
+  static void append(std::vector<dev::BvhNode>& to, const std::vector<dev::BvhNode>& from, int offset) {
+    for (dev::BvhNode n : from) {
+      for (int i = 0; i < 4; ++i)
+        if (n.child[i] >= 0 && n.lo_x[i] <= n.hi_x[i]) n.child[i] += offset;
+      to.push_back(n);
+    }
+  }
+
+  void bin(const Binner& b, uint32_t begin, uint32_t end, Bins* bins) const {
+    for (uint32_t i = begin; i < end; ++i) {
+      const Ref& ref = refs_[i];
+      v4f lo = ref.box_lo(), hi = ref.hi;
+      v4i k = b.index(lo + hi);
+      for (int a = 0; a < 3; ++a) {
+        int j = k[a];
+        bins->lo[a][j] = vmin(bins->lo[a][j], lo);
+        bins->hi[a][j] = vmax(bins->hi[a][j], hi);
+        bins->count[a][j]++;
+      }
+    }
+  }
+
+  // Binned SAH split of r into *left and *right (bounds included); false: r is a leaf.
+  // `parallel`: bin large ranges on every thread (the top phase, where the workers wait)
+  bool split(const Range& r, Range* left, Range* right, bool parallel) {
+    uint32_t count = r.end - r.begin;
+    if (count <= 1 || r.depth >= kMaxBvhDepth) return false;
+    // One pass bins the centroids along all three axes; small ranges get fewer bins (the
+    // sweep over the bins costs as much as binning a few dozen triangles)
+    int nbins = int(std::clamp<uint32_t>(count, 4, kBins));
+    glm::vec3 lo = r.cbox.lo, extent = r.cbox.hi - r.cbox.lo;
+    Binner binner;
+    binner.lo2 = vec(lo);
+    binner.top = v4i{nbins - 1, nbins - 1, nbins - 1, 0};
+    bool usable[3];
+    for (int a = 0; a < 3; ++a) {
+      float scale = float(nbins) / extent[a];
+      // A flat or denormal extent cannot be binned
+      usable[a] = extent[a] > 0.0f && std::isfinite(scale);
+      binner.scale2[a] = usable[a] ? scale : 0.0f;
+    }
+    binner.scale2[3] = 0.0f;
+    Bins bins;
+    bins.clear(nbins);
+    if (parallel && count >= kParallelBinning && threads_ > 1 && busy_.load() < threads_) {
+      std::vector<Bins> part(static_cast<size_t>(threads_));
+      for (Bins& p : part) p.clear(nbins);
+      parallel_for_indexed(count, [&](int t, size_t b, size_t e) {
+        bin(binner, r.begin + uint32_t(b), r.begin + uint32_t(e), &part[size_t(t)]);
+      });
+      for (const Bins& p : part) bins.merge(p, nbins);
+    } else {
+      bin(binner, r.begin, r.end, &bins);
+    }
+    int best_axis = -1, best_plane = 0;
+    float best_cost = 1e30f;
+    for (int a = 0; a < 3; ++a) {
+      if (!usable[a]) continue;
+      // Sweep: areas and counts left of each plane, then right
+      std::array<float, kBins - 1> left_area, right_area;
+      std::array<uint32_t, kBins - 1> left_count, right_count;
+      v4f alo = bins.lo[a][0], ahi = bins.hi[a][0];
+      uint32_t c = 0;
+      for (int i = 0; i < nbins - 1; ++i) {
+        alo = vmin(alo, bins.lo[a][i]);
+        ahi = vmax(ahi, bins.hi[a][i]);
+        c += bins.count[a][i];
+        left_area[i] = surface_area(alo, ahi);
+        left_count[i] = c;
+      }
+      alo = bins.lo[a][nbins - 1];
+      ahi = bins.hi[a][nbins - 1];
+      c = 0;
+      for (int i = nbins - 1; i > 0; --i) {
+        alo = vmin(alo, bins.lo[a][i]);
+        ahi = vmax(ahi, bins.hi[a][i]);
+        c += bins.count[a][i];
+        right_area[i - 1] = surface_area(alo, ahi);
+        right_count[i - 1] = c;
+      }
+      for (int i = 0; i < nbins - 1; ++i) {
+        if (left_count[i] == 0 || right_count[i] == 0) continue;
+        float cost = left_area[i] * left_count[i] + right_area[i] * right_count[i];
+        if (cost < best_cost) {
+          best_axis = a;
+          best_plane = i;
+          best_cost = cost;
+        }
+      }
+    }
+    float leaf_cost = float(count);
+    float split_cost = kTraversalCost + best_cost / std::max(surface_area(r.box), 1e-30f);
+    *left = Range();
+    *right = Range();
+    left->depth = right->depth = r.depth + 1;
+    left->begin = r.begin;
+    right->end = r.end;
+    if (best_axis >= 0 && (split_cost < leaf_cost || count > kMaxLeafSize)) {
+      // Partition by the same bin index as above, so that the bins' bounds are exact; the
+      // sides' centroid bounds on the way
+      int a = best_axis;
+      v4f lcmin = vec(Bounds().lo), lcmax = vec(Bounds().hi), rcmin = lcmin, rcmax = lcmax;
+      uint32_t i = r.begin, j = r.end;
+      while (true) {
+        for (; i < j; ++i) {
+          v4f c = refs_[i].centroid2();
+          if (binner.index(c)[a] > best_plane) break;
+          lcmin = vmin(lcmin, c);
+          lcmax = vmax(lcmax, c);
+        }
+        for (; i < j; --j) {
+          v4f c = refs_[j - 1].centroid2();
+          if (binner.index(c)[a] <= best_plane) break;
+          rcmin = vmin(rcmin, c);
+          rcmax = vmax(rcmax, c);
+        }
+        if (i >= j) break;
+        std::swap(refs_[i], refs_[j - 1]);
+      }
+      left->end = right->begin = i;
+      left->cbox = Bounds{glm3(lcmin), glm3(lcmax)};
+      right->cbox = Bounds{glm3(rcmin), glm3(rcmax)};
+      v4f blo[2] = {vec(Bounds().lo), vec(Bounds().lo)}, bhi[2] = {vec(Bounds().hi), vec(Bounds().hi)};
+      for (int k = 0; k < nbins; ++k) {
+        int s = k <= best_plane ? 0 : 1;
+        blo[s] = vmin(blo[s], bins.lo[a][k]);
+        bhi[s] = vmax(bhi[s], bins.hi[a][k]);
+      }
+      left->box = Bounds{glm3(blo[0]), glm3(bhi[0])};
+      right->box = Bounds{glm3(blo[1]), glm3(bhi[1])};
+      return true;
+    }
+    if (count <= kMaxLeafSize) return false;
+    // All centroids coincide (or no useful plane): split the range in half
+    left->end = right->begin = r.begin + count / 2;
+    for (Range* side : {left, right})
+      for (uint32_t i = side->begin; i < side->end; ++i) {
+        side->box.grow(Bounds{glm3(refs_[i].box_lo()), glm3(refs_[i].hi)});
+        side->cbox.grow(glm3(refs_[i].centroid2()));
+      }
+    return true;
+  }
+
+  const std::vector<float>& positions_;
+  const std::vector<dev::Prim>& prims_;
+  const std::vector<bool>& alpha_tested_;
+  const int threads_;
+  uint32_t job_refs_ = kMinJobRefs;
+  std::atomic<int> busy_{1};  // threads at work in the top phase (the caller's included)
+  std::vector<Ref> refs_;  // refs_[i]: primitive stored at leaf position i once built
+  Bvh bvh_;
+};
+
+}  // namespace
+
+int bvh_build_threads() {
+  if (const char* env = std::getenv("CANDELA_BVH_THREADS")) {
+    int n = std::atoi(env);
+    if (n > 0) return n;
+  }
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+double sah_cost(const Bvh& bvh) {
+  if (bvh.nodes.empty()) return 0.0;
+  // The root's box: the union of its children's
+  auto area = [](const dev::BvhNode& n, int i) {
+    double dx = double(n.hi_x[i]) - n.lo_x[i], dy = double(n.hi_y[i]) - n.lo_y[i], dz = double(n.hi_z[i]) - n.lo_z[i];
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+  };
+  const dev::BvhNode& root = bvh.nodes[0];
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (int i = 0; i < 4; ++i) {
+    if (root.lo_x[i] > root.hi_x[i]) continue;
+    lo = glm::min(lo, glm::dvec3(root.lo_x[i], root.lo_y[i], root.lo_z[i]));
+    hi = glm::max(hi, glm::dvec3(root.hi_x[i], root.hi_y[i], root.hi_z[i]));
+  }
+  if (lo.x > hi.x) return 0.0;
+  glm::dvec3 d = hi - lo;
+  double root_area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+  if (!(root_area > 0.0)) return 0.0;
+  // Every node is some node's child (the root aside): cost = sum over child slots of
+  // area / root area x (traversal cost for an inner child, triangle count for a leaf)
+  double cost = kTraversalCost;
+  for (const dev::BvhNode& n : bvh.nodes)
+    for (int i = 0; i < 4; ++i) {
+      if (n.lo_x[i] > n.hi_x[i]) continue;
+      double weight;
+      if (n.child[i] >= 0) {
+        weight = kTraversalCost;
+      } else {
+        size_t t = size_t(~n.child[i]), count = 1;
+        while (t < bvh.tris.size() && !(bvh.tris[t].flags & BVH_TRI_LAST)) ++t, ++count;
+        weight = double(count);
+      }
+      cost += area(n, i) / root_area * weight;
+    }
+  return cost;
+}
+
+Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
+              const std::vector<bool>& alpha_tested, int threads) {
+  return Builder(positions, prims, alpha_tested, threads > 0 ? threads : bvh_build_threads()).build();
+}
+
+}  // namespace candela

@@ -1,0 +1,30 @@
+// Kernel sources: embedded at build time (cmake/embed_kernels.cmake) or, while
+// developing, read from disk (--kernel-dir or CANDELA_KERNEL_DIR).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace candela {
+
+struct EmbeddedKernelFile {
+  const char* path;  // relative to the repository root, e.g. "cl/core/rng.cl"
+  const char* text;
+};
+
+const std::vector<EmbeddedKernelFile>& embedded_kernel_files();
+
+// Where kernel sources come from: empty = embedded; else the cl/ directory on disk
+void set_kernel_source_root(const std::string& root);
+
+// NanoVDB's PNanoVDB.h (its C platform) edited to compile as OpenCL C 1.2; throws Error when
+// the text lacks what the edits expect
+std::string pnanovdb_opencl_text(std::string text);
+
+// The renderer program: every cl/ file in order, each starting with a #line marker
+std::string renderer_program_source();
+
+// The renderer program followed by the test kernels of tests/cl/
+std::string test_program_source();
+
+}  // namespace candela

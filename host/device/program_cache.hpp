@@ -1,0 +1,36 @@
+// OpenCL program builds with an on-disk binary cache.
+// Key: platform, device, driver version, build options, source hash and candela version.
+// Directory: $CANDELA_CACHE_DIR, else $XDG_CACHE_HOME/candela/kernels, else
+// ~/.cache/candela/kernels; CANDELA_CACHE_DIR="" disables the cache.
+#pragma once
+
+#include <CL/opencl.hpp>
+#include <string>
+#include <vector>
+
+#include "device/device.hpp"
+
+namespace candela {
+
+struct ProgramBuild {
+  cl::Program program;
+  double seconds = 0.0;
+  bool from_cache = false;
+  std::string cache_file;  // empty when the cache is disabled
+};
+
+// Builds `source` with `options` for the device, through the cache. A corrupt or
+// rejected cache entry falls back to a source build. A failed source build throws
+// Error with the device's build log.
+ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device,
+                           const std::string& source, const std::string& options);
+
+std::string kernel_cache_dir();
+
+// Other data kept in the cache beside a program (e.g. under ProgramBuild::cache_file plus a
+// suffix), with the binaries' checks: the payload, or empty when missing or corrupt (a
+// corrupt entry is removed); writing is atomic and an unwritable cache is not an error
+std::vector<unsigned char> read_cache_entry(const std::string& path);
+void write_cache_entry(const std::string& path, const std::vector<unsigned char>& data);
+
+}  // namespace candela

@@ -1,0 +1,20 @@
+// glTF 2.0 (.gltf / .glb) scene loading through tinygltf.
+#pragma once
+
+#include <string>
+
+#include "scene/scene.hpp"
+
+namespace candela {
+
+// Loads the default scene (or the first) with node transforms applied. Throws Error
+// on a missing or malformed file; unsupported features land in Scene::warnings, and so
+// do images that cannot be decoded (their textures fall back or are dropped).
+Scene load_gltf(const std::string& path);
+
+// The same from the bytes of a .gltf or .glb (told apart by the "glTF" magic). External
+// URIs resolve against `base_dir`; with an empty `base_dir` no file is read (only data:
+// URIs and the GLB's own BIN chunk load), as for untrusted input.
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir);
+
+}  // namespace candela

@@ -1,0 +1,91 @@
+#include "render/film.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "base/error.hpp"
+
+namespace candela {
+
+glm::vec3 Film::variance_of_mean(size_t i) const {
+  float n = samples(i);
+  if (n < 2.0f) return glm::vec3(INFINITY);
+  glm::vec3 m(m2[4 * i], m2[4 * i + 1], m2[4 * i + 2]);
+  return m / (n - 1.0f) / n;
+}
+
+uint64_t Film::dropped_samples() const {
+  double total = 0.0;
+  for (size_t i = 0; i < pixels(); ++i) total += m2[4 * i + 3];
+  return uint64_t(total);
+}
+
+Film merge_films(const Film& a, const Film& b) {
+  if (a.width != b.width || a.height != b.height) throw Error("cannot merge films of different sizes");
+  Film out(a.width, a.height);
+  for (size_t i = 0; i < a.pixels(); ++i) {
+    double na = a.mean[4 * i + 3], nb = b.mean[4 * i + 3], n = na + nb;
+    for (int c = 0; c < 3; ++c) {
+      double ma = a.mean[4 * i + c], mb = b.mean[4 * i + c];
+      double delta = mb - ma;
+      out.mean[4 * i + c] = n > 0 ? float(ma + delta * nb / n) : 0.0f;
+      out.m2[4 * i + c] = n > 0 ? float(a.m2[4 * i + c] + b.m2[4 * i + c] + delta * delta * na * nb / n) : 0.0f;
+    }
+    out.mean[4 * i + 3] = float(n);
+    out.m2[4 * i + 3] = a.m2[4 * i + 3] + b.m2[4 * i + 3];
+  }
+  return out;
+}
+
+namespace {
+
+float linear_to_srgb(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+  return ext;
+}
+
+}  // namespace
+
+void check_output_path(const std::string& path) {
+  std::string ext = lower_extension(path);
+  if (ext != ".exr" && ext != ".png") throw Error("output must end in .exr or .png: " + path);
+}
+
+void write_image(const std::string& path, const Film& film,
+                 const std::map<std::string, std::string>& metadata, float exposure) {
+  check_output_path(path);
+  bool exr = lower_extension(path) == ".exr";
+
+  std::vector<float> rgb(film.pixels() * 3);
+  float scale = std::exp2(exposure);
+  for (size_t i = 0; i < film.pixels(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      float v = film.mean[4 * i + c];
+      rgb[3 * i + c] = exr ? v : linear_to_srgb(v * scale);
+    }
+  write_rgb_pixels(path, film.width, film.height, rgb, exr, metadata);
+}
+
+void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,
+                      bool float_channels, const std::map<std::string, std::string>& metadata) {
+  OIIO::ImageSpec spec(width, height, 3, float_channels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
+  spec.attribute("Software", "candela " CANDELA_VERSION);
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw Error("cannot write " + path + ": " + OIIO::geterror());
+  if (!out->open(path, spec)) throw Error("cannot write " + path + ": " + out->geterror());
+  bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
+  ok = out->close() && ok;
+  if (!ok) throw Error("cannot write " + path + ": " + out->geterror());
+}
+
+}  // namespace candela

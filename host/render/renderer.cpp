@@ -1,0 +1,345 @@
+#include "render/renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "device/energy.hpp"
+#include "base/error.hpp"
+#include "device/kernel_sources.hpp"
+#include "device/program_cache.hpp"
+
+namespace candela {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::string format_mib(uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f MiB", bytes / 1048576.0);
+  return buf;
+}
+
+// A read-only buffer holding `data`, or one dummy element when it is empty
+template <typename T>
+cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data,
+                  const char* what) {
+  std::vector<T> one(1);
+  const std::vector<T>& src = data.empty() ? one : data;
+  size_t bytes = src.size() * sizeof(T);
+  if (bytes > device.max_alloc)
+    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) +
+                " in one buffer, more than " + device.description() + " allows (" +
+                format_mib(device.max_alloc) + ")");
+  try {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(src.data()));
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
+  }
+}
+
+void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
+  if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 ||
+      settings.height > 65536 || uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
+    throw Error("image size must be between 1x1 and 65536x65536 with at most 2^28 pixels");
+  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 ||
+      device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
+    throw Error(device.description() + " supports only " + device.opencl_c_version +
+                "; candela needs OpenCL C 1.2");
+}
+
+}  // namespace
+
+DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene,
+                               const RenderSettings& settings, CompiledScene* release)
+    : device_(device), settings_(settings) {
+  check_settings(device, settings);
+  try {
+    context_ = cl::Context(device_.device);
+    queue_ = cl::CommandQueue(context_, device_.device);
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
+  }
+  std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
+  options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
+  ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
+  kernel_build_seconds_ = build.seconds;
+  kernel_from_cache_ = build.from_cache;
+  kernel_ = cl::Kernel(build.program, "render_paths");
+  const unsigned want_args = dev::kSceneBufferCount + 3;  // + params and the film's two buffers
+  if (kernel_.getInfo<CL_KERNEL_NUM_ARGS>() != want_args)
+    throw Error("render_paths takes " + std::to_string(kernel_.getInfo<CL_KERNEL_NUM_ARGS>()) +
+                " arguments, but the host binds " + std::to_string(want_args) +
+                " (CD_SCENE_BUFFERS out of step with the kernel)");
+  local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
+
+#define CD_UPLOAD(type, name)                                                  \
+  scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name)); \
+  if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);
+  CD_SCENE_BUFFERS(CD_UPLOAD)
+#undef CD_UPLOAD
+  if (settings.energy_compensation)
+    scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
+        ggx_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
+
+  params_host_.camera = make_device_camera(scene.camera, settings.width, settings.height);
+  params_host_.width = uint32_t(settings.width);
+  params_host_.height = uint32_t(settings.height);
+  params_host_.seed = settings.seed;
+  params_host_.max_depth = settings.max_depth;
+  params_host_.rr_depth = settings.rr_depth;
+  params_host_.strategy = uint32_t(settings.strategy);
+  params_host_.num_lights = uint32_t(scene.buffers.lights.size());  // kept by release
+  params_host_.environment_light = scene.environment_light;
+  params_host_.energy_compensation = settings.energy_compensation ? 1u : 0u;
+  params_host_.filter = uint32_t(settings.filter);
+
+  size_t pixels = size_t(settings.width) * settings.height;
+  chunk_ = std::min(pixels, std::max<size_t>(local_size_, 4096));
+  size_t film_bytes = pixels * 4 * sizeof(float);
+  try {
+    params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
+    film_mean_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
+    film_m2_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
+    queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
+    queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
+    cl_uint arg = 0;
+    for (const cl::Buffer& b : scene_buffers_) kernel_.setArg(arg++, b);
+    for (const cl::Buffer* b : {&params_, &film_mean_, &film_m2_}) kernel_.setArg(arg++, *b);
+    queue_.finish();
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("allocating the film", e.err()));
+  }
+}
+
+void DeviceRenderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end) {
+  params_host_.sample_begin = sample_begin;
+  params_host_.sample_count = count;
+  params_host_.pixel_begin = uint32_t(pixel_begin);
+  params_host_.pixel_end = uint32_t(pixel_end);
+  try {
+    queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
+    // Work-groups of local_size_ work-items; the kernel skips the padding at the end
+    size_t global = (pixel_end - pixel_begin + local_size_ - 1) / local_size_ * local_size_;
+    queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(local_size_));
+    queue_.finish();
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("running the path tracing kernel", e.err()));
+  }
+}
+
+bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
+                                  const std::function<void(double)>& progress) {
+  const size_t pixels = size_t(settings_.width) * settings_.height;
+  double seconds = 0.0;
+  for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
+    if (begin > 0 && stop && stop()) return false;
+    end = std::min(pixels, begin + chunk_);
+    auto t0 = Clock::now();
+    launch(sample_begin, count, begin, end);
+    double dt = seconds_since(t0);
+    seconds += dt;
+    // Next launch: about launch_seconds of pixels at the measured cost
+    double cost = dt / (double(end - begin) * count);
+    size_t want = size_t(settings_.launch_seconds / std::max(cost * count, 1e-12));
+    chunk_ = std::clamp((want + local_size_ - 1) / local_size_ * local_size_, std::min(local_size_, pixels), pixels);
+    if (end < pixels && progress) progress(double(end) / double(pixels));
+  }
+  // Next range: whole-image launches of several samples once one sample is cheap enough
+  pass_seconds_ = seconds / count;
+  double want = settings_.launch_seconds / std::max(pass_seconds_, 1e-12);
+  batch_ = uint32_t(std::clamp(want, 1.0, std::min(2.0 * count, 4096.0)));
+  if (want >= 1.0) chunk_ = pixels;
+  return true;
+}
+
+uint32_t DeviceRenderer::suggested_batch(double seconds_left) const {
+  if (pass_seconds_ <= 0.0) return batch_;
+  return uint32_t(std::clamp(seconds_left / pass_seconds_, 1.0, double(batch_)));
+}
+
+Film DeviceRenderer::film() {
+  Film film(settings_.width, settings_.height);
+  try {
+    queue_.enqueueReadBuffer(film_mean_, CL_TRUE, 0, film.mean.size() * sizeof(float), film.mean.data());
+    queue_.enqueueReadBuffer(film_m2_, CL_TRUE, 0, film.m2.size() * sizeof(float), film.m2.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("reading back the film", e.err()));
+  }
+  return film;
+}
+
+namespace {
+
+// Hands out disjoint ranges of sample indices to the workers and keeps the count of
+// samples that every pixel has received
+class SampleScheduler {
+ public:
+  SampleScheduler(uint32_t spp, double time_limit, size_t workers)
+      : limit_(spp > 0 ? spp : kMaxSamplesPerPixel), time_limit_(spp > 0 ? 0.0 : time_limit),
+        partial_(workers, 0.0), done_by_(workers, 0), start_(Clock::now()) {}
+
+  // The next range (offsets from the render's first sample) for a worker that wants
+  // `want` samples per pixel; false when the render is over
+  bool take(DeviceRenderer* w, uint32_t* begin, uint32_t* count) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (ended_ || next_ >= limit_ || out_of_time()) return false;
+    *begin = next_;
+    *count = std::min(w->suggested_batch(time_limit_ > 0 ? time_limit_ - seconds() : 1e30), limit_ - next_);
+    next_ += *count;
+    return true;
+  }
+
+  // A time limit ends the render only once every pixel has a sample
+  bool out_of_time() const { return time_limit_ > 0.0 && done_ > 0 && seconds() >= time_limit_; }
+  bool out_of_time_locked() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return out_of_time();
+  }
+
+  void finish(size_t worker, uint32_t count, bool whole, bool interrupted) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    partial_[worker] = 0.0;
+    if (whole) done_ += count;
+    if (whole) done_by_[worker] += count;
+    if (!whole) partial_pass_ = ended_ = true;
+    if (interrupted) interrupted_ = ended_ = true;
+  }
+
+  void report(size_t worker, double spp_partial, const std::function<void(const RenderProgress&)>& progress,
+              uint32_t spp) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    partial_[worker] = spp_partial;
+    if (!progress) return;
+    RenderProgress p;
+    p.spp_done = done_;
+    for (double v : partial_) p.spp_partial += v;
+    p.worker_spp.resize(partial_.size());
+    for (size_t i = 0; i < partial_.size(); ++i) p.worker_spp[i] = done_by_[i] + partial_[i];
+    p.spp_target = spp;
+    p.time_limit = time_limit_;
+    p.seconds = seconds();
+    progress(p);
+  }
+
+  double seconds() const { return seconds_since(start_); }
+  uint32_t done() const { return done_; }
+  bool interrupted() const { return interrupted_; }
+  bool partial_pass() const { return partial_pass_; }
+
+ private:
+  std::mutex mutex_;
+  const uint32_t limit_;
+  const double time_limit_;
+  std::vector<double> partial_;
+  std::vector<uint32_t> done_by_;  // whole ranges per worker, samples per pixel
+  Clock::time_point start_;
+  uint32_t next_ = 0, done_ = 0;
+  bool ended_ = false, interrupted_ = false, partial_pass_ = false;
+};
+
+}  // namespace
+
+RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin, uint32_t spp,
+                            double time_limit, const std::function<void(const RenderProgress&)>& progress,
+                            const std::function<bool()>& stop) {
+  if (workers.empty()) throw Error("render_samples needs a device");
+  if (spp == 0 && !(time_limit > 0.0)) throw Error("render needs a sample count or a time limit");
+  SampleScheduler sched(spp, time_limit, workers.size());
+  std::vector<std::exception_ptr> errors(workers.size());
+  auto work = [&](size_t i) {
+    try {
+      DeviceRenderer* w = workers[i];
+      uint32_t begin, count;
+      while (sched.take(w, &begin, &count)) {
+        bool stopped = false;
+        auto should_stop = [&] { return (stopped = stop && stop()) || sched.out_of_time_locked(); };
+        bool whole = w->render_range(sample_begin + begin, count, should_stop,
+                                     [&](double f) { sched.report(i, f * count, progress, spp); });
+        sched.finish(i, count, whole, stopped);
+        sched.report(i, 0.0, progress, spp);
+        if (stop && stop()) sched.finish(i, 0, true, true);
+      }
+    } catch (...) {
+      errors[i] = std::current_exception();
+      sched.finish(i, 0, true, true);
+    }
+  };
+  if (workers.size() == 1) {
+    work(0);
+  } else {
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < workers.size(); ++i) threads.emplace_back(work, i);
+    for (auto& t : threads) t.join();
+  }
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+
+  RenderResult result;
+  result.spp = sched.done();
+  result.seconds = sched.seconds();
+  result.interrupted = sched.interrupted();
+  result.partial_pass = sched.partial_pass();
+  // Each worker's share: the samples its film holds (partial ranges included)
+  for (size_t i = 0; i < workers.size(); ++i) {
+    Film f = workers[i]->film();
+    double total = 0.0;
+    for (size_t p = 0; p < f.pixels(); ++p) total += f.samples(p);
+    result.worker_samples.push_back(uint64_t(total + 0.5));
+    result.film = i == 0 ? std::move(f) : merge_films(result.film, f);
+  }
+  return result;
+}
+
+Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
+    : Renderer(device, std::make_shared<const CompiledScene>(compile_scene(scene)), settings) {}
+
+Renderer::Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+                   const RenderSettings& settings)
+    : Renderer(std::vector<DeviceEntry>{device}, std::move(scene), settings) {}
+
+Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
+                   const RenderSettings& settings)
+    : scene_(std::move(scene)) {
+  if (devices.empty()) throw Error("a render needs at least one device");
+  for (const auto& d : devices) workers_.push_back(std::make_unique<DeviceRenderer>(d, *scene_, settings));
+}
+
+Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
+                   const RenderSettings& settings, bool release_host_arrays)
+    : scene_(scene) {
+  if (devices.empty()) throw Error("a render needs at least one device");
+  for (size_t i = 0; i < devices.size(); ++i)
+    workers_.push_back(std::make_unique<DeviceRenderer>(
+        devices[i], *scene_, settings, release_host_arrays && i + 1 == devices.size() ? scene.get() : nullptr));
+  if (release_host_arrays) scene->release_host_arrays();
+}
+
+double Renderer::kernel_build_seconds() const {
+  double s = 0.0;
+  for (const auto& w : workers_) s += w->kernel_build_seconds();
+  return s;
+}
+
+bool Renderer::kernel_from_cache() const {
+  for (const auto& w : workers_)
+    if (!w->kernel_from_cache()) return false;
+  return true;
+}
+
+RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_limit,
+                              const std::function<void(const RenderProgress&)>& progress,
+                              const std::function<bool()>& stop) {
+  std::vector<DeviceRenderer*> workers;
+  for (auto& w : workers_) workers.push_back(w.get());
+  return render_samples(workers, sample_begin, spp, time_limit, progress, stop);
+}
+
+}  // namespace candela

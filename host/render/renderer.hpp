@@ -1,0 +1,157 @@
+// Rendering a compiled scene: a DeviceRenderer per device (context, queue, program,
+// buffers, film) renders given ranges of sample indices; render_samples hands ranges out
+// to one or more of them and merges their films. Renderer bundles the common case: one
+// scene, compiled once, on one device.
+#pragma once
+
+#include <CL/opencl.hpp>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "device/device.hpp"
+#include "render/film.hpp"
+#include "scene/scene.hpp"
+#include "compile/scene_compiler.hpp"
+
+namespace candela {
+
+enum class Strategy : uint32_t { Nee = STRATEGY_NEE, Bsdf = STRATEGY_BSDF, Auto = STRATEGY_AUTO };
+
+// Pixel filter, importance-sampled by the kernel (cl/camera/filter.cl)
+enum class PixelFilter : uint32_t { Box = FILTER_BOX, Tent = FILTER_TENT, Gaussian = FILTER_GAUSSIAN };
+
+// Where the kernels' random numbers come from (cl/core/rng.cl): Owen-scrambled Sobol
+// (stratified) or independent hashes; a build option of the kernel program
+enum class Sampler : uint32_t { Sobol, Independent };
+
+// The film's per-pixel sample count is a float: exact up to 2^24
+constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
+
+struct RenderSettings {
+  int width = 512, height = 512;
+  uint32_t seed = 0;
+  uint32_t max_depth = 16;  // scattering events
+  uint32_t rr_depth = 3;  // Russian roulette after this many bounces
+  Strategy strategy = Strategy::Nee;
+  bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/bsdf/energy.cl)
+  PixelFilter filter = PixelFilter::Box;
+  Sampler sampler = Sampler::Sobol;
+  double launch_seconds = 0.2;  // target duration of one launch
+};
+
+struct RenderProgress {
+  uint32_t spp_done = 0;
+  double spp_partial = 0.0;  // samples per pixel of the ranges under way
+  uint32_t spp_target = 0;  // 0 when rendering for a time budget
+  double seconds = 0.0;
+  double time_limit = 0.0;
+  std::vector<double> worker_spp;  // per worker: samples per pixel done and under way
+};
+
+struct RenderResult {
+  Film film;
+  uint32_t spp = 0;  // samples every pixel received
+  double seconds = 0.0;
+  bool interrupted = false;  // stopped by the caller
+  bool partial_pass = false;  // stopped inside a range: some pixels hold more samples
+  std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
+};
+
+// One device's worker: renders ranges of sample indices of a compiled scene into its film
+class DeviceRenderer {
+ public:
+  // Builds the kernel program for the scene's features, uploads the scene buffers and,
+  // with energy compensation, the GGX albedo table (host/device/energy.hpp)
+  // `release`: the same scene, whose host arrays are freed one by one once uploaded (for
+  // the last device that uploads them; CompiledScene::release_host_arrays)
+  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings,
+                 CompiledScene* release = nullptr);
+
+  // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
+  // of about settings.launch_seconds over ranges of pixels. `stop` is polled between
+  // launches; returns false when it stopped the range part way (some pixels then hold
+  // the range's samples, the others not). `progress` gets the fraction of the range done.
+  bool render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
+                    const std::function<void(double)>& progress);
+
+  // Samples per pixel for the next range: about launch_seconds of work once measured,
+  // and no more than fit in `seconds_left`
+  uint32_t suggested_batch(double seconds_left) const;
+
+  Film film();  // reads the film back from the device
+  double kernel_build_seconds() const { return kernel_build_seconds_; }
+  bool kernel_from_cache() const { return kernel_from_cache_; }
+  const DeviceEntry& device() const { return device_; }
+
+ private:
+  void launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end);
+
+  DeviceEntry device_;
+  RenderSettings settings_;
+  cl::Context context_;
+  cl::CommandQueue queue_;
+  cl::Kernel kernel_;
+  std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
+  cl::Buffer params_, film_mean_, film_m2_;
+  dev::RenderParams params_host_{};
+  size_t local_size_ = 1;
+  size_t chunk_ = 1;  // pixels per launch
+  uint32_t batch_ = 1;  // samples per pixel for the next range
+  double pass_seconds_ = 0.0;  // one sample of every pixel, measured; 0 = not yet
+  double kernel_build_seconds_ = 0.0;
+  bool kernel_from_cache_ = false;
+};
+
+// Renders sample indices [sample_begin, sample_begin + spp) of every pixel, or for
+// time_limit seconds when spp == 0, handing ranges out to the workers (one thread each)
+// and merging their films by sample count. A time limit never ends the first range.
+// `stop` is polled between launches; a stopped render keeps the samples already done.
+// After a result with partial_pass, some pixels already hold sample indices from
+// sample_begin + result.spp on: do not resume that film from there.
+RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin,
+                            uint32_t spp, double time_limit = 0.0,
+                            const std::function<void(const RenderProgress&)>& progress = {},
+                            const std::function<bool()>& stop = {});
+
+// A scene compiled once and rendered on one device, or on several (one worker each,
+// sharing the ranges of sample indices)
+class Renderer {
+ public:
+  Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
+  Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+           const RenderSettings& settings);
+  // One DeviceRenderer per entry (an entry listed twice gets two workers); builds the
+  // kernels one device after the other. Throws Error when `devices` is empty.
+  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
+           const RenderSettings& settings);
+  // The same, and then the scene's host arrays are freed as the last device uploads them
+  // (CompiledScene::release_host_arrays): for a caller that needs them no more (the CLI)
+  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
+           const RenderSettings& settings, bool release_host_arrays);
+
+  RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
+                      const std::function<void(const RenderProgress&)>& progress = {},
+                      const std::function<bool()>& stop = {});
+
+  const CompiledScene& scene() const { return *scene_; }
+  DeviceRenderer& worker() { return *workers_.front(); }
+  const DeviceRenderer& worker() const { return *workers_.front(); }
+  size_t worker_count() const { return workers_.size(); }
+  DeviceRenderer& worker(size_t i) { return *workers_.at(i); }
+  const DeviceRenderer& worker(size_t i) const { return *workers_.at(i); }
+  // The first worker's kernel build; with several devices, the sum of all of them
+  double kernel_build_seconds() const;
+  bool kernel_from_cache() const;  // every worker's kernel came from the cache
+  double bvh_build_seconds() const { return scene_->bvh_build_seconds; }
+  size_t triangles() const { return scene_->triangles; }
+  size_t lights() const { return scene_->buffers.lights.size(); }
+
+ private:
+  std::shared_ptr<const CompiledScene> scene_;
+  std::vector<std::unique_ptr<DeviceRenderer>> workers_;
+};
+
+}  // namespace candela

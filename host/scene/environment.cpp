@@ -1,0 +1,153 @@
+#include "scene/environment.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "base/error.hpp"
+
+namespace candela {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr uint64_t kMaxMapBytes = uint64_t(1) << 30;  // as float RGBA: 8192 x 8192
+
+// Unnormalized CDF of n non-negative weights, appended as n + 1 floats from 0. The sum is
+// kept in double; a positive weight gets a step of at least one float ulp, a zero weight
+// none, so the device's steps are > 0 exactly where the weights are.
+void append_cdf(const double* weights, int n, std::vector<float>* out) {
+  double sum = 0.0;
+  float prev = 0.0f;
+  out->push_back(prev);
+  for (int i = 0; i < n; ++i) {
+    sum += weights[i];
+    float c = prev;
+    if (weights[i] > 0.0) c = std::max(float(sum), std::nextafter(prev, INFINITY));
+    out->push_back(c);
+    prev = c;
+  }
+}
+
+double texel_luminance(const TextureDesc& map, size_t i) {
+  const float* t = &map.rgbaf[4 * i];
+  return dev::luminance_rgb(t[0], t[1], t[2]);
+}
+
+}  // namespace
+
+const char* const kBuiltinSkyNote =
+    "note: the scene has no light; lighting it with the built-in sky (--no-default-light keeps it black)";
+
+TextureDesc load_environment_image(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec) || fs::is_directory(path, ec)) throw Error("environment map not found: " + path);
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    std::string why = OIIO::geterror();
+    throw Error("cannot read environment map " + path + (why.empty() ? "" : ": " + why));
+  }
+  const OIIO::ImageSpec spec = in->spec();
+  int w = spec.width, h = spec.height, nc = spec.nchannels;
+  if (w <= 0 || h <= 0 || nc <= 0) throw Error("environment map " + path + " has no pixels");
+  if (uint64_t(w) * uint64_t(h) * 16 > kMaxMapBytes)
+    throw Error("environment map " + path + " is too large (" + std::to_string(w) + " x " + std::to_string(h) +
+                ", over 1 GiB as float RGBA)");
+  std::vector<float> pixels(size_t(w) * size_t(h) * size_t(nc));
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw Error("cannot read environment map " + path + ": " + in->geterror());
+  in->close();
+  // Integer images hold sRGB-encoded colour unless they say otherwise
+  bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  std::string space = spec.get_string_attribute("oiio:ColorSpace");
+  bool srgb = integer && space != "Linear" && space != "linear";
+  TextureDesc t;
+  t.width = w;
+  t.height = h;
+  t.wrap_s = WRAP_REPEAT;
+  t.wrap_t = WRAP_CLAMP;
+  t.nearest = true;
+  t.rgbaf.resize(size_t(w) * size_t(h) * 4);
+  for (size_t i = 0; i < t.texels(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      float v = pixels[i * size_t(nc) + size_t(std::min(c, nc - 1))];
+      if (srgb) v = dev::srgb_to_linear(std::clamp(v, 0.0f, 1.0f));
+      t.rgbaf[4 * i + size_t(c)] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+    t.rgbaf[4 * i + 3] = 1.0f;
+  }
+  return t;
+}
+
+EnvironmentDesc load_environment(const std::string& path, float strength, float rotation) {
+  if (!(strength >= 0.0f) || !std::isfinite(strength))
+    throw Error("environment strength must be finite and non-negative");
+  if (!std::isfinite(rotation)) throw Error("environment rotation must be finite");
+  EnvironmentDesc e;
+  e.image = load_environment_image(path);
+  e.strength = strength;
+  e.rotation = rotation;
+  e.source = path;
+  return e;
+}
+
+EnvironmentDesc builtin_sky() {
+  const int w = 64, h = 32;
+  const double ground[3] = {0.4, 0.35, 0.3}, zenith_gain[3] = {0.1, 0.25, 0.6};
+  EnvironmentDesc e;
+  e.source = "built-in sky";
+  TextureDesc& t = e.image;
+  t.width = w;
+  t.height = h;
+  t.wrap_t = WRAP_CLAMP;
+  t.nearest = true;
+  t.rgbaf.resize(size_t(w) * h * 4);
+  for (int r = 0; r < h; ++r) {
+    double y = std::cos(kPi * (r + 0.5) / h);
+    for (int c = 0; c < w; ++c) {
+      float* texel = &t.rgbaf[4 * (size_t(r) * w + c)];
+      for (int k = 0; k < 3; ++k)
+        texel[k] = float(y >= 0.0 ? 1.0 + y * zenith_gain[k] : ground[k] + (1.0 - ground[k]) * std::exp(y / 0.1));
+      texel[3] = 1.0f;
+    }
+  }
+  return e;
+}
+
+std::vector<float> environment_distribution(const TextureDesc& map) {
+  int w = map.width, h = map.height;
+  std::vector<double> row_weight(static_cast<size_t>(h)), weights(static_cast<size_t>(w));
+  std::vector<float> out;
+  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1));
+  out.resize(size_t(h) + 1);  // the marginal CDF goes here once the rows are known
+  for (int r = 0; r < h; ++r) {
+    double sin_theta = std::sin(kPi * (r + 0.5) / h);
+    double sum = 0.0;
+    for (int c = 0; c < w; ++c) {
+      weights[size_t(c)] = texel_luminance(map, size_t(r) * w + c) * sin_theta;
+      sum += weights[size_t(c)];
+    }
+    row_weight[size_t(r)] = sum;
+    // A black row is never sampled; a uniform CDF keeps its steps well defined
+    if (!(sum > 0.0)) std::fill(weights.begin(), weights.end(), 1.0);
+    append_cdf(weights.data(), w, &out);
+  }
+  std::vector<float> marginal;
+  append_cdf(row_weight.data(), h, &marginal);
+  std::copy(marginal.begin(), marginal.end(), out.begin());
+  return out;
+}
+
+double environment_mean_luminance(const TextureDesc& map) {
+  int w = map.width, h = map.height;
+  double sum = 0.0;
+  for (int r = 0; r < h; ++r) {
+    double solid_angle = 2.0 * kPi / w * (std::cos(kPi * r / h) - std::cos(kPi * (r + 1) / h));
+    for (int c = 0; c < w; ++c) sum += texel_luminance(map, size_t(r) * w + c) * solid_angle;
+  }
+  return sum / (4.0 * kPi);
+}
+
+}  // namespace candela

@@ -1,0 +1,183 @@
+#include "scene/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "base/error.hpp"
+
+namespace candela {
+
+std::string SceneFeatures::build_options() const {
+  auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
+  return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
+         flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
+         flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media) +
+         flag("CD_FEATURE_NANOVDB", nanovdb) + flag("CD_FEATURE_GLTF_BSDF", gltf_bsdf) +
+         flag("CD_FEATURE_CONDUCTOR", conductor) + flag("CD_FEATURE_PUNCTUAL", punctual) +
+         flag("CD_FEATURE_ENVIRONMENT", environment);
+}
+
+bool SceneFeatures::covers(const SceneFeatures& n) const {
+  auto has = [](bool kernel, bool needed) { return kernel || !needed; };
+  return has(textures, n.textures) && has(uvs, n.uvs) && has(tangents, n.tangents) &&
+         has(vertex_colors, n.vertex_colors) && has(alpha, n.alpha) && has(media, n.media) &&
+         has(nanovdb, n.nanovdb) && has(gltf_bsdf, n.gltf_bsdf) && has(conductor, n.conductor) &&
+         has(punctual, n.punctual) && has(environment, n.environment);
+}
+
+uint32_t MaterialDesc::kernel_type() const {
+  bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f;
+  return type == MATERIAL_GLTF && lambertian ? MATERIAL_DIFFUSE : type;
+}
+
+bool MaterialDesc::alpha_tested() const {
+  bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
+  if (alpha_mode == AlphaMode::Mask) return textured || base_color.a < alpha_cutoff;
+  if (alpha_mode == AlphaMode::Blend) return textured || base_color.a < 1.0f;
+  return false;
+}
+
+double TextureDesc::mean_luminance() const {
+  size_t n = texels();
+  if (n == 0) return 0.0;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    float c[3];
+    for (int k = 0; k < 3; ++k) {
+      if (!rgbaf.empty()) {
+        c[k] = rgbaf[4 * i + k];
+      } else {
+        float v = rgba8[4 * i + k] / 255.0f;
+        c[k] = srgb ? dev::srgb_to_linear(v) : v;
+      }
+    }
+    sum += dev::luminance_rgb(c[0], c[1], c[2]);
+  }
+  return sum / double(n);
+}
+
+size_t Scene::triangles() const {
+  size_t n = 0;
+  for (const auto& m : meshes) n += m.triangles();
+  return n;
+}
+
+Bounds Scene::bounds() const {
+  Bounds b;
+  for (const auto& m : meshes)
+    for (const auto& p : m.positions) b.grow(p);
+  return b;
+}
+
+SceneFeatures Scene::features() const {
+  SceneFeatures f;
+  for (const auto& m : materials)
+    for (const auto& t : m.textures) f.textures |= t.index != NO_TEXTURE;
+  for (const auto& m : meshes) {
+    f.uvs |= !m.uv0.empty() || !m.uv1.empty();
+    f.tangents |= !m.tangents.empty();
+    for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
+    f.alpha |= materials.at(m.material).alpha_tested();
+    f.media |= materials.at(m.material).medium >= 0;
+    // BSDFs of the materials meshes use (the loader's default material may go unused)
+    f.gltf_bsdf |= materials.at(m.material).kernel_type() == MATERIAL_GLTF;
+    f.conductor |= materials.at(m.material).kernel_type() == MATERIAL_CONDUCTOR;
+  }
+  f.media |= global_medium >= 0;
+  for (const auto& m : media) f.nanovdb |= f.media && m.is_nanovdb();
+  // The lights compile_lights makes: emitting punctual lights; the map, else a background
+  f.punctual = punctual_light_count() > 0;
+  f.environment = environment.has_value() ||
+                  dev::luminance_rgb(background.x, background.y, background.z) > 0.0f;
+  return f;
+}
+
+size_t Scene::punctual_light_count() const {
+  size_t n = 0;
+  for (const PunctualLightDesc& l : punctual_lights)
+    n += dev::luminance_rgb(l.color.x, l.color.y, l.color.z) * l.intensity > 0.0f;
+  return n;
+}
+
+bool Scene::has_light() const {
+  if (environment) {
+    if (environment->strength > 0.0f && environment->image.mean_luminance() > 0.0) return true;
+  } else if (background.x > 0.0f || background.y > 0.0f || background.z > 0.0f) {
+    return true;
+  }
+  if (punctual_light_count() > 0) return true;
+  for (const auto& mesh : meshes) {
+    const MaterialDesc& m = materials.at(mesh.material);
+    bool factor = m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;
+    int tex = m.texture(TEX_EMISSION).index;
+    if (factor && (tex == NO_TEXTURE || textures.at(size_t(tex)).mean_luminance() > 0.0)) return true;
+  }
+  return false;
+}
+
+glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                               double* area) {
+  glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+  double len = glm::length(n);
+  *area = 0.5 * len;
+  return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
+}
+
+CameraDesc framing_camera(const Scene& scene) {
+  // Look at the bounds from +z, far enough to see the whole bounding sphere
+  Bounds b = scene.bounds();
+  CameraDesc cam;
+  float r = std::max(b.radius(), 1e-3f);
+  float dist = r / std::sin(0.5f * cam.yfov) * 1.05f;
+  cam.position = b.center() + glm::vec3(0.0f, 0.0f, dist);
+  cam.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+  return cam;
+}
+
+CameraDesc resolve_camera(const Scene& scene) {
+  CameraDesc cam = scene.camera ? *scene.camera : framing_camera(scene);
+  if (!(cam.aperture_radius >= 0.0f) || !std::isfinite(cam.aperture_radius))
+    throw Error("the camera's aperture radius must be finite and non-negative");
+  if (cam.aperture_radius > 0.0f && cam.projection == Projection::Orthographic)
+    throw Error("an orthographic camera has no lens: depth of field (an aperture) needs a perspective camera");
+  if (!cam.focus_distance) {
+    Bounds b = scene.bounds();
+    float along = b.empty() ? 0.0f : glm::dot(b.center() - cam.position, glm::normalize(cam.forward));
+    cam.focus_distance = along > 0.0f ? along : std::max(b.empty() ? 1.0f : b.radius(), 1e-3f);
+  }
+  if (!(*cam.focus_distance > 0.0f) || !std::isfinite(*cam.focus_distance))
+    throw Error("the camera's focus distance must be finite and positive");
+  return cam;
+}
+
+dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
+  glm::vec3 f = glm::normalize(cam.forward);
+  glm::vec3 r = glm::cross(f, cam.up);
+  if (!(glm::length(r) > 1e-6f)) {
+    // Up is parallel to the view: use the world axis least aligned with it
+    glm::vec3 a = glm::abs(f);
+    glm::vec3 axis = a.x <= a.y && a.x <= a.z ? glm::vec3(1, 0, 0)
+                     : a.y <= a.z            ? glm::vec3(0, 1, 0)
+                                             : glm::vec3(0, 0, 1);
+    r = glm::cross(f, axis);
+  }
+  r = glm::normalize(r);
+  glm::vec3 u = glm::cross(r, f);
+  // Half-extents of the image at depth 1 (perspective) or in scene units (orthographic)
+  bool ortho = cam.projection == Projection::Orthographic;
+  float half_y = ortho ? cam.ymag : std::tan(0.5f * cam.yfov);
+  float half_x = half_y * float(width) / float(height);
+  dev::Camera c{};
+  c.type = ortho ? CAMERA_ORTHOGRAPHIC : CAMERA_PERSPECTIVE;
+  c.lens_radius = ortho ? 0.0f : cam.aperture_radius;
+  c.focus_distance = cam.focus_distance.value_or(1.0f);
+  for (int i = 0; i < 3; ++i) {
+    c.origin[i] = cam.position[i];
+    c.forward[i] = f[i];
+    c.right[i] = r[i] * half_x;
+    c.up[i] = u[i] * half_y;
+  }
+  return c;
+}
+
+}  // namespace candela

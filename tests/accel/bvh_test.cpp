@@ -1,0 +1,340 @@
+// Kernel ray-triangle intersection and BVH traversal against a brute-force host
+// reference in double precision, on random rays and on rays through edges and vertices.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <algorithm>
+#include <random>
+
+#include "compile/bvh_builder.hpp"
+#include "support/gltf_builder.hpp"
+#include "support/test_support.hpp"
+
+namespace candela::test {
+namespace {
+
+struct Tri {
+  glm::vec3 p[3];
+};
+
+// Triangle soup as vertex positions and primitives (prim i = tris[i]), and its BVH
+struct Soup {
+  std::vector<float> positions;
+  std::vector<dev::Prim> prims;
+  Bvh bvh;
+  explicit Soup(const std::vector<Tri>& tris) {
+    for (const Tri& t : tris) {
+      dev::Prim p{};
+      for (int k = 0; k < 3; ++k) {
+        p.v[k] = uint32_t(positions.size() / 3);
+        for (int a = 0; a < 3; ++a) positions.push_back(t.p[k][a]);
+      }
+      prims.push_back(p);
+    }
+    bvh = build_bvh(positions, prims);
+  }
+};
+
+struct HostHit {
+  double t = INFINITY;
+  int tri = -1;
+  double margin = 0.0;  // smallest barycentric coordinate, relative: near 0 = near an edge
+};
+
+// Moller-Trumbore in double precision over every triangle
+HostHit host_closest_hit(const std::vector<Tri>& tris, glm::dvec3 o, glm::dvec3 d, double tmax) {
+  HostHit best;
+  best.t = tmax;
+  for (size_t i = 0; i < tris.size(); ++i) {
+    glm::dvec3 v0 = tris[i].p[0], v1 = tris[i].p[1], v2 = tris[i].p[2];
+    glm::dvec3 e1 = v1 - v0, e2 = v2 - v0, p = glm::cross(d, e2);
+    double det = glm::dot(e1, p);
+    if (det == 0.0) continue;
+    glm::dvec3 s = o - v0;
+    double u = glm::dot(s, p) / det;
+    glm::dvec3 q = glm::cross(s, e1);
+    double v = glm::dot(d, q) / det;
+    double t = glm::dot(e2, q) / det;
+    if (u < 0 || v < 0 || u + v > 1 || t <= 0 || t >= best.t) continue;
+    best.t = t;
+    best.tri = int(i);
+    best.margin = std::min({u, v, 1.0 - u - v});
+  }
+  return best;
+}
+
+Tri make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  Tri t;
+  t.p[0] = a;
+  t.p[1] = b;
+  t.p[2] = c;
+  return t;
+}
+
+// Closed icosphere with shared vertices: every edge belongs to two triangles
+std::vector<Tri> icosphere(int subdivisions, glm::vec3 center, float radius) {
+  GltfBuilder::Primitive p = sphere_primitive(center, radius, subdivisions, 0);
+  std::vector<Tri> out;
+  for (size_t i = 0; i + 2 < p.indices.size(); i += 3)
+    out.push_back(make_tri(p.positions[p.indices[i]], p.positions[p.indices[i + 1]], p.positions[p.indices[i + 2]]));
+  return out;
+}
+
+struct GpuTrace {
+  std::vector<cl_float4> bvh_hits, brute_hits;
+  std::vector<cl_int> occluded;
+};
+
+// rays: pairs (org + tmax, dir)
+GpuTrace trace(KernelRig& rig, const Bvh& bvh, const std::vector<cl_float4>& rays) {
+  const auto& tris = bvh.tris;
+  size_t n = rays.size() / 2;
+  cl::Buffer nodes(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bvh.nodes.size() * sizeof(dev::BvhNode),
+                   const_cast<dev::BvhNode*>(bvh.nodes.data()));
+  cl::Buffer tri_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, tris.size() * sizeof(dev::BvhTriangle),
+                     const_cast<dev::BvhTriangle*>(tris.data()));
+  cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4),
+                     const_cast<cl_float4*>(rays.data()));
+  cl::Buffer out_bvh(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+  cl::Buffer out_brute(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+  cl::Buffer out_occ(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_int));
+  cl::Kernel kb(rig.program, "test_trace_bvh");
+  kb.setArg(0, nodes);
+  kb.setArg(1, tri_buf);
+  kb.setArg(2, ray_buf);
+  kb.setArg(3, out_bvh);
+  kb.setArg(4, out_occ);
+  rig.queue.enqueueNDRangeKernel(kb, cl::NullRange, cl::NDRange(n));
+  cl::Kernel kf(rig.program, "test_trace_brute");
+  kf.setArg(0, tri_buf);
+  kf.setArg(1, cl_uint(tris.size()));
+  kf.setArg(2, ray_buf);
+  kf.setArg(3, out_brute);
+  rig.queue.enqueueNDRangeKernel(kf, cl::NullRange, cl::NDRange(n));
+  GpuTrace r;
+  r.bvh_hits.resize(n);
+  r.brute_hits.resize(n);
+  r.occluded.resize(n);
+  rig.queue.enqueueReadBuffer(out_bvh, CL_TRUE, 0, n * sizeof(cl_float4), r.bvh_hits.data());
+  rig.queue.enqueueReadBuffer(out_brute, CL_TRUE, 0, n * sizeof(cl_float4), r.brute_hits.data());
+  rig.queue.enqueueReadBuffer(out_occ, CL_TRUE, 0, n * sizeof(cl_int), r.occluded.data());
+  return r;
+}
+
+cl_float4 f4(glm::vec3 v, float w) { return cl_float4{{v.x, v.y, v.z, w}}; }
+
+class BvhTest : public ::testing::TestWithParam<std::string> {};
+
+}  // namespace
+
+// Every triangle in exactly one leaf run (ending at a BVH_TRI_LAST triangle), child
+// boxes holding their triangles and nodes, and no path pushing more than the kernel's
+// traversal stack holds
+static void check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
+  EXPECT_LE(bvh.depth, kMaxBvhDepth);
+  ASSERT_EQ(bvh.tris.size(), tris.size());
+  std::vector<int> seen(tris.size(), 0);
+  for (const auto& t : bvh.tris) seen[t.prim]++;
+  for (int s : seen) ASSERT_EQ(s, 1);
+  std::vector<int> covered(tris.size(), 0), node_seen(bvh.nodes.size(), 0);
+  int max_pushes = 0;
+  struct Item {
+    int node, pushes;
+  };
+  std::vector<Item> todo = {{0, 0}};
+  while (!todo.empty()) {
+    Item item = todo.back();
+    todo.pop_back();
+    ASSERT_GE(item.node, 0);
+    ASSERT_LT(item.node, int(bvh.nodes.size()));
+    ASSERT_EQ(node_seen[item.node]++, 0) << "node reached twice";
+    const dev::BvhNode& node = bvh.nodes[item.node];
+    int used = 0;
+    for (int i = 0; i < 4; ++i) used += node.lo_x[i] <= node.hi_x[i];
+    int pushes = item.pushes + std::max(0, used - 1);
+    max_pushes = std::max(max_pushes, pushes);
+    for (int i = 0; i < 4; ++i) {
+      glm::vec3 lo(node.lo_x[i], node.lo_y[i], node.lo_z[i]), hi(node.hi_x[i], node.hi_y[i], node.hi_z[i]);
+      if (lo.x > hi.x) {  // unused slot: empty on every axis
+        ASSERT_GT(lo.y, hi.y);
+        ASSERT_GT(lo.z, hi.z);
+        continue;
+      }
+      auto inside = [&](const glm::vec3& p) {
+        for (int a = 0; a < 3; ++a)
+          if (p[a] < lo[a] || p[a] > hi[a]) return false;
+        return true;
+      };
+      int c = node.child[i];
+      if (c < 0) {
+        for (int t = ~c;; ++t) {
+          ASSERT_LT(t, int(bvh.tris.size()));
+          covered[t]++;
+          for (const auto& p : tris[bvh.tris[t].prim].p) ASSERT_TRUE(inside(p));
+          if (bvh.tris[t].flags & BVH_TRI_LAST) break;
+        }
+      } else {
+        ASSERT_GT(c, 0);
+        const dev::BvhNode& child = bvh.nodes[c];
+        for (int k = 0; k < 4; ++k) {
+          if (child.lo_x[k] > child.hi_x[k]) continue;
+          ASSERT_TRUE(inside(glm::vec3(child.lo_x[k], child.lo_y[k], child.lo_z[k])));
+          ASSERT_TRUE(inside(glm::vec3(child.hi_x[k], child.hi_y[k], child.hi_z[k])));
+        }
+        todo.push_back({c, pushes});
+      }
+    }
+  }
+  for (int c : covered) ASSERT_EQ(c, 1);
+  for (int n : node_seen) ASSERT_EQ(n, 1);
+  EXPECT_LE(max_pushes, BVH_STACK_SIZE);
+}
+
+TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Tri> tris;
+  for (int i = 0; i < 5000; ++i) {
+    glm::vec3 c(u(rng), u(rng), u(rng));
+    tris.push_back(make_tri(c, c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.05f * glm::vec3(u(rng), u(rng), u(rng))));
+  }
+  // Many copies of one triangle: no spatial split exists
+  for (int i = 0; i < 100; ++i) tris.push_back(tris[0]);
+  check_bvh(Soup(tris).bvh, tris);
+}
+
+// A chain of ever smaller triangles, split off a few at a time: a deep tree stays within
+// the depth limit and the traversal stack
+TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
+  std::vector<Tri> tris;
+  for (int i = 0; i < 120; ++i) {
+    float s = std::ldexp(1.0f, -i), x = s;
+    tris.push_back(make_tri(glm::vec3(x, 0, 0), glm::vec3(x + 0.01f * s, 0.01f * s, 0), glm::vec3(x, 0, 0.01f * s)));
+  }
+  Bvh bvh = Soup(tris).bvh;
+  EXPECT_GT(bvh.depth, 30);
+  check_bvh(bvh, tris);
+}
+
+// The parallel builder gives the same tree, byte for byte, on any number of threads: the
+// top of the tree is built with parallel binning and subtrees on threads of their own,
+// the rest as jobs on a pool, joined in a fixed order. 150k triangles are enough for
+// both (parallel binning from 32768 refs, jobs of at most max(4096, refs / 128)).
+TEST(BvhBuilder, SameTreeOnAnyThreadCount) {
+  std::vector<Tri> tris = icosphere(6, glm::vec3(0.0f), 1.0f);  // 81920 triangles
+  std::vector<Tri> more = icosphere(5, glm::vec3(3.0f, 0.5f, 0.0f), 0.5f);  // 20480, apart
+  tris.insert(tris.end(), more.begin(), more.end());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+  for (int i = 0; i < 50000; ++i) {  // and a cloud of small triangles
+    glm::vec3 c(u(rng), u(rng), u(rng));
+    tris.push_back(make_tri(c, c + 0.02f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.02f * glm::vec3(u(rng), u(rng), u(rng))));
+  }
+  Soup soup(tris);  // default thread count
+  check_bvh(soup.bvh, tris);
+  double cost = sah_cost(soup.bvh);
+  EXPECT_GT(cost, 1.0);
+  for (int threads : {1, 2, 3, 8}) {
+    Bvh bvh = build_bvh(soup.positions, soup.prims, {}, threads);
+    ASSERT_EQ(bvh.nodes.size(), soup.bvh.nodes.size()) << threads << " threads";
+    ASSERT_EQ(bvh.tris.size(), soup.bvh.tris.size());
+    EXPECT_EQ(0, std::memcmp(bvh.nodes.data(), soup.bvh.nodes.data(), bvh.nodes.size() * sizeof(bvh.nodes[0])))
+        << threads << " threads";
+    EXPECT_EQ(0, std::memcmp(bvh.tris.data(), soup.bvh.tris.data(), bvh.tris.size() * sizeof(bvh.tris[0])))
+        << threads << " threads";
+    EXPECT_EQ(bvh.depth, soup.bvh.depth);
+    EXPECT_EQ(sah_cost(bvh), cost);
+  }
+}
+
+TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
+  DeviceEntry device;
+  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
+  KernelRig rig(device);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Tri> scene = icosphere(2, glm::vec3(0.3f, -0.2f, 0.1f), 0.6f);
+  for (int i = 0; i < 2000; ++i) {
+    glm::vec3 c(u(rng), u(rng), u(rng));
+    float s = 0.02f + 0.15f * std::fabs(u(rng));
+    scene.push_back(make_tri(c, c + s * glm::vec3(u(rng), u(rng), u(rng)), c + s * glm::vec3(u(rng), u(rng), u(rng))));
+  }
+  Bvh bvh = Soup(scene).bvh;
+  std::vector<cl_float4> rays;
+  for (int i = 0; i < 20000; ++i) {
+    glm::vec3 o = 1.5f * glm::vec3(u(rng), u(rng), u(rng));
+    glm::vec3 d = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+    if (i % 10 == 0) d = glm::vec3(0, 0, 0), d[i % 3] = u(rng) < 0 ? -1.0f : 1.0f;  // axis-aligned
+    float tmax = i % 4 == 0 ? 0.5f + 2.0f * std::fabs(u(rng)) : INFINITY;
+    rays.push_back(f4(o, tmax));
+    rays.push_back(f4(d, 0));
+  }
+  GpuTrace gpu = trace(rig, bvh, rays);
+  int hits = 0, checked = 0;
+  for (size_t i = 0; i < rays.size() / 2; ++i) {
+    glm::dvec3 o(rays[2 * i].s[0], rays[2 * i].s[1], rays[2 * i].s[2]);
+    glm::dvec3 d(rays[2 * i + 1].s[0], rays[2 * i + 1].s[1], rays[2 * i + 1].s[2]);
+    HostHit ref = host_closest_hit(scene, o, d, rays[2 * i].s[3]);
+    const cl_float4& h = gpu.bvh_hits[i];
+    // BVH and brute force in the kernel share one intersection routine: identical
+    ASSERT_EQ(h.s[3], gpu.brute_hits[i].s[3]) << "ray " << i;
+    ASSERT_EQ(h.s[0], gpu.brute_hits[i].s[0]) << "ray " << i;
+    ASSERT_EQ(gpu.occluded[i], h.s[3] >= 0 ? 1 : 0) << "ray " << i;
+    if (ref.tri >= 0 && ref.margin < 1e-5) continue;  // within float error of an edge
+    ++checked;
+    ASSERT_EQ(h.s[3] >= 0, ref.tri >= 0) << "ray " << i << " host t " << ref.t;
+    if (ref.tri < 0) continue;
+    ++hits;
+    EXPECT_NEAR(h.s[0], ref.t, 1e-5 * (1.0 + ref.t)) << "ray " << i;
+    int kernel_tri = int(h.s[3]);  // stable primitive index
+    if (kernel_tri != ref.tri) {
+      // Another triangle at the same distance (overlapping soup): accept only a tie
+      HostHit alt = host_closest_hit({scene[kernel_tri]}, o, d, INFINITY);
+      EXPECT_NEAR(alt.t, ref.t, 1e-5 * (1.0 + ref.t)) << "ray " << i;
+    }
+  }
+  EXPECT_GT(checked, 19000);
+  EXPECT_GT(hits, 3000);
+}
+
+TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
+  DeviceEntry device;
+  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
+  KernelRig rig(device);
+  glm::vec3 center(0.1f, 0.2f, -0.3f);
+  std::vector<Tri> sphere = icosphere(3, center, 2.0f);
+  Bvh bvh = Soup(sphere).bvh;
+  // From points inside, aim exactly at every vertex and every edge midpoint
+  std::vector<glm::vec3> origins = {center, center + glm::vec3(0.3f, -0.5f, 0.2f), center + glm::vec3(-1.1f, 0.4f, 0.6f)};
+  std::vector<cl_float4> rays;
+  for (const auto& o : origins)
+    for (const auto& t : sphere)
+      for (int k = 0; k < 3; ++k) {
+        for (glm::vec3 target : {t.p[k], 0.5f * (t.p[k] + t.p[(k + 1) % 3])}) {
+          rays.push_back(f4(o, INFINITY));
+          rays.push_back(f4(glm::normalize(target - o), 0));
+        }
+      }
+  GpuTrace gpu = trace(rig, bvh, rays);
+  int leaks = 0;
+  for (size_t i = 0; i < rays.size() / 2; ++i) {
+    const cl_float4& h = gpu.bvh_hits[i];
+    glm::vec3 o(rays[2 * i].s[0], rays[2 * i].s[1], rays[2 * i].s[2]);
+    glm::vec3 d(rays[2 * i + 1].s[0], rays[2 * i + 1].s[1], rays[2 * i + 1].s[2]);
+    if (h.s[3] < 0) {
+      ++leaks;
+      continue;
+    }
+    // The hit lies on the sphere's surface, between inscribed facets and the sphere
+    float r = glm::length(o + h.s[0] * d - center);
+    EXPECT_LE(r, 2.0f * 1.0001f);
+    EXPECT_GE(r, 2.0f * 0.99f);
+  }
+  EXPECT_EQ(leaks, 0) << "of " << rays.size() / 2 << " rays through edges and vertices";
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, BvhTest, ::testing::Values("pocl", "rusticl"),
+                         [](const auto& info) { return std::string(info.param); });
+
+}  // namespace candela::test
