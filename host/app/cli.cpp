@@ -52,6 +52,7 @@ struct RenderArgs {
   bool no_default_light = false;
   std::string stats;
   float exposure = 0.0f;
+  std::string tonemap = "neutral";
   std::string look_from, look_at, up;
   std::optional<float> fov;  // degrees
   std::optional<float> aperture, focus_distance;
@@ -486,6 +487,8 @@ int run_render(RenderArgs a) {
   if (!a.strategy.empty()) parse_strategy(a.strategy);  // a bad name fails before loading
   settings.filter = parse_filter(a.filter);
   settings.sampler = parse_sampler(a.sampler);
+  parse_tonemap(a.tonemap);  // a bad name fails before loading
+  if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number of stops");
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
   check_variance_path(a);
@@ -532,7 +535,7 @@ int run_render(RenderArgs a) {
       {"sampler", a.sampler},
       {"sample_offset", std::to_string(a.sample_offset)}};
   for (const auto& out : a.outputs) {
-    write_image(out, r.film, meta, a.exposure);
+    write_image(out, r.film, meta, {a.exposure, parse_tonemap(a.tonemap)});
     std::printf("wrote %s\n", out.c_str());
   }
   write_variance_output(a, r.film, meta);
@@ -550,7 +553,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   RenderArgs& a = *args;
   auto* render = app->add_subcommand("render", "Render a glTF scene");
   render->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
-  render->add_option("-o,--output", a.outputs, "Output image, .exr (linear) or .png (sRGB); repeatable")->required();
+  render->add_option("-o,--output", a.outputs, "Output image: .exr (linear), .png or .jpg (tone-mapped sRGB, --tonemap); repeatable")->required();
   auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(CLI::Range(1u, 1u << 24));
   render->add_option("--time", a.time, "Render for this many seconds instead of a sample count")
       ->check(CLI::PositiveNumber)
@@ -572,7 +575,9 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_flag("--no-default-light", a.no_default_light,
                    "Keep a scene without any light black instead of lighting it with the built-in sky");
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
-  render->add_option("--exposure", a.exposure, "PNG exposure in stops (default 0)");
+  render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear");
+  render->add_option("--tonemap", a.tonemap,
+                     "Display transform of PNG/JPEG outputs: neutral (Khronos PBR Neutral, default), agx (as Blender 4) or clamp");
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");

@@ -42,6 +42,7 @@ Film merge_films(const Film& a, const Film& b) {
 
 namespace {
 
+// sRGB encoding (IEC 61966-2-1) of a display-linear value
 float linear_to_srgb(float c) {
   c = std::clamp(c, 0.0f, 1.0f);
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
@@ -57,22 +58,25 @@ std::string lower_extension(const std::string& path) {
 
 void check_output_path(const std::string& path) {
   std::string ext = lower_extension(path);
-  if (ext != ".exr" && ext != ".png") throw Error("output must end in .exr or .png: " + path);
+  if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg")
+    throw Error("output must end in .exr, .png or .jpg: " + path);
 }
 
 void write_image(const std::string& path, const Film& film,
-                 const std::map<std::string, std::string>& metadata, float exposure) {
+                 const std::map<std::string, std::string>& metadata, const DisplayTransform& display) {
   check_output_path(path);
   bool exr = lower_extension(path) == ".exr";
 
   std::vector<float> rgb(film.pixels() * 3);
-  float scale = std::exp2(exposure);
-  for (size_t i = 0; i < film.pixels(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      float v = film.mean[4 * i + c];
-      rgb[3 * i + c] = exr ? v : linear_to_srgb(v * scale);
-    }
-  write_rgb_pixels(path, film.width, film.height, rgb, exr, metadata);
+  float scale = std::exp2(display.exposure);
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    glm::vec3 v = film.pixel(i);
+    if (!exr) v = tonemap_apply(display.tonemap, v * scale);
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = exr ? v[c] : linear_to_srgb(v[c]);
+  }
+  std::map<std::string, std::string> meta = metadata;
+  if (!exr) meta["tonemap"] = tonemap_name(display.tonemap);
+  write_rgb_pixels(path, film.width, film.height, rgb, exr, meta);
 }
 
 void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,

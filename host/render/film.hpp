@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "render/tonemap.hpp"
+
 namespace candela {
 
 struct Film {
@@ -28,18 +30,24 @@ struct Film {
 // (Chan, Golub and LeVeque 1979, parallel variance update).
 Film merge_films(const Film& a, const Film& b);
 
-// Throws Error unless the path ends in .exr or .png (case-insensitive)
+// Throws Error unless the path ends in .exr, .png, .jpg or .jpeg (case-insensitive)
 void check_output_path(const std::string& path);
 
 // Writes width x height RGB pixels (3 floats each) to path: float channels (.exr) or 8-bit
-// ones (.png, the values already encoded), with each metadata entry as attribute candela:KEY
+// ones (.png, .jpg, the values already encoded), with each metadata entry as attribute candela:KEY
 // and Software = candela VERSION; throws Error naming the path when it cannot
 void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,
                       bool float_channels, const std::map<std::string, std::string>& metadata);
 
-// Writes OUT.exr (linear float RGB + metadata) or OUT.png (exposure-scaled, clamped,
-// sRGB, 8 bit). Other extensions throw Error.
+// How radiance becomes an 8-bit display value: scaled by 2^exposure, tone-mapped, sRGB-encoded
+struct DisplayTransform {
+  float exposure = 0.0f;  // stops
+  Tonemap tonemap = Tonemap::Neutral;
+};
+
+// Writes OUT.exr (linear float RGB + metadata, no display transform) or OUT.png / OUT.jpg
+// (8-bit sRGB through `display`). Other extensions throw Error.
 void write_image(const std::string& path, const Film& film,
-                 const std::map<std::string, std::string>& metadata, float exposure = 0.0f);
+                 const std::map<std::string, std::string>& metadata, const DisplayTransform& display = {});
 
 }  // namespace candela

@@ -43,7 +43,7 @@ expect_error "device index out of range" "there are only" -- "$bin" render "$sce
 mkdir -p "$tmp/no-vendors"
 expect_error "no OpenCL platform" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$scene" -o "$tmp/x.png"
 expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" devices
-expect_error "bad output extension" "must end in .exr or .png" -- "$bin" render "$scene" -o "$tmp/x.jpg" --device pocl
+expect_error "bad output extension" "must end in .exr, .png or .jpg" -- "$bin" render "$scene" -o "$tmp/x.tiff" --device pocl
 expect_error "bad strategy" "strategy must be nee, bsdf or auto" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
 expect_error "bad background" "three comma-separated numbers" -- "$bin" render "$scene" -o "$tmp/x.png" --background 1,2 --device pocl
 expect_error "zero field of view" "fov must be between 0 and 180" -- "$bin" render "$scene" -o "$tmp/x.png" --fov 0 --device pocl
