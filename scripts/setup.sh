@@ -11,7 +11,7 @@ CANDELA_PACKAGES=(
   libtinygltf-dev nlohmann-json3-dev
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
   googletest libgtest-dev
-  python3-numpy python3-openimageio python3-matplotlib
+  python3-numpy python3-openimageio python3-matplotlib python3-pil
 )
 # A script sourcing this may add packages (scripts/fuzz: clang and libFuzzer)
 read -r -a _candela_extra <<<"${CANDELA_EXTRA_PACKAGES:-}"
