@@ -1,11 +1,13 @@
 #include "render/film.hpp"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 
+#include "base/atomic_file.hpp"
 #include "base/error.hpp"
 
 namespace candela {
@@ -48,6 +50,8 @@ float linear_to_srgb(float c) {
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
@@ -57,6 +61,7 @@ std::string lower_extension(const std::string& path) {
 }  // namespace
 
 void check_output_path(const std::string& path) {
+  check_writable_path(path);
   std::string ext = lower_extension(path);
   if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg")
     throw Error("output must end in .exr, .png or .jpg: " + path);
@@ -84,12 +89,16 @@ void write_rgb_pixels(const std::string& path, int width, int height, const std:
   OIIO::ImageSpec spec(width, height, 3, float_channels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   for (const auto& [key, value] : metadata) spec.attribute("candela:" + key, value);
   spec.attribute("Software", "candela " CANDELA_VERSION);
+  // Encoded in memory (no encoder meets a full disk half way), then written atomically
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput memory(bytes);
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error("cannot write " + path + ": " + OIIO::geterror());
-  if (!out->open(path, spec)) throw Error("cannot write " + path + ": " + out->geterror());
-  bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
+  if (!out) throw Error("cannot write " + path + ": " + first_line(OIIO::geterror()));
+  out->set_ioproxy(&memory);
+  bool ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
   ok = out->close() && ok;
-  if (!ok) throw Error("cannot write " + path + ": " + out->geterror());
+  if (!ok || bytes.empty()) throw Error("cannot encode " + path + ": " + first_line(out->geterror()));
+  write_file_atomically(path, bytes.data(), bytes.size());
 }
 
 }  // namespace candela

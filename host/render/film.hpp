@@ -30,12 +30,14 @@ struct Film {
 // (Chan, Golub and LeVeque 1979, parallel variance update).
 Film merge_films(const Film& a, const Film& b);
 
-// Throws Error unless the path ends in .exr, .png, .jpg or .jpeg (case-insensitive)
+// Throws Error unless the path ends in .exr, .png, .jpg or .jpeg (case-insensitive) and its
+// folder exists and can be written (check_writable_path)
 void check_output_path(const std::string& path);
 
 // Writes width x height RGB pixels (3 floats each) to path: float channels (.exr) or 8-bit
 // ones (.png, .jpg, the values already encoded), with each metadata entry as attribute candela:KEY
-// and Software = candela VERSION; throws Error naming the path when it cannot
+// and Software = candela VERSION, atomically (write_file_atomically: a failure leaves an
+// existing file as it was); throws Error naming the path when it cannot
 void write_rgb_pixels(const std::string& path, int width, int height, const std::vector<float>& rgb,
                       bool float_channels, const std::map<std::string, std::string>& metadata);
 
