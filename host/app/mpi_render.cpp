@@ -1,8 +1,13 @@
+// `candela render --mpi` (mpi_render.hpp): the MPI session, the sample blocks and the films' gathering.
 #include "app/mpi_render.hpp"
 
+#include <cstdio>
 #include <cstdlib>
+#include <string>
 
+#include "app/render_command.hpp"
 #include "base/error.hpp"
+#include "device/device.hpp"
 
 #ifdef CANDELA_WITH_MPI
 #include <mpi.h>
@@ -79,5 +84,47 @@ Film mpi_gather_films(const MpiSession&, const Film&, uint32_t*, double*, bool*,
 void mpi_abort(int code) { std::_Exit(code); }
 
 #endif
+
+namespace {
+MpiSession* g_mpi = nullptr;  // the job's session while a render runs under it
+}  // namespace
+
+int run_render_under_mpi(const RenderArgs& a, int (*run)(RenderArgs)) {
+  MpiSession session;
+  g_mpi = &session;
+  try {
+    int rc = run(a);
+    g_mpi = nullptr;
+    return rc;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), cl_error_message(e.what(), e.err()).c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "candela: error: rank %d: %s\n", session.rank(), e.what());
+  }
+  std::fflush(stderr);
+  if (session.size() > 1) mpi_abort(1);
+  g_mpi = nullptr;
+  return 1;
+}
+
+int mpi_ranks() { return g_mpi ? g_mpi->size() : 0; }
+
+uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
+  if (!g_mpi) return a->sample_offset;
+  if (*spp == 0) throw Error("--mpi needs --spp: each rank renders a fixed block of the sample indices");
+  if (*spp < uint32_t(g_mpi->size()))
+    throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) + " ranks");
+  uint32_t begin = 0, count = 0;
+  mpi_block(*spp, g_mpi->rank(), g_mpi->size(), &begin, &count);
+  if (g_mpi->rank() != 0) a->quiet = true;
+  *spp = count;
+  return a->sample_offset + begin;
+}
+
+bool mpi_combine(RenderResult* r) {
+  if (!g_mpi) return true;
+  r->film = mpi_gather_films(*g_mpi, r->film, &r->spp, &r->seconds, &r->interrupted, &r->partial_pass);
+  return g_mpi->rank() == 0;
+}
 
 }  // namespace candela

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "render/film.hpp"
+#include "render/renderer.hpp"
 
 namespace candela {
 
@@ -40,5 +41,22 @@ Film mpi_gather_films(const MpiSession& s, const Film& film, uint32_t* spp, doub
 
 // Ends the whole job after an error on one rank (the others may wait in a collective)
 [[noreturn]] void mpi_abort(int code);
+
+struct RenderArgs;
+
+// `render --mpi`: `run` inside the job's session; an error on one rank ends the job (the
+// others would wait for its film for ever)
+int run_render_under_mpi(const RenderArgs& args, int (*run)(RenderArgs));
+
+// The ranks of the job a render runs under (run_render_under_mpi), else 0
+int mpi_ranks();
+
+// This rank's first sample index, and in *spp its sample count: its block of the render's
+// under --mpi (other ranks than 0 then render quietly), else --sample-offset and *spp as is
+uint32_t mpi_shard(RenderArgs* args, uint32_t* spp);
+
+// Under --mpi, rank 0 gets every rank's samples merged into its result; returns whether
+// this rank writes the outputs (rank 0 only; every rank without --mpi)
+bool mpi_combine(RenderResult* result);
 
 }  // namespace candela

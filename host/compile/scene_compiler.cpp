@@ -531,8 +531,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   const SceneFeatures needed = scene.features();
   if (!features.covers(needed))
     throw Error("compile_scene: the kernel features leave out some the scene needs");
-  c.camera = resolve_camera(scene);
-  check_extent(scene, c.camera);
+  check_extent(scene, resolve_camera(scene));
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);
   compile_textures(scene, &c.buffers);

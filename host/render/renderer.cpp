@@ -1,3 +1,4 @@
+// Rendering a compiled scene on devices (renderer.hpp): the device workers and the sample scheduler.
 #include "render/renderer.hpp"
 
 #include <algorithm>
@@ -57,7 +58,7 @@ void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
 
 }  // namespace
 
-DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene,
+DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const dev::Camera& camera,
                                const RenderSettings& settings, CompiledScene* release)
     : device_(device), settings_(settings) {
   check_settings(device, settings);
@@ -89,7 +90,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
     scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
         ggx_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
 
-  params_host_.camera = make_device_camera(scene.camera, settings.width, settings.height);
+  params_host_.camera = camera;
   params_host_.width = uint32_t(settings.width);
   params_host_.height = uint32_t(settings.height);
   params_host_.seed = settings.seed;
@@ -298,27 +299,24 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
   return result;
 }
 
-Renderer::Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings)
-    : Renderer(device, std::make_shared<const CompiledScene>(compile_scene(scene)), settings) {}
-
-Renderer::Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+Renderer::Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene, const dev::Camera& camera,
                    const RenderSettings& settings)
-    : Renderer(std::vector<DeviceEntry>{device}, std::move(scene), settings) {}
+    : Renderer(std::vector<DeviceEntry>{device}, std::move(scene), camera, settings) {}
 
 Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
-                   const RenderSettings& settings)
+                   const dev::Camera& camera, const RenderSettings& settings)
     : scene_(std::move(scene)) {
   if (devices.empty()) throw Error("a render needs at least one device");
-  for (const auto& d : devices) workers_.push_back(std::make_unique<DeviceRenderer>(d, *scene_, settings));
+  for (const auto& d : devices) workers_.push_back(std::make_unique<DeviceRenderer>(d, *scene_, camera, settings));
 }
 
 Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
-                   const RenderSettings& settings, bool release_host_arrays)
+                   const dev::Camera& camera, const RenderSettings& settings, bool release_host_arrays)
     : scene_(scene) {
   if (devices.empty()) throw Error("a render needs at least one device");
   for (size_t i = 0; i < devices.size(); ++i)
     workers_.push_back(std::make_unique<DeviceRenderer>(
-        devices[i], *scene_, settings, release_host_arrays && i + 1 == devices.size() ? scene.get() : nullptr));
+        devices[i], *scene_, camera, settings, release_host_arrays && i + 1 == devices.size() ? scene.get() : nullptr));
   if (release_host_arrays) scene->release_host_arrays();
 }
 

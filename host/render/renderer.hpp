@@ -1,7 +1,7 @@
-// Rendering a compiled scene: a DeviceRenderer per device (context, queue, program,
-// buffers, film) renders given ranges of sample indices; render_samples hands ranges out
-// to one or more of them and merges their films. Renderer bundles the common case: one
-// scene, compiled once, on one device.
+// Rendering a compiled scene through a device camera: a DeviceRenderer per device (context,
+// queue, program, buffers, film) renders given ranges of sample indices; render_samples hands
+// ranges out to one or more of them and merges their films. Renderer bundles the common
+// case: one compiled scene on one device or several.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -11,10 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "base/device_types.hpp"
+#include "base/enum_names.hpp"
+#include "compile/compiled_scene.hpp"
 #include "device/device.hpp"
 #include "render/film.hpp"
-#include "scene/scene.hpp"
-#include "compile/scene_compiler.hpp"
 
 namespace candela {
 
@@ -26,6 +27,19 @@ enum class PixelFilter : uint32_t { Box = FILTER_BOX, Tent = FILTER_TENT, Gaussi
 // Where the kernels' random numbers come from (cl/core/rng.cl): Owen-scrambled Sobol
 // (stratified) or independent hashes; a build option of the kernel program
 enum class Sampler : uint32_t { Sobol, Independent };
+
+// Each enum's names (the CLI's options, --stats, the EXR metadata) and help notes
+inline constexpr EnumName<Strategy> kStrategyNames[] = {
+    {Strategy::Nee, "nee", "next-event estimation"},
+    {Strategy::Bsdf, "bsdf", "BSDF sampling only"},
+    {Strategy::Auto, "auto", "per vertex: bsdf at near-specular surfaces, nee elsewhere"}};
+inline constexpr EnumName<PixelFilter> kPixelFilterNames[] = {
+    {PixelFilter::Box, "box", "default"},
+    {PixelFilter::Tent, "tent", "radius 1 pixel"},
+    {PixelFilter::Gaussian, "gaussian", "sigma 0.5 pixel"}};
+inline constexpr EnumName<Sampler> kSamplerNames[] = {
+    {Sampler::Sobol, "sobol", "Owen-scrambled Sobol, stratified; default"},
+    {Sampler::Independent, "independent", ""}};
 
 // The film's per-pixel sample count is a float: exact up to 2^24
 constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
@@ -64,11 +78,12 @@ struct RenderResult {
 class DeviceRenderer {
  public:
   // Builds the kernel program for the scene's features, uploads the scene buffers and,
-  // with energy compensation, the GGX albedo table (host/device/energy.hpp)
+  // with energy compensation, the GGX albedo table (host/device/energy.hpp). `camera`:
+  // the device record for settings.width x settings.height (compile/camera.hpp).
   // `release`: the same scene, whose host arrays are freed one by one once uploaded (for
   // the last device that uploads them; CompiledScene::release_host_arrays)
-  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const RenderSettings& settings,
-                 CompiledScene* release = nullptr);
+  DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const dev::Camera& camera,
+                 const RenderSettings& settings, CompiledScene* release = nullptr);
 
   // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
   // of about settings.launch_seconds over ranges of pixels. `stop` is polled between
@@ -116,21 +131,20 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
                             const std::function<void(const RenderProgress&)>& progress = {},
                             const std::function<bool()>& stop = {});
 
-// A scene compiled once and rendered on one device, or on several (one worker each,
-// sharing the ranges of sample indices)
+// A scene compiled once and rendered through one camera on one device, or on several
+// (one worker each, sharing the ranges of sample indices)
 class Renderer {
  public:
-  Renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
-  Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene,
+  Renderer(const DeviceEntry& device, std::shared_ptr<const CompiledScene> scene, const dev::Camera& camera,
            const RenderSettings& settings);
   // One DeviceRenderer per entry (an entry listed twice gets two workers); builds the
   // kernels one device after the other. Throws Error when `devices` is empty.
   Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<const CompiledScene> scene,
-           const RenderSettings& settings);
+           const dev::Camera& camera, const RenderSettings& settings);
   // The same, and then the scene's host arrays are freed as the last device uploads them
   // (CompiledScene::release_host_arrays): for a caller that needs them no more (the CLI)
   Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
-           const RenderSettings& settings, bool release_host_arrays);
+           const dev::Camera& camera, const RenderSettings& settings, bool release_host_arrays);
 
   RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
                       const std::function<void(const RenderProgress&)>& progress = {},

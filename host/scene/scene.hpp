@@ -224,8 +224,5 @@ CameraDesc framing_camera(const Scene& scene);
 // invalid camera (negative aperture, non-positive focus distance, a lens on an
 // orthographic camera).
 CameraDesc resolve_camera(const Scene& scene);
-// Device record for an image of width x height. The vertical extent (yfov or ymag) is
-// kept and the horizontal one follows from width / height.
-dev::Camera make_device_camera(const CameraDesc& cam, int width, int height);
 
 }  // namespace candela

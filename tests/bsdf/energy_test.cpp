@@ -449,7 +449,7 @@ TEST_P(EnergyFurnaceTest, WhiteRoughMetalSphereVanishes) {
       s.strategy = strategy;
       s.energy_compensation = compensate;
       s.seed = 5;
-      Renderer renderer(device, scene, s);
+      Renderer renderer = scene_renderer(device, scene, s);
       RenderResult r = renderer.render(0, 256);
       Estimate e = region_mean(r.film, 1, 8, 24, 8, 24);  // a square inside the sphere's outline
       std::printf("%s, compensation %s: sphere mean %.5f +- %.5f\n", strategy == Strategy::Nee ? "nee" : "bsdf",

@@ -146,7 +146,7 @@ Film render(const DeviceEntry& device, const Scene& scene, int w, int h, uint32_
   settings.max_depth = 0;
   settings.filter = filter;
   settings.seed = seed;
-  return Renderer(device, scene, settings).render(0, spp).film;
+  return scene_renderer(device, scene, settings).render(0, spp).film;
 }
 
 // The edge scene: a camera at the origin looking down -z with tan(yfov/2) = 1/8 on a

@@ -264,7 +264,7 @@ TEST(SamplerConvergence, SobolBeatsIndependentOnAnAreaLitFloor) {
     settings.max_depth = 1;
     settings.sampler = sampler;
     settings.seed = seed;
-    return Renderer(pocl_device(), scene, settings).render(0, spp).film;
+    return scene_renderer(pocl_device(), scene, settings).render(0, spp).film;
   };
   Film reference = render(Sampler::Sobol, 1000, 4096);
   auto rel_mse = [&](const Film& f) {

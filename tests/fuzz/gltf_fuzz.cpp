@@ -11,6 +11,7 @@
 #include <string>
 
 #include "compile/bvh_builder.hpp"
+#include "compile/camera.hpp"
 #include "base/error.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "compile/scene_compiler.hpp"
@@ -26,7 +27,7 @@ void require(bool ok, const char* what) {
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // What the kernels assume of the scene buffers: every index lands inside its array
-void check_compiled(const candela::CompiledScene& c) {
+void check_compiled(const candela::CompiledScene& c, const candela::CameraDesc& camera) {
   const candela::dev::SceneBuffers& b = c.buffers;
   size_t vertices = b.positions.size() / 3;
   require(b.positions.size() == 3 * vertices && b.normals.size() == b.positions.size(), "vertex arrays");
@@ -81,7 +82,7 @@ void check_compiled(const candela::CompiledScene& c) {
       }
     }
   require(c.bvh_depth <= candela::kMaxBvhDepth, "BVH depth");
-  require(finite3(c.camera.position) && finite3(c.camera.forward) && finite3(c.camera.up), "finite camera");
+  require(finite3(camera.position) && finite3(camera.forward) && finite3(camera.up), "finite camera");
 }
 
 }  // namespace
@@ -92,8 +93,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // No base folder: external URIs cannot reach the file system
     candela::Scene scene = candela::load_gltf_from_memory(bytes, "");
     candela::CompiledScene compiled = candela::compile_scene(scene);
-    check_compiled(compiled);
-    candela::make_device_camera(compiled.camera, 64, 48);
+    check_compiled(compiled, candela::resolve_camera(scene));
+    candela::compile_camera(scene, 64, 48);
   } catch (const candela::Error& e) {
     require(e.what()[0] != '\0', "an Error without a message");  // expected: bad input, told clearly
   }

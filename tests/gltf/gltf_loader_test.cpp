@@ -235,7 +235,7 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 2;
-  Film f = Renderer(pocl_device(), s, settings).render(0, 16).film;
+  Film f = scene_renderer(pocl_device(), s, settings).render(0, 16).film;
   // Radiance equals the albedo (white background of 1, nothing else to see): the
   // colour at screen x is the linear blend of red (x = -1) and blue (x = +1)
   double half_width = 3.0 * std::tan(0.25);
@@ -332,7 +332,7 @@ TEST(GltfLoader, BaseColorTextureIsSrgbDecodedAndRendered) {
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 4;
-  Renderer r(pocl_device(), s, settings);
+  Renderer r = scene_renderer(pocl_device(), s, settings);
   Film f = r.render(0, 64).film;
   // Quad spans the whole view; the left and right quarters see only their texel (clamped).
   // Background sampling has variance: compare within 4 measured standard errors

@@ -137,7 +137,7 @@ class PunctualRender : public ::testing::TestWithParam<std::string> {
     settings.width = settings.height = view.size;
     settings.max_depth = 1;  // direct light only
     settings.seed = 7;
-    return Renderer(device_, scene, settings).render(0, spp).film;
+    return scene_renderer(device_, scene, settings).render(0, spp).film;
   }
 
   // Pixel (x, y) against its expected value within 5 standard errors of the jitter's noise
@@ -345,7 +345,7 @@ TEST(PunctualLights, ContributeNothingUnderBsdfStrategy) {
   RenderSettings settings;
   settings.width = settings.height = 8;
   settings.strategy = Strategy::Bsdf;
-  Renderer r(pocl_device(), s, settings);
+  Renderer r = scene_renderer(pocl_device(), s, settings);
   EXPECT_EQ(r.lights(), 1u);
   EXPECT_EQ(image_mean(r.render(0, 16).film).mean, 0.0);
 }

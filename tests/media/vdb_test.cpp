@@ -323,7 +323,7 @@ TEST(VolumeVdbFurnace, RotatedFogSphereIsInvisible) {
   settings.width = settings.height = 16;
   settings.max_depth = 1000;
   settings.seed = 17;
-  Film f = Renderer(*device_by_name("pocl"), scene, settings).render(0, 128).film;
+  Film f = scene_renderer(*device_by_name("pocl"), scene, settings).render(0, 128).film;
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01);
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << "SE " << e.standard_error;
@@ -332,7 +332,7 @@ TEST(VolumeVdbFurnace, RotatedFogSphereIsInvisible) {
   GltfBuilder g2;
   g2.add_camera(glm::vec3(0.0f, 0.3f, 2.5f), glm::vec3(0.0f), 0.6f);
   g2.set_background(glm::vec3(1.0f));
-  Film dark = Renderer(*device_by_name("pocl"), grid_scene(medium, "fog-absorbing", &g2), settings).render(0, 16).film;
+  Film dark = scene_renderer(*device_by_name("pocl"), grid_scene(medium, "fog-absorbing", &g2), settings).render(0, 16).film;
   Estimate mid = region_mean(dark, 0, 5, 11, 5, 11);
   EXPECT_LT(mid.mean + 10.0 * mid.standard_error, 1.0);
 }

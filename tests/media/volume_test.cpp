@@ -275,7 +275,7 @@ Film render(const Scene& scene, Strategy s, int size, uint32_t spp, uint32_t max
   settings.strategy = s;
   settings.max_depth = max_depth;
   settings.seed = seed;
-  return Renderer(*device_by_name(device), scene, settings).render(0, spp).film;
+  return scene_renderer(*device_by_name(device), scene, settings).render(0, spp).film;
 }
 
 const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : "bsdf"; }

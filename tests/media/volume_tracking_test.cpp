@@ -508,7 +508,7 @@ Film render_furnace(const FurnaceCase& c, uint32_t seed) {
   s.strategy = c.strategy;
   s.max_depth = c.max_depth;
   s.seed = seed;
-  return Renderer(pocl_device(), load_scene(g, std::string("furnace-") + c.name), s).render(0, c.spp).film;
+  return scene_renderer(pocl_device(), load_scene(g, std::string("furnace-") + c.name), s).render(0, c.spp).film;
 }
 
 constexpr uint32_t kNoDepthCap = 1u << 24;  // never reached: paths end by escaping

@@ -127,10 +127,10 @@ TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 4;
-  Renderer nee(pocl_device(), scene, settings);
+  Renderer nee = scene_renderer(pocl_device(), scene, settings);
   settings.strategy = Strategy::Bsdf;
   settings.seed = 5;
-  Renderer bsdf(pocl_device(), scene, settings);
+  Renderer bsdf = scene_renderer(pocl_device(), scene, settings);
   Film a = nee.render(0, 64).film, b = bsdf.render(0, 256).film;
   Estimate ea = image_mean(a), eb = image_mean(b);
   double se = std::sqrt(ea.standard_error * ea.standard_error + eb.standard_error * eb.standard_error);
@@ -170,10 +170,10 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 2;
-  Film nee = Renderer(pocl_device(), scene, settings).render(0, 128).film;
+  Film nee = scene_renderer(pocl_device(), scene, settings).render(0, 128).film;
   settings.strategy = Strategy::Bsdf;
   settings.seed = 9;
-  Film bsdf = Renderer(pocl_device(), scene, settings).render(0, 1024).film;
+  Film bsdf = scene_renderer(pocl_device(), scene, settings).render(0, 1024).film;
   double left = 0.0, right = 0.0;
   for (int by = 0; by < 16; by += 4)
     for (int bx = 0; bx < 16; bx += 4) {
@@ -194,7 +194,7 @@ TEST(Render, TimeLimitShorterThanOnePassStillRendersOneSample) {
   RenderSettings settings;
   settings.width = settings.height = 32;
   settings.launch_seconds = 1e-9;  // one work-group of pixels per launch
-  RenderResult r = Renderer(pocl_device(), scene, settings).render(0, 0, 1e-9);
+  RenderResult r = scene_renderer(pocl_device(), scene, settings).render(0, 0, 1e-9);
   EXPECT_EQ(r.spp, 1u);
   EXPECT_FALSE(r.partial_pass);
   for (size_t i = 0; i < r.film.pixels(); ++i) ASSERT_EQ(r.film.samples(i), 1.0f) << "pixel " << i;
@@ -209,7 +209,7 @@ TEST(Render, BufferLargerThanTheDeviceAllowsIsAClearError) {
   RenderSettings settings;
   settings.width = settings.height = 8;
   try {
-    Renderer r(device, scene, settings);
+    Renderer r = scene_renderer(device, scene, settings);
     FAIL() << "no error";
   } catch (const Error& e) {
     std::string msg = e.what();
@@ -224,9 +224,9 @@ TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
   RenderSettings settings;
   settings.width = settings.height = 24;
   settings.seed = 42;
-  Renderer one(device, scene, settings);
+  Renderer one = scene_renderer(device, scene, settings);
   Film a = one.render(0, 12).film;
-  Renderer two(device, scene, settings);
+  Renderer two = scene_renderer(device, scene, settings);
   two.render(0, 5);
   two.render(5, 4);
   Film b = two.render(9, 3).film;
@@ -236,12 +236,12 @@ TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
   // Tiny launches: every launch covers one work-group of pixels and one sample
   RenderSettings tiny = settings;
   tiny.launch_seconds = 1e-9;
-  Film d = Renderer(device, scene, tiny).render(0, 12).film;
+  Film d = scene_renderer(device, scene, tiny).render(0, 12).film;
   EXPECT_EQ(a.mean, d.mean);
   EXPECT_EQ(a.m2, d.m2);
 
   settings.seed = 43;
-  Renderer other(device, scene, settings);
+  Renderer other = scene_renderer(device, scene, settings);
   Film c = other.render(0, 12).film;
   EXPECT_NE(a.mean, c.mean) << "a different seed must give a different image";
 }
@@ -251,9 +251,9 @@ TEST(Determinism, FilmsOfDisjointSampleRangesMergeToTheWholeRender) {
   Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
   RenderSettings settings;
   settings.width = settings.height = 16;
-  Film whole = Renderer(device, scene, settings).render(0, 16).film;
-  Film first = Renderer(device, scene, settings).render(0, 6).film;
-  Film second = Renderer(device, scene, settings).render(6, 10).film;
+  Film whole = scene_renderer(device, scene, settings).render(0, 16).film;
+  Film first = scene_renderer(device, scene, settings).render(0, 6).film;
+  Film second = scene_renderer(device, scene, settings).render(6, 10).film;
   Film merged = merge_films(first, second);
   for (size_t i = 0; i < whole.mean.size(); ++i) {
     EXPECT_NEAR(merged.mean[i], whole.mean[i], 1e-4f * (1.0f + std::fabs(whole.mean[i])));

@@ -15,15 +15,17 @@ namespace candela::test {
 // Two workers on PoCL (two contexts, one thread each) against one: the RNG is keyed by
 // sample index, so the merged film equals the single one up to the rounding of the merge
 TEST(Scheduler, TwoWorkersGiveTheSingleWorkerImage) {
-  auto scene = std::make_shared<const CompiledScene>(compile_scene(load_gltf(scene_path("cornell-box/cornell-box.gltf"))));
+  Scene loaded = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  auto scene = std::make_shared<const CompiledScene>(compile_scene(loaded));
   RenderSettings settings;
   settings.width = settings.height = 24;
   settings.seed = 3;
   settings.launch_seconds = 1e-3;  // many small ranges, so both workers get some
   DeviceEntry device = pocl_device();
-  Film one = Renderer(device, scene, settings).render(0, 40).film;
+  Film one = Renderer(device, scene, scene_camera(loaded, settings), settings).render(0, 40).film;
 
-  DeviceRenderer a(device, *scene, settings), b(device, *scene, settings);
+  DeviceRenderer a(device, *scene, scene_camera(loaded, settings), settings),
+      b(device, *scene, scene_camera(loaded, settings), settings);
   RenderResult two = render_samples({&a, &b}, 0, 40);
   EXPECT_EQ(two.spp, 40u);
   EXPECT_FALSE(two.partial_pass);
@@ -41,11 +43,13 @@ TEST(Scheduler, TwoWorkersGiveTheSingleWorkerImage) {
 
 // A time limit with two workers still ends with every pixel sampled at least once
 TEST(Scheduler, TimeLimitWithTwoWorkersKeepsWholeRanges) {
-  auto scene = std::make_shared<const CompiledScene>(compile_scene(load_gltf(scene_path("cornell-box/cornell-box.gltf"))));
+  Scene loaded = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  auto scene = std::make_shared<const CompiledScene>(compile_scene(loaded));
   RenderSettings settings;
   settings.width = settings.height = 16;
   DeviceEntry device = pocl_device();
-  DeviceRenderer a(device, *scene, settings), b(device, *scene, settings);
+  DeviceRenderer a(device, *scene, scene_camera(loaded, settings), settings),
+      b(device, *scene, scene_camera(loaded, settings), settings);
   RenderResult r = render_samples({&a, &b}, 0, 0, 0.3);
   EXPECT_GE(r.spp, 1u);
   for (size_t i = 0; i < r.film.pixels(); ++i) ASSERT_GE(r.film.samples(i), float(r.spp)) << "pixel " << i;
@@ -55,15 +59,16 @@ TEST(Scheduler, TimeLimitWithTwoWorkersKeepsWholeRanges) {
 // the single-device render, the shares of the samples adding up to all of them, and the
 // progress reporting each worker's samples
 TEST(Scheduler, RendererOnTwoDevicesReportsEachShare) {
-  auto scene = std::make_shared<const CompiledScene>(compile_scene(load_gltf(scene_path("cornell-box/cornell-box.gltf"))));
+  Scene loaded = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
+  auto scene = std::make_shared<const CompiledScene>(compile_scene(loaded));
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.seed = 5;
   settings.launch_seconds = 1e-3;
   DeviceEntry device = pocl_device();
-  Film one = Renderer(device, scene, settings).render(4, 24).film;
+  Film one = Renderer(device, scene, scene_camera(loaded, settings), settings).render(4, 24).film;
 
-  Renderer two({device, device}, scene, settings);
+  Renderer two({device, device}, scene, scene_camera(loaded, settings), settings);
   ASSERT_EQ(two.worker_count(), 2u);
   std::vector<double> last;
   RenderResult r = two.render(4, 24, 0.0, [&](const RenderProgress& p) { last = p.worker_spp; });
@@ -79,7 +84,7 @@ TEST(Scheduler, RendererOnTwoDevicesReportsEachShare) {
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(r.film.pixel(i)[c], one.pixel(i)[c], 1e-4f * (1.0f + one.pixel(i)[c])) << "pixel " << i;
   }
-  EXPECT_THROW(Renderer(std::vector<DeviceEntry>{}, scene, settings), Error);
+  EXPECT_THROW(Renderer(std::vector<DeviceEntry>{}, scene, scene_camera(loaded, settings), settings), Error);
 }
 
 }  // namespace candela::test

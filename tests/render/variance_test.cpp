@@ -236,7 +236,8 @@ TEST(Specialization, GenericAndSpecializedKernelsAgreeOnEveryShippedScene) {
     if (!scene.strategy.empty()) settings.strategy = scene.strategy == "bsdf" ? Strategy::Bsdf
                                                      : scene.strategy == "auto" ? Strategy::Auto
                                                                                 : Strategy::Nee;
-    Renderer r(device, std::make_shared<const CompiledScene>(compile_scene(scene, features)), settings);
+    Renderer r(device, std::make_shared<const CompiledScene>(compile_scene(scene, features)),
+               scene_camera(scene, settings), settings);
     RenderResult res = r.render(0, 32);
     return std::make_pair(as_image(res.film, tag), as_variance(res.film, tag));
   };

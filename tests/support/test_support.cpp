@@ -127,7 +127,7 @@ Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t s
 
 RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp,
                            const DeviceEntry& device) {
-  return Renderer(device, scene, settings).render(0, spp);
+  return scene_renderer(device, scene, settings).render(0, spp);
 }
 
 Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
@@ -135,6 +135,15 @@ Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t s
   return render_film(scene, strategy, w, h, spp, max_depth, seed, pocl_device());
 }
 
-const char* strategy_name(Strategy s) { return s == Strategy::Nee ? "nee" : s == Strategy::Bsdf ? "bsdf" : "auto"; }
+dev::Camera scene_camera(const Scene& scene, const RenderSettings& settings) {
+  return compile_camera(scene, settings.width, settings.height);
+}
+
+Renderer scene_renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings) {
+  return Renderer(device, std::make_shared<const CompiledScene>(compile_scene(scene)), scene_camera(scene, settings),
+                  settings);
+}
+
+const char* strategy_name(Strategy s) { return enum_name(kStrategyNames, s); }
 
 }  // namespace candela::test

@@ -11,6 +11,7 @@
 #include "base/device_types.hpp"
 #include "support/gltf_builder.hpp"
 #include "render/renderer.hpp"
+#include "compile/camera.hpp"
 #include "compile/scene_compiler.hpp"
 
 namespace candela::test {
@@ -66,6 +67,12 @@ Estimate image_mean(const Film& f);  // all pixels, channels averaged
 Estimate sample_mean(const std::vector<cl_float4>& samples, int c);
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
+
+// The device camera of `scene` for a settings.width x settings.height image
+dev::Camera scene_camera(const Scene& scene, const RenderSettings& settings);
+
+// A Renderer of `scene`, compiled, through its camera, on `device`
+Renderer scene_renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
 
 // A render of `scene` with `settings`, `spp` samples per pixel (sample indices [0, spp))
 RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp,

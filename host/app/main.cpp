@@ -1,0 +1,75 @@
+// The candela executable: the CLI11 app, its subcommands, and the one `candela: error:` handler.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/options.hpp"
+#include "app/render_command.hpp"
+#include "base/error.hpp"
+#include "device/device.hpp"
+#include "device/kernel_sources.hpp"
+
+namespace {
+
+using namespace candela;
+
+// Mesa's rusticl exposes its CPU device only when asked, before the ICD loader starts
+void enable_rusticl_if_named(const std::string& device) {
+  std::string wanted = lowercase(device);
+  if ((wanted.find("rusticl") != std::string::npos || wanted.find("llvmpipe") != std::string::npos) &&
+      !std::getenv("RUSTICL_ENABLE"))
+    setenv("RUSTICL_ENABLE", "llvmpipe", 0);
+}
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "candela: error: %s\n", message.c_str());
+  return 1;
+}
+
+// The subcommand asked for, its exceptions turned into `candela: error:` lines
+template <typename Run>
+int run_reporting_errors(Run run) {
+  try {
+    return run();
+  } catch (const Error& e) {
+    return fail(e.what());
+  } catch (const cl::Error& e) {
+    return fail(cl_error_message(e.what(), e.err()));
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"candela: a physically based path tracer running on OpenCL devices"};
+  app.set_version_flag("--version", "candela " CANDELA_VERSION);
+  app.require_subcommand(1);
+  std::string kernel_dir;
+  app.add_option("--kernel-dir", kernel_dir,
+                 "Load kernel sources from this cl/ directory instead of the embedded copy "
+                 "(also: CANDELA_KERNEL_DIR)");
+  CLI::App* devices_cmd = add_devices_command(&app);
+  RenderArgs render_args;
+  add_render_command(&app, &render_args);
+  CompareCommand compare;
+  CLI::App* compare_cmd = add_compare_command(&app, &compare);
+  MergeArgs merge_args;
+  CLI::App* merge_cmd = add_merge_command(&app, &merge_args);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  enable_rusticl_if_named(render_args.device);
+  return run_reporting_errors([&] {
+    if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
+    if (*devices_cmd) return run_devices_command();
+    if (*compare_cmd) return run_compare_command(compare_cmd, &compare);
+    if (*merge_cmd) return run_merge(merge_args);
+    return run_render_command(render_args);
+  });
+}

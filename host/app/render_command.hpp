@@ -1,0 +1,50 @@
+// `candela render SCENE -o OUT ...`: its options and the render they ask for.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace candela {
+
+struct RenderArgs {
+  std::string scene;
+  std::vector<std::string> outputs;
+  uint32_t spp = 0;
+  double time = 0.0;
+  int width = 0, height = 0;
+  std::string device;
+  uint32_t seed = 0;
+  uint32_t max_depth = 16;
+  std::string strategy;  // empty: the scene's (extras candela.strategy), else nee
+  bool no_energy_compensation = false;
+  std::string background;
+  std::string env;
+  std::optional<float> env_strength, env_rotation;
+  bool no_default_light = false;
+  std::string stats;
+  float exposure = 0.0f;
+  std::string tonemap = "neutral";
+  std::string look_from, look_at, up;
+  std::optional<float> fov;  // degrees
+  std::optional<float> aperture, focus_distance;
+  std::string filter = "box";
+  std::string sampler = "sobol";
+  bool quiet = false;
+  std::string variance;  // --variance: variance-of-the-mean image (render/image_stats.hpp)
+  bool generic = false;  // --generic: the kernel with every scene feature compiled in
+  uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
+  bool mpi = false;  // --mpi: spread the samples over the ranks of an MPI job
+};
+
+CLI::App* add_render_command(CLI::App* app, RenderArgs* args);
+
+// Renders, writes the outputs and returns the exit code (130: interrupted)
+int run_render(RenderArgs args);
+
+// run_render, under an MPI session with --mpi (app/mpi_render.hpp)
+int run_render_command(const RenderArgs& args);
+
+}  // namespace candela

@@ -1,0 +1,142 @@
+// The scene a render draws, with the command line's overrides (render_scene.hpp).
+#include "app/render_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "app/options.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "render/renderer.hpp"
+#include "scene/environment.hpp"
+
+namespace candela {
+namespace {
+
+void check_camera_options(const RenderArgs& a) {
+  if (a.fov && !(*a.fov > 0 && *a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees (exclusive)");
+  if (a.aperture && !(*a.aperture >= 0 && std::isfinite(*a.aperture)))
+    throw Error("--aperture must be a non-negative radius in scene units");
+  if (a.focus_distance && !(*a.focus_distance > 0 && std::isfinite(*a.focus_distance)))
+    throw Error("--focus-distance must be a positive distance in scene units");
+}
+
+// --look-from, --look-at, --up; returns the look-at point's distance when it is given
+std::optional<float> aim_camera(const RenderArgs& a, CameraDesc* cam) {
+  std::optional<float> look_at_distance;
+  if (!a.look_from.empty()) cam->position = parse_vec3(a.look_from, "--look-from");
+  if (!a.look_at.empty()) {
+    glm::vec3 target = parse_vec3(a.look_at, "--look-at");
+    if (glm::length(target - cam->position) <= 0) throw Error("--look-at must differ from the camera position");
+    cam->forward = glm::normalize(target - cam->position);
+    look_at_distance = glm::length(target - cam->position);
+  }
+  if (!a.up.empty()) cam->up = parse_vec3(a.up, "--up");
+  return look_at_distance;
+}
+
+// --fov, --aperture, --focus-distance
+void set_lens(const RenderArgs& a, std::optional<float> look_at_distance, CameraDesc* cam) {
+  if (a.fov) {  // a field of view makes the camera perspective
+    cam->projection = Projection::Perspective;
+    cam->yfov = *a.fov * 3.14159265f / 180.0f;
+  }
+  if (a.aperture) {
+    if (*a.aperture > 0 && cam->projection == Projection::Orthographic)
+      throw Error("--aperture needs a perspective camera: the scene camera is orthographic (add --fov to replace it)");
+    cam->aperture_radius = *a.aperture;
+  }
+  // Focus: --focus-distance, else the look-at point, else the scene camera's extras,
+  // else (resolve_camera) the bounds' centre along the view axis
+  if (a.focus_distance)
+    cam->focus_distance = *a.focus_distance;
+  else if (look_at_distance)
+    cam->focus_distance = look_at_distance;
+}
+
+void apply_camera_options(const RenderArgs& a, Scene* scene) {
+  check_camera_options(a);
+  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov || a.aperture ||
+             a.focus_distance;
+  if (!any) return;
+  CameraDesc cam = scene->camera ? *scene->camera : framing_camera(*scene);
+  std::optional<float> look_at_distance = aim_camera(a, &cam);
+  set_lens(a, look_at_distance, &cam);
+  scene->camera = cam;
+}
+
+// --background replaces the scene's background and map; --env the map
+void apply_background_options(const RenderArgs& a, Scene* scene) {
+  if (!a.background.empty()) {
+    scene->background = parse_vec3(a.background, "--background");
+    if (scene->background.x < 0 || scene->background.y < 0 || scene->background.z < 0)
+      throw Error("--background must not be negative");
+    scene->environment.reset();  // the constant replaces the scene's map too
+  }
+  if (!a.env.empty()) scene->environment = load_environment(a.env, 1.0f, 0.0f);
+}
+
+// A scene without any light (and without a map) gets the built-in sky
+void add_default_light(const RenderArgs& a, Scene* scene) {
+  if (scene->has_light() || scene->environment) return;
+  if (a.no_default_light) {
+    std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
+  } else {
+    std::fprintf(stderr, "%s\n", kBuiltinSkyNote);
+    scene->environment = builtin_sky();
+  }
+}
+
+// --env-strength, --env-rotation
+void apply_environment_options(const RenderArgs& a, Scene* scene) {
+  if (!scene->environment) {
+    if (a.env_strength || a.env_rotation)
+      std::fprintf(stderr, "warning: --env-strength and --env-rotation apply to an environment map; the scene has none\n");
+    return;
+  }
+  EnvironmentDesc& env = *scene->environment;
+  if (a.env_strength) env.strength = *a.env_strength;
+  if (a.env_rotation) env.rotation = *a.env_rotation;
+  if (!(env.strength >= 0.0f) || !std::isfinite(env.strength))
+    throw Error("--env-strength must be finite and non-negative");
+  if (!std::isfinite(env.rotation)) throw Error("--env-rotation must be finite");
+  if (!scene->has_light())
+    std::fprintf(stderr, "warning: the scene has no light: the environment map is black; the image will be black\n");
+}
+
+// No BSDF-sampled ray can hit a point, spot or directional light
+void warn_unreachable_lights(const RenderArgs& a, const Scene& scene) {
+  size_t n = scene.punctual_light_count();
+  if (n > 0 && parse_enum(kStrategyNames, "--strategy", a.strategy) == Strategy::Bsdf)
+    std::fprintf(stderr, "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee or auto\n", n,
+                 n == 1 ? "" : "s", n == 1 ? "s" : "");
+}
+
+}  // namespace
+
+Scene load_render_scene(RenderArgs* args) {
+  RenderArgs& a = *args;
+  Scene scene = load_gltf(a.scene);
+  if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "nee" : scene.strategy;
+  apply_background_options(a, &scene);
+  apply_camera_options(a, &scene);
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  add_default_light(a, &scene);
+  apply_environment_options(a, &scene);
+  warn_unreachable_lights(a, scene);
+  if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
+  return scene;
+}
+
+void resolve_image_size(const RenderArgs& a, const Scene& scene, int* w, int* h) {
+  float aspect = scene.camera ? scene.camera->aspect : 0.0f;
+  *w = a.width;
+  *h = a.height;
+  if (*w == 0 && *h == 0) *w = 512;
+  auto scaled = [](double v) { return int(std::clamp(std::round(v), 1.0, 65536.0)); };
+  if (*h == 0) *h = aspect > 0 ? scaled(*w / double(aspect)) : *w;
+  if (*w == 0) *w = aspect > 0 ? scaled(*h * double(aspect)) : *h;
+}
+
+}  // namespace candela
