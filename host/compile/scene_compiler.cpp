@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "compile/bvh_builder.hpp"
+#include "compile/environment_distribution.hpp"
 #include "scene/environment.hpp"
 #include "base/error.hpp"
 

@@ -1,3 +1,4 @@
+// Environment maps on the host (environment.hpp): loading, the built-in sky, the mean radiance.
 #include "scene/environment.hpp"
 
 #include <OpenImageIO/imageio.h>
@@ -13,22 +14,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr uint64_t kMaxMapBytes = uint64_t(1) << 30;  // as float RGBA: 8192 x 8192
-
-// Unnormalized CDF of n non-negative weights, appended as n + 1 floats from 0. The sum is
-// kept in double; a positive weight gets a step of at least one float ulp, a zero weight
-// none, so the device's steps are > 0 exactly where the weights are.
-void append_cdf(const double* weights, int n, std::vector<float>* out) {
-  double sum = 0.0;
-  float prev = 0.0f;
-  out->push_back(prev);
-  for (int i = 0; i < n; ++i) {
-    sum += weights[i];
-    float c = prev;
-    if (weights[i] > 0.0) c = std::max(float(sum), std::nextafter(prev, INFINITY));
-    out->push_back(c);
-    prev = c;
-  }
-}
 
 double texel_luminance(const TextureDesc& map, size_t i) {
   const float* t = &map.rgbaf[4 * i];
@@ -114,30 +99,6 @@ EnvironmentDesc builtin_sky() {
     }
   }
   return e;
-}
-
-std::vector<float> environment_distribution(const TextureDesc& map) {
-  int w = map.width, h = map.height;
-  std::vector<double> row_weight(static_cast<size_t>(h)), weights(static_cast<size_t>(w));
-  std::vector<float> out;
-  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1));
-  out.resize(size_t(h) + 1);  // the marginal CDF goes here once the rows are known
-  for (int r = 0; r < h; ++r) {
-    double sin_theta = std::sin(kPi * (r + 0.5) / h);
-    double sum = 0.0;
-    for (int c = 0; c < w; ++c) {
-      weights[size_t(c)] = texel_luminance(map, size_t(r) * w + c) * sin_theta;
-      sum += weights[size_t(c)];
-    }
-    row_weight[size_t(r)] = sum;
-    // A black row is never sampled; a uniform CDF keeps its steps well defined
-    if (!(sum > 0.0)) std::fill(weights.begin(), weights.end(), 1.0);
-    append_cdf(weights.data(), w, &out);
-  }
-  std::vector<float> marginal;
-  append_cdf(row_weight.data(), h, &marginal);
-  std::copy(marginal.begin(), marginal.end(), out.begin());
-  return out;
 }
 
 double environment_mean_luminance(const TextureDesc& map) {

@@ -1,6 +1,6 @@
 // Environment maps on the host: equirectangular images read through OpenImageIO, the
-// built-in sky that lights scenes without any light, and the sampling distribution that
-// cl/lights/environment.cl inverts.
+// built-in sky that lights scenes without any light, and their mean radiance. The sampling
+// distribution is the compile step's (compile/environment_distribution.hpp).
 #pragma once
 
 #include <string>
@@ -27,11 +27,6 @@ EnvironmentDesc builtin_sky();
 
 // The note printed when a scene without light gets the built-in sky
 extern const char* const kBuiltinSkyNote;
-
-// Sampling CDFs of a map, laid out as cl/lights/environment.cl reads them: texel weights
-// luminance x sin(theta at the row centre); every texel of positive luminance keeps a
-// float CDF step > 0, so its pdf is > 0.
-std::vector<float> environment_distribution(const TextureDesc& map);
 
 // Mean luminance of the radiance over the sphere (texels weighted by solid angle)
 double environment_mean_luminance(const TextureDesc& map);

@@ -1,0 +1,128 @@
+// The glTF loader's entry points: the file or bytes through tinygltf, then each reader in
+// turn (materials, then the node trees with their meshes, cameras and lights, then the
+// environment map the extras name).
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "base/error.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "gltf/limits.hpp"
+#include "gltf/reader.hpp"
+
+namespace candela {
+namespace gltf {
+
+bool supported_extension(const std::string& name) {
+  static const std::set<std::string> kSupported = {
+      "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization",
+      "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
+      "KHR_materials_volume", "KHR_materials_clearcoat", "KHR_materials_anisotropy", "KHR_lights_punctual"};
+  return kSupported.count(name) > 0;
+}
+
+namespace {
+
+void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
+  for (const auto& ext : model.extensionsUsed)
+    if (!supported_extension(ext)) warn->add("glTF extension " + ext + " is not supported yet and is ignored");
+  for (const auto& ext : model.extensionsRequired)
+    if (!supported_extension(ext))
+      warn->add("the scene requires glTF extension " + ext + ", which candela does not support: the image may be wrong");
+  if (!model.animations.empty()) warn->add("animations are ignored (the first frame is rendered)");
+  if (!model.skins.empty()) warn->add("skins are ignored (meshes render in their bind pose)");
+}
+
+// tinygltf file access that finds no file: glTF from memory without a base folder
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string no_expand_path(const std::string& path, void*) { return path; }
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+  if (err) *err += "external files are not read: " + path + "\n";
+  return false;
+}
+bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
+
+void trim_end(std::string* text, const char* chars) {
+  while (!text->empty() && std::string(chars).find(text->back()) != std::string::npos) text->pop_back();
+}
+
+// The document parsed by tinygltf; images that fail their checks are left empty, with
+// the reason in *image_errors. *warn gets tinygltf's warnings.
+tinygltf::Model parse_model(const std::string& data, const std::string& base_dir, const std::string& name,
+                            std::map<int, std::string>* image_errors, std::string* warn) {
+  tinygltf::TinyGLTF gltf;
+  if (base_dir.empty()) {
+    tinygltf::FsCallbacks fs = {};
+    fs.FileExists = no_file_exists;
+    fs.ExpandFilePath = no_expand_path;
+    fs.ReadWholeFile = no_read;
+    fs.WriteWholeFile = no_write;
+    gltf.SetFsCallbacks(fs);
+  }
+  gltf.SetImageLoader(load_checked_image, image_errors);
+  tinygltf::Model model;
+  std::string err;
+  // Binary glTF starts with the magic "glTF", whatever the file is called
+  bool binary = data.compare(0, 4, "glTF") == 0;
+  std::string patched;  // the file with defaults tinygltf needs written in, if any
+  const std::string& bytes = prepare_document(data, binary, name, &patched);
+  bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, warn,
+                                               reinterpret_cast<const unsigned char*>(bytes.data()),
+                                               unsigned(bytes.size()), base_dir)
+                   : gltf.LoadASCIIFromString(&model, &err, warn, bytes.data(), unsigned(bytes.size()), base_dir);
+  if (!ok) {
+    trim_end(&err, "\n ");
+    throw Error("cannot load glTF scene " + name + ": " + (err.empty() ? "malformed file" : err));
+  }
+  return model;
+}
+
+// Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
+// External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
+Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name) {
+  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
+  if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
+  std::map<int, std::string> image_errors;  // filled by load_checked_image
+  std::string warn;
+  tinygltf::Model model = parse_model(data, base_dir, name, &image_errors, &warn);
+  Scene scene;
+  if (!warn.empty()) {
+    trim_end(&warn, "\n");
+    scene.warnings.push_back("glTF loader: " + warn);
+  }
+  Warnings warnings(&scene.warnings);
+  warn_model_wide(model, &warnings);
+  ReadContext ctx{model, scene, warnings, base_dir, image_errors};
+  read_materials(ctx);
+  read_nodes(ctx);
+  if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
+  load_environment_file(ctx);
+  return scene;
+}
+
+}  // namespace
+}  // namespace gltf
+
+Scene load_gltf(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
+  if (fs::is_directory(path, ec)) throw Error("scene path is a directory, not a glTF file: " + path);
+  std::string data;
+  std::ifstream in(path, std::ios::binary);
+  uintmax_t size = fs::file_size(path, ec);
+  if (in && !ec) {
+    data.resize(size_t(size));
+    in.read(data.data(), std::streamsize(size));
+  }
+  if (!in || ec) throw Error("cannot read scene file " + path);
+  std::string dir = fs::path(path).parent_path().string();
+  return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path);
+}
+
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir) {
+  return gltf::load_gltf_bytes(data, base_dir, "(from memory)");
+}
+
+}  // namespace candela

@@ -1,0 +1,97 @@
+// Inside the glTF loader: the state its readers share while one document becomes a Scene,
+// and each reader's entry point (one file per glTF concept; loader.cpp runs them).
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace candela::gltf {
+
+// Scene::warnings, each one once
+class Warnings {
+ public:
+  explicit Warnings(std::vector<std::string>* out) : out_(out) {}
+  void add(const std::string& w) {
+    if (seen_.insert(w).second) out_->push_back(w);
+  }
+
+ private:
+  std::vector<std::string>* out_;
+  std::set<std::string> seen_;
+};
+
+struct ReadContext {
+  const tinygltf::Model& model;
+  Scene& scene;
+  Warnings& warn;
+  const std::string& base_dir;  // where files the scene names are found; empty: nowhere
+  const std::map<int, std::string>& image_errors;  // why load_checked_image left each image empty
+  std::map<std::pair<int, bool>, int> textures = {};  // (glTF texture, sRGB) -> Scene::textures or NO_TEXTURE
+  size_t degenerate = 0;  // zero-area triangles skipped
+  std::vector<bool> visited = {};  // nodes reached so far
+};
+
+// obj[key] (index < 0) or obj[key][index] when it is a number, else `fallback`
+inline double number_or(const tinygltf::Value& obj, const char* key, int index, double fallback) {
+  if (!obj.Has(key)) return fallback;
+  const tinygltf::Value& v = obj.Get(key);
+  if (index >= 0) {
+    if (!v.IsArray() || int(v.ArrayLen()) <= index || !v.Get(index).IsNumber()) return fallback;
+    return v.Get(index).GetNumberAsDouble();
+  }
+  return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+// An extension this loader implements fully (others are named in a warning)
+bool supported_extension(const std::string& name);
+
+// document.cpp: the bytes tinygltf parses (`data` itself or *patched); Error for JSON nested
+// deeper than kMaxJsonDepth
+const std::string& prepare_document(const std::string& data, bool binary, const std::string& name,
+                                    std::string* patched);
+
+// images.cpp: tinygltf's image decoding behind the size checks (a tinygltf::LoadImageDataFunction)
+bool load_checked_image(tinygltf::Image* image, int index, std::string* err, std::string* warn, int req_width,
+                        int req_height, const unsigned char* bytes, int size, void* errors);
+
+// accessors.cpp: accessor elements (count x components values), sparse substitution applied
+std::vector<float> read_accessor(const tinygltf::Model& model, int index, int want_components);
+std::vector<uint32_t> read_indices(const tinygltf::Model& model, int index);
+
+// textures.cpp: a material's texture slot from a core textureInfo (with its extensions) or
+// from a textureInfo `key` inside an extension object; each texture's image decoded once
+void set_texture_slot(ReadContext& ctx, MaterialDesc* m, int slot, int gltf_texture, int texcoord,
+                      const tinygltf::ExtensionMap& extensions, bool srgb);
+void set_texture_slot(ReadContext& ctx, MaterialDesc* m, int slot, const tinygltf::Value& ext, const char* key,
+                      bool srgb);
+
+// materials.cpp: every material, then the default one (index = the model's material count)
+void read_materials(ReadContext& ctx);
+
+// media.cpp: a medium from candela's extras (`where` names it in errors)
+MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir);
+
+// nodes.cpp: the default scene's node trees (meshes, the first camera, lights), its extras
+void read_nodes(ReadContext& ctx);
+
+// meshes.cpp: the mesh's primitives, placed in the world
+void read_mesh(ReadContext& ctx, const tinygltf::Mesh& mesh, const glm::mat4& world);
+
+// lights.cpp: the node's KHR_lights_punctual light, placed in the world
+void read_node_light(ReadContext& ctx, int node_index, const tinygltf::Value& ext, const glm::mat4& world);
+
+// extras.cpp: the scene's extras.candela (environment, strategy, medium, background), and
+// the environment map file it names, read once the document is
+void read_scene_extras(ReadContext& ctx, const tinygltf::Value& extras);
+void load_environment_file(ReadContext& ctx);
+
+}  // namespace candela::gltf
