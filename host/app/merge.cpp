@@ -1,3 +1,4 @@
+// `candela merge` (merge.hpp): shards of one render checked against each other and merged.
 #include "app/merge.hpp"
 
 #include <algorithm>
@@ -74,49 +75,43 @@ std::string format_range(const std::pair<uint64_t, uint64_t>& r) {
   return "[" + std::to_string(r.first) + ", " + std::to_string(r.second) + ")";
 }
 
-}  // namespace
+struct Input {
+  std::string path;
+  RgbImage img;
+  uint64_t spp;
+  SampleRanges ranges;
+};
 
-int run_merge(const MergeArgs& args) {
-  if (args.inputs.size() < 2) throw Error("merge needs at least two input images");
-  if (!ends_with_exr(args.output)) throw Error("merge writes an .exr (linear float with metadata): " + args.output);
+Input read_input(const std::string& path) {
+  if (!ends_with_exr(path)) throw Error("cannot merge " + path + ": merge reads .exr images written by candela render");
+  Input x{path, read_rgb_image(path, "image"), 0, {}};
+  if (!x.img.metadata.count("spp"))
+    throw Error("cannot merge " + path + ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
+  if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
+    throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
+  x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
+  if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no samples (candela:spp 0)");
+  x.ranges = ranges_of(x.img, path, x.spp);
+  return x;
+}
 
-  struct Input {
-    std::string path;
-    RgbImage img;
-    uint64_t spp;
-    SampleRanges ranges;
-  };
-  std::vector<Input> in;
-  for (const auto& path : args.inputs) {
-    if (!ends_with_exr(path)) throw Error("cannot merge " + path + ": merge reads .exr images written by candela render");
-    Input x{path, read_rgb_image(path, "image"), 0, {}};
-    if (!x.img.metadata.count("spp"))
-      throw Error("cannot merge " + path + ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
-    if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
-      throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
-    x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
-    if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no samples (candela:spp 0)");
-    x.ranges = ranges_of(x.img, path, x.spp);
-    in.push_back(std::move(x));
+// Same size and the kMustMatch metadata as the first input
+void check_same_render(const Input& first, const Input& x) {
+  if (x.img.width != first.img.width || x.img.height != first.img.height)
+    throw Error("cannot merge: " + x.path + " is " + std::to_string(x.img.width) + "x" + std::to_string(x.img.height) +
+                ", " + first.path + " is " + std::to_string(first.img.width) + "x" + std::to_string(first.img.height));
+  for (const char* key : kMustMatch) {
+    auto a = first.img.metadata.find(key), b = x.img.metadata.find(key);
+    std::string va = a == first.img.metadata.end() ? "(none)" : a->second;
+    std::string vb = b == x.img.metadata.end() ? "(none)" : b->second;
+    if (va != vb)
+      throw Error("cannot merge: different " + std::string(key) + ": " + first.path + " has '" + va + "', " + x.path +
+                  " has '" + vb + "'");
   }
+}
 
-  const Input& first = in.front();
-  for (size_t i = 1; i < in.size(); ++i) {
-    const Input& x = in[i];
-    if (x.img.width != first.img.width || x.img.height != first.img.height)
-      throw Error("cannot merge: " + x.path + " is " + std::to_string(x.img.width) + "x" + std::to_string(x.img.height) +
-                  ", " + first.path + " is " + std::to_string(first.img.width) + "x" + std::to_string(first.img.height));
-    for (const char* key : kMustMatch) {
-      auto a = first.img.metadata.find(key), b = x.img.metadata.find(key);
-      std::string va = a == first.img.metadata.end() ? "(none)" : a->second;
-      std::string vb = b == x.img.metadata.end() ? "(none)" : b->second;
-      if (va != vb)
-        throw Error("cannot merge: different " + std::string(key) + ": " + first.path + " has '" + va + "', " + x.path +
-                    " has '" + vb + "'");
-    }
-  }
-
-  // Disjoint sample ranges: sort all of them and compare neighbours
+// Every input's sample ranges (with the input's index), sorted; Error unless disjoint
+std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>> disjoint_ranges(const std::vector<Input>& in) {
   std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>> all;
   for (size_t i = 0; i < in.size(); ++i)
     for (const auto& r : in[i].ranges) all.push_back({r, i});
@@ -126,12 +121,12 @@ int run_merge(const MergeArgs& args) {
       throw Error("cannot merge: overlapping sample ranges: " + in[all[k - 1].second].path + " holds " +
                   format_range(all[k - 1].first) + ", " + in[all[k].second].path + " holds " + format_range(all[k].first) +
                   " (give each shard its own --sample-offset)");
+  return all;
+}
 
-  // Weighted mean per pixel, in double
-  uint64_t total = 0;
-  for (const auto& x : in) total += x.spp;
-  if (total > (uint64_t(1) << 32)) throw Error("cannot merge: more than 2^32 samples per pixel");
-  Film film(first.img.width, first.img.height);
+// Weighted mean per pixel, in double
+Film merged_film(const std::vector<Input>& in, uint64_t total) {
+  Film film(in.front().img.width, in.front().img.height);
   for (size_t p = 0; p < film.pixels(); ++p) {
     for (int c = 0; c < 3; ++c) {
       double sum = 0.0;
@@ -140,9 +135,11 @@ int run_merge(const MergeArgs& args) {
     }
     film.mean[4 * p + 3] = float(total);
   }
+  return film;
+}
 
-  // Metadata: the first input's, with the merged counts and ranges (coalesced)
-  std::map<std::string, std::string> meta = first.img.metadata;
+// "B:E,B:E": the sorted ranges, adjacent ones coalesced; *first gets the first index
+std::string ranges_text(const std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>>& all, uint64_t* first) {
   SampleRanges merged;
   for (const auto& [r, i] : all) {
     if (!merged.empty() && merged.back().second == r.first)
@@ -150,8 +147,16 @@ int run_merge(const MergeArgs& args) {
     else
       merged.push_back(r);
   }
-  std::string ranges_text;
-  for (const auto& r : merged) ranges_text += (ranges_text.empty() ? "" : ",") + std::to_string(r.first) + ":" + std::to_string(r.second);
+  std::string text;
+  for (const auto& r : merged) text += (text.empty() ? "" : ",") + std::to_string(r.first) + ":" + std::to_string(r.second);
+  *first = merged.front().first;
+  return text;
+}
+
+// The first input's metadata with the merged counts: seconds and dropped samples summed,
+// each device once
+std::map<std::string, std::string> merged_metadata(const std::vector<Input>& in, uint64_t total) {
+  std::map<std::string, std::string> meta = in.front().img.metadata;
   double seconds = 0.0;
   uint64_t dropped = 0;
   std::vector<std::string> devices;
@@ -166,17 +171,35 @@ int run_merge(const MergeArgs& args) {
   std::string device_text;
   for (const auto& d : devices) device_text += (device_text.empty() ? "" : " + ") + d;
   meta["spp"] = std::to_string(total);
-  meta["sample_offset"] = std::to_string(merged.front().first);
-  meta["sample_ranges"] = ranges_text;
   meta["seconds"] = std::to_string(seconds);
   meta["dropped_samples"] = std::to_string(dropped);
   meta["device"] = device_text;
   meta["merged_from"] = std::to_string(in.size());
+  return meta;
+}
+
+}  // namespace
+
+int run_merge(const MergeArgs& args) {
+  if (args.inputs.size() < 2) throw Error("merge needs at least two input images");
+  if (!ends_with_exr(args.output)) throw Error("merge writes an .exr (linear float with metadata): " + args.output);
+  std::vector<Input> in;
+  for (const auto& path : args.inputs) in.push_back(read_input(path));
+  for (size_t i = 1; i < in.size(); ++i) check_same_render(in.front(), in[i]);
+  auto all = disjoint_ranges(in);
+  uint64_t total = 0;
+  for (const auto& x : in) total += x.spp;
+  if (total > (uint64_t(1) << 32)) throw Error("cannot merge: more than 2^32 samples per pixel");
+  Film film = merged_film(in, total);
+  std::map<std::string, std::string> meta = merged_metadata(in, total);
+  uint64_t first_index = 0;
+  std::string ranges = ranges_text(all, &first_index);
+  meta["sample_offset"] = std::to_string(first_index);
+  meta["sample_ranges"] = ranges;
   write_image(args.output, film, meta);
   std::printf("wrote %s\n", args.output.c_str());
   if (!args.quiet)
-    std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total,
-                ranges_text.c_str());
+    std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total, ranges.c_str());
   return 0;
 }
 
