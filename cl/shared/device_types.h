@@ -2,7 +2,8 @@
 // Included by the OpenCL program (first in the source list) and by the host inside
 // namespace candela::dev (host/device_types.hpp), which static_asserts every layout from
 // CD_LAYOUT below; the device-side layout test checks the same list on each device.
-// Only 4-byte scalars and arrays of them: no float3, no vector types, explicit padding.
+// Only 4-byte scalars, arrays of them and unions of such structs: no float3, no vector types,
+// explicit padding.
 
 #ifndef CANDELA_DEVICE_TYPES_H
 #define CANDELA_DEVICE_TYPES_H

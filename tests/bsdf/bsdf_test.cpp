@@ -157,7 +157,7 @@ ReferenceLobe conductor_reference(HostGgx g, glm::dvec3 eta, glm::dvec3 k) {
 // glTF metallic-roughness (glTF 2.0 Appendix B with KHR_materials_specular, _ior,
 // _transmission, _clearcoat, _anisotropy) as a weighted sum of lobes: coat over
 // metal + plastic (specular + Lambert) + glass. Its pdf is the kernel's mixture, with
-// component probabilities estimated at wo (cl/bsdf/bsdf_gltf.cl, gltf_lobes).
+// component probabilities estimated at wo (cl/bsdf/bsdf_gltf.cl, gltf_at_wo).
 struct GltfReference {
   glm::dvec3 base, f0;
   double metallic, transmission, ior, f90, coat;

@@ -144,6 +144,10 @@ LOBE = {
     'sample': ('bool', ['const Bsdf*', 'float3', 'float', 'float2', 'BsdfSample*']),
     'alpha': ('float', ['const Bsdf*']),
 }
+COMPONENT = {
+    'weight': ('float', ['const Bsdf*', 'const GltfAtWo*', 'float']),
+    'sample': ('int', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float', 'float2', 'BsdfSample*']),
+}
 LIGHT = {
     'sample': ('bool', ['const SceneData*', '__global const Light*', 'const LightSampleContext*', 'float2',
                         'LightSample*']),
@@ -151,46 +155,54 @@ LIGHT = {
 }
 
 
-def list_violations(sources, types_path, dispatch):
-    """Disagreements between the lists of sources[types_path] and the kernel code in sources
-    (path -> text). dispatch: list macro -> (prefix, {suffix: signature}, file of the dispatch)."""
+def generated_callers(text, prefix, suffix):
+    """Macros of text whose body calls prefix_##NAME##_suffix (a dispatch to generate from a list)."""
+    callers = []
+    for m in re.finditer(r'^#define (\w+)\([^)]*\)((?:[^\n]*\\\n)*[^\n]*)', text, re.M):
+        if re.search(prefix + r'_##\w+##_' + suffix + r'\(', m.group(2)):
+            callers.append(m.group(1))
+    return callers
+
+
+def list_violations(sources, features_path, lists):
+    """Disagreements between the lists and the kernel code in sources (path -> text).
+    features_path: the file of CD_SCENE_FEATURES. lists: list macro -> (file of the list,
+    prefix, {suffix: signature} of each entry's functions, file of the dispatch, whether the
+    third column is a feature)."""
     found = []
-    types = sources[types_path]
-    features = list_entries(macro_body(types, 'CD_SCENE_FEATURES') or '')
+    features = list_entries(macro_body(sources[features_path], 'CD_SCENE_FEATURES') or '')
     feature_macros = {e[1] for e in features if len(e) == 4}
     if not features or len(feature_macros) != len(features):
-        found.append(f'{types_path}: CD_SCENE_FEATURES is missing or not X(name, macro, default, needs)')
+        found.append(f'{features_path}: CD_SCENE_FEATURES is missing or not X(name, macro, default, needs)')
     code = {p: strip_comments(t) for p, t in sources.items()}
     for path, text in code.items():
         for m in re.finditer(r'#\s*(?:define|ifndef|undef)\s+(CD_FEATURE_\w+)', text):
             found.append(f'{path}: {m.group(0)}: the defaults of kernel features come from CD_SCENE_FEATURES alone')
         for name in sorted(set(re.findall(r'\bCD_FEATURE_\w+', text)) - feature_macros):
             found.append(f'{path}: {name} is not in CD_SCENE_FEATURES')
-    for macro, (prefix, functions, dispatch_path) in dispatch.items():
-        entries = list_entries(macro_body(types, macro) or '')
+    defs = {}
+    for text in code.values():
+        defs.update(definitions(text))
+    for macro, (list_path, prefix, functions, dispatch_path, has_feature) in lists.items():
+        entries = list_entries(macro_body(sources.get(list_path, ''), macro) or '')
         if not entries or any(len(e) != 3 for e in entries):
-            found.append(f'{types_path}: {macro} is missing or not X(id, name, feature)')
+            found.append(f'{list_path}: {macro} is missing or not X(id, name, {"feature" if has_feature else "kind"})')
             continue
         ids = [e[0] for e in entries]
-        defined = defines_above(types, macro)
+        defined = defines_above(sources[list_path], macro)
         if [d[0] for d in defined] != ids or [d[1] for d in defined] != list(range(len(ids))):
-            found.append(f'{types_path}: the ids defined above {macro} ({", ".join(f"{d[0]} {d[1]}" for d in defined)}) '
+            found.append(f'{list_path}: the ids defined above {macro} ({", ".join(f"{d[0]} {d[1]}" for d in defined)}) '
                          f'are not its entries ({", ".join(ids)}) numbered 0, 1, ...')
         for e in entries:
-            if e[2] != '1' and e[2] not in feature_macros:
-                found.append(f'{types_path}: {macro} entry {e[1]}: feature {e[2]} is neither 1 nor in CD_SCENE_FEATURES')
+            if has_feature and e[2] != '1' and e[2] not in feature_macros:
+                found.append(f'{list_path}: {macro} entry {e[1]}: feature {e[2]} is neither 1 nor in CD_SCENE_FEATURES')
         # Only the generated dispatch tells the types apart
         id_pattern = r'\b(?:' + '|'.join(re.escape(i) for i in ids) + r')\b'
         for path, text in code.items():
-            if path == types_path:
-                continue
             for m in re.finditer(r'case\s+' + id_pattern + r'|[!=]=\s*' + id_pattern + '|' + id_pattern + r'\s*[!=]=',
                                  text):
                 found.append(f'{path}: "{m.group(0)}": a hand-written test of the type; dispatch through {macro}')
-        # Each type's functions with the one signature, and the dispatch calling each
-        defs = {}
-        for text in code.values():
-            defs.update(definitions(text))
+        # Each entry's functions with the one signature, and a dispatch generated from the list calling each
         dispatch_text = code.get(dispatch_path, '')
         for suffix, signature in functions.items():
             for e in entries:
@@ -200,9 +212,8 @@ def list_violations(sources, types_path, dispatch):
                 elif defs[fn] != signature:
                     found.append(f'{fn}: {defs[fn][0]} ({", ".join(defs[fn][1])}), not the one signature '
                                  f'{signature[0]} ({", ".join(signature[1])})')
-            generated = [m.group(1) for m in re.finditer(r'#define (\w+)\([^)]*\)[^\n]*\\\n[^\n]*' + prefix + r'_##\w+##_'
-                                                         + suffix + r'\(', dispatch_text)]
-            if not any(re.search(macro + r'\(\s*' + g + r'\s*\)', dispatch_text) for g in generated):
+            callers = generated_callers(dispatch_text, prefix, suffix)
+            if not any(re.search(macro + r'\(\s*' + c + r'\s*\)', dispatch_text) for c in callers):
                 found.append(f'{dispatch_path}: no dispatch of {prefix}_NAME_{suffix} generated from {macro}')
     return found
 
@@ -220,7 +231,7 @@ uint t_two_get(const Bsdf* b) { return 2u; }
   if (feature && b->type == id) return t_##name##_get(b);
 uint t_get(const Bsdf* b) { CD_TS(T_GET) return 0u; }
 """
-PLANTED_DISPATCH = {'CD_TS': ('t', {'get': ('uint', ['const Bsdf*'])}, 'good.cl')}
+PLANTED_DISPATCH = {'CD_TS': ('types.h', 't', {'get': ('uint', ['const Bsdf*'])}, 'good.cl', True)}
 
 
 def planted_cases():
@@ -280,9 +291,12 @@ def main():
         return 1
     found = violations(sources)
     program_sources = {p: t for p, t in sources.items() if p in program}
-    found += list_violations(program_sources, os.path.join('cl', 'shared', 'device_types.h'), {
-        'CD_MATERIALS': ('bsdf', LOBE, os.path.join('cl', 'bsdf', 'bsdf.cl')),
-        'CD_LIGHTS': ('lights', LIGHT, os.path.join('cl', 'lights', 'lights.cl')),
+    types = os.path.join('cl', 'shared', 'device_types.h')
+    gltf = os.path.join('cl', 'bsdf', 'bsdf_gltf.cl')
+    found += list_violations(program_sources, types, {
+        'CD_MATERIALS': (types, 'bsdf', LOBE, os.path.join('cl', 'bsdf', 'bsdf.cl'), True),
+        'CD_LIGHTS': (types, 'lights', LIGHT, os.path.join('cl', 'lights', 'lights.cl'), True),
+        'GLTF_COMPONENTS': (gltf, 'gltf', COMPONENT, gltf, False),
     })
     # Test kernels may tell types apart, but use only the listed features
     test_sources = {p: strip_comments(t) for p, t in sources.items() if p.startswith('tests' + os.sep)}
