@@ -40,11 +40,11 @@
 #define GLTF_MS 4u
 #define GLTF_GLASS 5u
 #define GLTF_COMPONENTS(X)               \
-  X(GLTF_COAT, coat, BSDF_GLOSSY)       \
-  X(GLTF_METAL, metal, BSDF_GLOSSY)     \
-  X(GLTF_SPEC, spec, BSDF_GLOSSY)       \
+  X(GLTF_COAT, coat, BSDF_GLOSSY)        \
+  X(GLTF_METAL, metal, BSDF_GLOSSY)      \
+  X(GLTF_SPEC, spec, BSDF_GLOSSY)        \
   X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE) \
-  X(GLTF_MS, ms, BSDF_GLOSSY)           \
+  X(GLTF_MS, ms, BSDF_GLOSSY)            \
   X(GLTF_GLASS, glass, BSDF_GLOSSY)
 #define GLTF_COUNT_COMPONENT(id, name, kind) +1
 #define GLTF_COMPONENT_COUNT (0 GLTF_COMPONENTS(GLTF_COUNT_COMPONENT))

@@ -14,17 +14,17 @@
 // build options -Dmacro=0|1 in this order (part of the program-cache key) and the kernel's
 // default without them, `#define macro default`, which host/device/kernel_sources.cpp
 // prepends to the program. Kernel code tests `#if macro`.
-#define CD_SCENE_FEATURES(X)                                                                  \
-  X(textures, CD_FEATURE_TEXTURES, 1, "some material slot has a texture")                   \
-  X(uvs, CD_FEATURE_UVS, 1, "some mesh has TEXCOORD_0 or TEXCOORD_1")                        \
-  X(tangents, CD_FEATURE_TANGENTS, 1, "some mesh has TANGENT")                               \
-  X(vertex_colors, CD_FEATURE_VERTEX_COLORS, 1, "some COLOR_0 is not white")                 \
-  X(alpha, CD_FEATURE_ALPHA, 1, "some mesh's material is alpha-tested (MaterialDesc::alpha_tested)") \
-  X(media, CD_FEATURE_MEDIA, 1, "a global medium, or a mesh whose material has an interior medium") \
-  X(nanovdb, CD_FEATURE_NANOVDB, CD_PNANOVDB_AVAILABLE, "a medium with a NanoVDB grid")      \
-  X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material of type MATERIAL_GLTF (MaterialDesc::kernel_type)") \
-  X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material of type MATERIAL_CONDUCTOR")     \
-  X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")               \
+#define CD_SCENE_FEATURES(X)                                                                       \
+  X(textures, CD_FEATURE_TEXTURES, 1, "some material slot has a texture")                          \
+  X(uvs, CD_FEATURE_UVS, 1, "some mesh has TEXCOORD_0 or TEXCOORD_1")                              \
+  X(tangents, CD_FEATURE_TANGENTS, 1, "some mesh has TANGENT")                                     \
+  X(vertex_colors, CD_FEATURE_VERTEX_COLORS, 1, "some COLOR_0 is not white")                       \
+  X(alpha, CD_FEATURE_ALPHA, 1, "a mesh's material is alpha-tested (alpha_tested)")                \
+  X(media, CD_FEATURE_MEDIA, 1, "a global medium, or a mesh's material with an interior medium")   \
+  X(nanovdb, CD_FEATURE_NANOVDB, CD_PNANOVDB_AVAILABLE, "a medium with a NanoVDB grid")            \
+  X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material shaded as MATERIAL_GLTF (kernel_type)") \
+  X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
+  X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
 
 // Material types. CD_MATERIALS: X(id, name, feature), one entry per type, generates every
@@ -40,9 +40,9 @@
 #define MATERIAL_DIFFUSE 0u  // Lambertian, albedo = base color
 #define MATERIAL_GLTF 1u  // glTF metallic-roughness with its KHR_materials_* extensions
 #define MATERIAL_CONDUCTOR 2u  // measured conductor: complex index eta + i k, GGX roughness
-#define CD_MATERIALS(X)                           \
-  X(MATERIAL_DIFFUSE, diffuse, 1)                 \
-  X(MATERIAL_GLTF, gltf, CD_FEATURE_GLTF_BSDF)   \
+#define CD_MATERIALS(X)                                  \
+  X(MATERIAL_DIFFUSE, diffuse, 1)                        \
+  X(MATERIAL_GLTF, gltf, CD_FEATURE_GLTF_BSDF)           \
   X(MATERIAL_CONDUCTOR, conductor, CD_FEATURE_CONDUCTOR)
 
 // Material flags
@@ -77,11 +77,11 @@
 #define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
 #define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
 #define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
-#define CD_LIGHTS(X)                                  \
-  X(LIGHT_TRIANGLE, triangle, 1)                      \
+#define CD_LIGHTS(X)                                        \
+  X(LIGHT_TRIANGLE, triangle, 1)                            \
   X(LIGHT_ENVIRONMENT, environment, CD_FEATURE_ENVIRONMENT) \
-  X(LIGHT_POINT, point, CD_FEATURE_PUNCTUAL)          \
-  X(LIGHT_SPOT, spot, CD_FEATURE_PUNCTUAL)            \
+  X(LIGHT_POINT, point, CD_FEATURE_PUNCTUAL)                \
+  X(LIGHT_SPOT, spot, CD_FEATURE_PUNCTUAL)                  \
   X(LIGHT_DIRECTIONAL, directional, CD_FEATURE_PUNCTUAL)
 
 // Integration strategies (no MIS: each light path is counted by exactly one of them)

@@ -1,8 +1,8 @@
 // Host view of cl/shared/device_types.h, the one definition of every struct that crosses to
 // the device, with its layout pinned down by static_asserts generated from CD_LAYOUT;
 // tests/device/layout_test.cpp checks the same list on each device. The name tables of the
-// material and light types come from their lists (CD_MATERIALS, CD_LIGHTS). cl/shared/color.h brings the
-// colour helpers both sides share.
+// material and light types come from their lists (CD_MATERIALS, CD_LIGHTS). cl/shared/color.h
+// brings the colour helpers both sides share.
 #pragma once
 
 #include <cmath>
