@@ -6,10 +6,6 @@
 // Hits on triangles flagged BVH_TRI_ALPHA_TEST count only where the scene's alpha test
 // says so (cut-outs, stochastic opacity): that code is compiled in with CD_FEATURE_ALPHA.
 
-#ifndef CD_FEATURE_ALPHA
-#define CD_FEATURE_ALPHA 1
-#endif
-
 // Does the hit at barycentrics (b1, b2) of primitive `prim` along `ray` count? Defined by
 // the scene (cl/scene/alpha.cl); the traversal passes `sc` through without reading it.
 struct SceneData;

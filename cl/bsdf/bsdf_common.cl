@@ -1,5 +1,5 @@
-// What every BSDF lobe (bsdf_*.cl) shares with the dispatch in bsdf.cl: the sample record
-// and the BSDF record of a shading point.
+// What every BSDF lobe (bsdf_*.cl) shares with the dispatch in bsdf.cl: the sample record,
+// the BSDF record of a shading point and the material lookups of the lobes' params.
 
 // BsdfSample flags (pbrt-v4's BxDFFlags): what kind of lobe produced the sample
 #define BSDF_REFLECTION 1u
@@ -16,13 +16,8 @@ typedef struct {
   float eta;  // relative index of refraction across a transmission, else 1
 } BsdfSample;
 
-// The BSDF of one shading point: frame, normals and the material evaluated there
+// Parameters of a MATERIAL_GLTF BSDF at a shading point (bsdf_gltf.cl)
 typedef struct {
-  Frame frame;  // shading frame; frame.n is the (mapped) shading normal on wo's side
-  float3 ng;  // geometric normal on wo's side
-  bool entering;  // wo is on the front face: refraction goes from outside (1) to inside (ior)
-  uint type;  // MATERIAL_*
-  float3 base_color;  // diffuse albedo, metal F0, transmission tint
   float metallic;
   Ggx ggx;  // specular roughness, ax along frame.t
   float eta;  // relative index across the surface seen from wo: eta_t / eta_i
@@ -32,7 +27,49 @@ typedef struct {
   bool thin;  // a thin-walled sheet: transmission does not bend
   float coat;  // clearcoat weight
   Ggx coat_ggx;
-  float3 cond_eta, cond_k;  // MATERIAL_CONDUCTOR
-  float3 cond_f_avg;  // MATERIAL_CONDUCTOR: hemispherical average of its Fresnel term
+} GltfBsdf;
+
+// Parameters of a MATERIAL_CONDUCTOR BSDF at a shading point (bsdf_conductor.cl)
+typedef struct {
+  Ggx ggx;  // ax along frame.t
+  float3 eta, k;
+  float3 f_avg;  // hemispherical average of its Fresnel term
+} ConductorBsdf;
+
+// The BSDF of one shading point: what every type has (frame, normals, colour), then the
+// parameters of its type's lobe, evaluated there
+typedef struct {
+  Frame frame;  // shading frame; frame.n is the (mapped) shading normal on wo's side
+  float3 ng;  // geometric normal on wo's side
+  bool entering;  // wo is on the front face: refraction goes from outside (1) to inside (ior)
+  uint type;  // MATERIAL_*
+  float3 base_color;  // diffuse albedo, metal F0, transmission tint
   __global const float* ggx_albedo;  // GGX albedo table (energy.cl); 0: no energy compensation
+  union {
+    GltfBsdf gltf;
+    ConductorBsdf conductor;
+  } lobe;  // by type
 } Bsdf;
+
+// A texture slot of the material at the hit
+float4 bsdf_texture(const SceneData* sc, __global const Material* m, int slot, const SurfaceHit* s) {
+  return textures_lookup(sc, &m->textures[slot], s->uvs);
+}
+
+// GGX roughness (x metallicRoughnessTexture G) and KHR_materials_anisotropy: the strength,
+// and a direction in the tangent plane, rotated, that the frame's tangent turns to
+Ggx bsdf_microfacet_at(const SceneData* sc, __global const Material* m, const SurfaceHit* s, float roughness,
+                       float anisotropy_strength, float anisotropy_rotation, Frame* frame) {
+  float r = roughness * bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s).y;
+  float4 an = bsdf_texture(sc, m, TEX_ANISOTROPY, s);
+  float2 dir = m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.xy * 2.0f - 1.0f : (float2)(1.0f, 0.0f);
+  float strength = anisotropy_strength * (m->textures[TEX_ANISOTROPY].index != NO_TEXTURE ? an.z : 1.0f);
+  if (strength > 0.0f) {
+    float cr, sr = sincos(anisotropy_rotation, &cr);
+    float3 t = (cr * dir.x - sr * dir.y) * frame->t + (sr * dir.x + cr * dir.y) * frame->b;
+    float hand = dot(cross(frame->n, frame->t), frame->b) < 0.0f ? -1.0f : 1.0f;
+    *frame = frame_from_z_x(frame->n, t);
+    frame->b *= hand;
+  }
+  return ggx_from_roughness(r, strength);
+}

@@ -1,17 +1,22 @@
 // Lambertian reflection in the local shading frame (z = shading normal): f = albedo / pi,
-// cosine-weighted sampling.
+// cosine-weighted sampling. The albedo is the base colour (Bsdf.base_color).
 
-float3 bsdf_diffuse_eval(float3 albedo, float3 wo, float3 wi) {
-  return wi.z > 0.0f ? albedo * INV_PI_F : (float3)(0.0f);
+void bsdf_diffuse_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {}
+
+uint bsdf_diffuse_flags(const Bsdf* b) { return BSDF_REFLECTION | BSDF_DIFFUSE; }
+
+float3 bsdf_diffuse_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
+  *pdf = sample_cosine_hemisphere_pdf(wi.z);
+  return wi.z > 0.0f ? b->base_color * INV_PI_F : (float3)(0.0f);
 }
 
-float bsdf_diffuse_pdf(float3 wo, float3 wi) { return sample_cosine_hemisphere_pdf(wi.z); }
-
-bool bsdf_diffuse_sample(float3 albedo, float3 wo, float2 u, BsdfSample* bs) {
+bool bsdf_diffuse_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   bs->wi = sample_cosine_hemisphere(u.x, u.y);
-  bs->pdf = sample_cosine_hemisphere_pdf(bs->wi.z);
-  bs->f = bsdf_diffuse_eval(albedo, wo, bs->wi);
+  bs->f = bsdf_diffuse_eval(b, wo, bs->wi, &bs->pdf);
   bs->flags = BSDF_REFLECTION | BSDF_DIFFUSE;
   bs->eta = 1.0f;
   return bs->pdf > 0.0f;
 }
+
+// No microfacet lobe: as rough as it gets (the auto strategy light-samples diffuse lobes)
+float bsdf_diffuse_alpha(const Bsdf* b) { return 1.0f; }

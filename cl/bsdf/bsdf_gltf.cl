@@ -25,10 +25,59 @@
 // Sampling picks a component with a probability from its estimated weight at wo (the
 // lecture's combined BSDF); eval and pdf sum every non-delta component, so sampling and
 // evaluation describe the same mixture.
+//
+// GLTF_COMPONENTS: X(id, name, kind), the components in sampling order, kind the BSDF_*
+// flag of a direction the component samples. Each has
+//   float gltf_NAME_weight(const Bsdf*, const GltfAtWo*, float cos_o): its weight at wo
+//   int gltf_NAME_sample(const Bsdf*, const GltfAtWo*, float3 wo, float uc, float2 u, BsdfSample*)
+// and a term of f and pdf in gltf_eval_at, which adds the components in its own order: the
+// metal and plastic specular lobes share one microfacet evaluation, and the coat is a layer
+// over the others rather than a term beside them.
+#define GLTF_COAT 0u
+#define GLTF_METAL 1u
+#define GLTF_SPEC 2u
+#define GLTF_DIFFUSE 3u
+#define GLTF_MS 4u
+#define GLTF_GLASS 5u
+#define GLTF_COMPONENTS(X)               \
+  X(GLTF_COAT, coat, BSDF_GLOSSY)        \
+  X(GLTF_METAL, metal, BSDF_GLOSSY)      \
+  X(GLTF_SPEC, spec, BSDF_GLOSSY)        \
+  X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE) \
+  X(GLTF_MS, ms, BSDF_GLOSSY)            \
+  X(GLTF_GLASS, glass, BSDF_GLOSSY)
+#define GLTF_COUNT_COMPONENT(id, name, kind) +1
+#define GLTF_COMPONENT_COUNT (0 GLTF_COMPONENTS(GLTF_COUNT_COMPONENT))
 
-typedef struct {
-  float coat, metal, spec, diffuse, ms, glass;  // selection probabilities, summing to 1
-} GltfLobes;
+// What a component's sample did
+#define GLTF_SAMPLE_FAILED 0  // nothing: the path ends
+#define GLTF_SAMPLE_DIRECTION 1  // chose bs->wi, which the whole mixture weighs
+#define GLTF_SAMPLE_DONE 2  // a complete sample of a delta component
+
+// The material at the hit: factors times textures; KHR_materials_specular gives
+// F0 = min(F0(ior) x colour, 1) x specular and F90 = specular. Where the textures put no
+// specular layer, metal, glass or coat the BSDF is exactly Lambertian: MATERIAL_DIFFUSE
+// takes the short path.
+void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
+  __global const GltfMaterial* g = &m->params.gltf;
+  GltfBsdf* lobe = &b->lobe.gltf;
+  lobe->metallic = g->metallic * bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s).z;
+  lobe->ggx = bsdf_microfacet_at(sc, m, s, g->roughness, g->anisotropy_strength, g->anisotropy_rotation, &b->frame);
+  lobe->transmission = g->transmission * bsdf_texture(sc, m, TEX_TRANSMISSION, s).x;
+  lobe->thin = (m->flags & MATERIAL_THIN_WALLED) != 0u;
+  float spec = g->specular_color[3] * bsdf_texture(sc, m, TEX_SPECULAR, s).w;
+  float r = (g->ior - 1.0f) / (g->ior + 1.0f);
+  float3 tint = load3(g->specular_color) * bsdf_texture(sc, m, TEX_SPECULAR_COLOR, s).xyz;
+  lobe->spec_f0 = fmin(r * r * tint, (float3)(1.0f)) * spec;
+  lobe->spec_f90 = spec;
+  // A thin sheet has air on both sides: light meets air -> glass from either face
+  lobe->eta = b->entering || lobe->thin ? g->ior : 1.0f / g->ior;
+  lobe->coat = g->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
+  float coat_rough = g->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
+  lobe->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);
+  if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f)
+    b->type = MATERIAL_DIFFUSE;
+}
 
 float schlick_weight(float cos_i) {
   float m = clamp(1.0f - cos_i, 0.0f, 1.0f);
@@ -38,8 +87,9 @@ float schlick_weight(float cos_i) {
 
 // The GGX albedo table looked up for the metal and plastic specular lobes, if any
 GgxEnergy gltf_energy(const Bsdf* b, float cos_o) {
-  bool specular = b->metallic > 0.0f || (b->transmission < 1.0f && b->spec_f90 > 0.0f);
-  return energy_ggx(specular ? b->ggx_albedo : 0, b->ggx, cos_o);
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  bool specular = lobe->metallic > 0.0f || (lobe->transmission < 1.0f && lobe->spec_f90 > 0.0f);
+  return energy_ggx(specular ? b->ggx_albedo : 0, lobe->ggx, cos_o);
 }
 
 // A dielectric GGX layer with Schlick's Fresnel term (f0, f90) above something else
@@ -80,14 +130,16 @@ GltfLayer gltf_layer(GgxEnergy e, float3 f0, float f90, float3 f_ms, float cos_o
 
 // The plastic's specular layer over its diffuse base, normalized where the table is bound
 GltfLayer gltf_spec_layer(const Bsdf* b, const GgxEnergy* e, float cos_o) {
-  float3 f_ms = energy_ms_fresnel(e, energy_schlick_average(b->spec_f0, (float3)(b->spec_f90)));
-  return gltf_layer(*e, b->spec_f0, b->spec_f90, f_ms, cos_o, b->ggx_albedo != 0);
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float3 f_ms = energy_ms_fresnel(e, energy_schlick_average(lobe->spec_f0, (float3)(lobe->spec_f90)));
+  return gltf_layer(*e, lobe->spec_f0, lobe->spec_f90, f_ms, cos_o, b->ggx_albedo != 0);
 }
 
 // The clearcoat: Schlick(0.04, 1) weighted by the coat factor, never normalized
 GltfLayer gltf_coat_layer(const Bsdf* b, float cos_o) {
-  GgxEnergy e = energy_ggx(b->coat > 0.0f ? b->ggx_albedo : 0, b->coat_ggx, cos_o);
-  return gltf_layer(e, (float3)(0.04f * b->coat), b->coat, (float3)(0.0f), cos_o, false);
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  GgxEnergy e = energy_ggx(lobe->coat > 0.0f ? b->ggx_albedo : 0, lobe->coat_ggx, cos_o);
+  return gltf_layer(e, (float3)(0.04f * lobe->coat), lobe->coat, (float3)(0.0f), cos_o, false);
 }
 
 // W(mu_o, mu_i) of what lies below the layer, both directions above
@@ -98,95 +150,107 @@ float gltf_below(const GltfLayer* l, float cos_i) {
 
 // Colour of the multiple-scattering lobe: each lobe's weight times its F_ms
 float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
-  float m = b->metallic, t = b->transmission;
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float m = lobe->metallic, t = lobe->transmission;
   float3 metal = energy_ms_fresnel(e, energy_schlick_average(b->base_color, (float3)(1.0f)));
-  float3 spec = energy_ms_fresnel(e, energy_schlick_average(b->spec_f0, (float3)(b->spec_f90)));
+  float3 spec = energy_ms_fresnel(e, energy_schlick_average(lobe->spec_f0, (float3)(lobe->spec_f90)));
   return m * metal + (1.0f - m) * (1.0f - t) * spec;
 }
 
-GltfLobes gltf_lobes(const Bsdf* b, float cos_o, const GgxEnergy* e, const GltfLayer* spec,
-                     const GltfLayer* coat) {
-  float m = b->metallic, t = b->transmission;
-  float fc = coat->a_o;
-  float fs = luminance(fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_o));
-  float rest = 1.0f - fc;
-  GltfLobes w;
-  w.coat = fc;
-  w.metal = rest * m * e->e_o;
-  w.spec = rest * (1.0f - m) * (1.0f - t) * fs * e->e_o;
-  w.diffuse = rest * (1.0f - m) * (1.0f - t) * (1.0f - spec->a_o) * luminance(b->base_color);
-  w.ms = e->table ? rest * energy_ms_albedo(e) * luminance(gltf_ms_fresnel(b, e)) : 0.0f;
-  w.glass = rest * (1.0f - m) * t;
-  float sum = w.coat + w.metal + w.spec + w.diffuse + w.ms + w.glass;
-  float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
-  w.coat *= inv;
-  w.metal *= inv;
-  w.spec *= inv;
-  w.diffuse *= inv;
-  w.ms *= inv;
-  w.glass *= inv;
-  return w;
-}
-
 // Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor, at the coat lobe's wo.h
-float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->coat * (0.04f + 0.96f * schlick_weight(cos_i)); }
+float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i)); }
 
 // What depends on wo alone: the albedo-table lookups, the layers and the mixture weights
 // (computed once per sample: bsdf_gltf_sample evaluates with the ones it sampled with)
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
-  GltfLobes w;
+  float w[GLTF_COMPONENT_COUNT];  // selection probabilities by GLTF_* id, summing to 1 (or all 0)
 } GltfAtWo;
+
+// Each component's weight at wo before normalization: its albedo estimate, below the coat
+float gltf_coat_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) { return g->coat.a_o; }
+
+float gltf_metal_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+  return (1.0f - g->coat.a_o) * b->lobe.gltf.metallic * g->e.e_o;
+}
+
+float gltf_spec_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float fs = luminance(fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_o));
+  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fs * g->e.e_o;
+}
+
+float gltf_diffuse_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * (1.0f - g->spec.a_o) *
+         luminance(b->base_color);
+}
+
+float gltf_ms_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+  return g->e.table ? (1.0f - g->coat.a_o) * energy_ms_albedo(&g->e) * luminance(gltf_ms_fresnel(b, &g->e)) : 0.0f;
+}
+
+float gltf_glass_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * lobe->transmission;
+}
 
 GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
   GltfAtWo g;
   g.e = gltf_energy(b, cos_o);
   g.spec = gltf_spec_layer(b, &g.e, cos_o);
   g.coat = gltf_coat_layer(b, cos_o);
-  g.w = gltf_lobes(b, cos_o, &g.e, &g.spec, &g.coat);
+#define GLTF_WEIGHT(id, name, kind) g.w[id] = gltf_##name##_weight(b, &g, cos_o);
+  GLTF_COMPONENTS(GLTF_WEIGHT)
+#undef GLTF_WEIGHT
+  float sum = g.w[0];
+  for (uint k = 1u; k < GLTF_COMPONENT_COUNT; ++k) sum += g.w[k];
+  float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
+  for (uint k = 0u; k < GLTF_COMPONENT_COUNT; ++k) g.w[k] *= inv;
   return g;
 }
 
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
 float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, float* pdf) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
   *pdf = 0.0f;
   GgxEnergy e = g->e;
   GltfLayer spec = g->spec, coat = g->coat;
-  GltfLobes w = g->w;
-  float m = b->metallic, t = b->transmission;
+  const float* w = g->w;
+  float m = lobe->metallic, t = lobe->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
   float cos_h = wo.z;  // wo.h of reflections
   float d = 0.0f, p = 0.0f;
   if (wi.z > 0.0f) {
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
-    bool glossy = m > 0.0f || b->spec_f90 > 0.0f || b->coat > 0.0f;
-    if (glossy) d = ggx_reflection_eval(b->ggx, wo, wi, &p, &cos_h);
-    float3 fd = glossy ? fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), cos_h) : (float3)(0.0f);
+    bool glossy = m > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
+    if (glossy) d = ggx_reflection_eval(lobe->ggx, wo, wi, &p, &cos_h);
+    float3 fd = glossy ? fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_h) : (float3)(0.0f);
     under = (1.0f - m) * (1.0f - t) * gltf_below(&spec, wi.z) * b->base_color * INV_PI_F;
-    *pdf += w.diffuse * sample_cosine_hemisphere_pdf(wi.z);
-    if (glossy && !ggx_is_delta(b->ggx)) {
+    *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
+    if (glossy && !ggx_is_delta(lobe->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
-      *pdf += (w.metal + w.spec) * p;
+      *pdf += (w[GLTF_METAL] + w[GLTF_SPEC]) * p;
     }
     if (e.table) {
       under += gltf_ms_fresnel(b, &e) * energy_ms(&e, wi.z);
-      *pdf += w.ms * sample_cosine_hemisphere_pdf(wi.z);
+      *pdf += w[GLTF_MS] * sample_cosine_hemisphere_pdf(wi.z);
     }
   }
   if (t > 0.0f) {
     float glass_p;
-    under += (1.0f - m) * t * bsdf_dielectric_eval(b->ggx, b->eta, b->thin, b->base_color, wo, wi, &glass_p);
-    *pdf += w.glass * glass_p;
+    under += (1.0f - m) * t * bsdf_dielectric_eval(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
+    *pdf += w[GLTF_GLASS] * glass_p;
   }
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
   // direction outside
   float3 f = under * (wi.z > 0.0f ? gltf_below(&coat, wi.z) : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -wi.z));
-  if (wi.z > 0.0f && b->coat > 0.0f && !ggx_is_delta(b->coat_ggx)) {
+  if (wi.z > 0.0f && lobe->coat > 0.0f && !ggx_is_delta(lobe->coat_ggx)) {
     float coat_p, coat_h;
-    float coat_d = ggx_reflection_eval(b->coat_ggx, wo, wi, &coat_p, &coat_h);
+    float coat_d = ggx_reflection_eval(lobe->coat_ggx, wo, wi, &coat_p, &coat_h);
     f += gltf_coat_fresnel(b, coat_h) * coat_d;
-    *pdf += w.coat * coat_p;
+    *pdf += w[GLTF_COAT] * coat_p;
   }
   return f;
 }
@@ -200,66 +264,116 @@ float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
 }
 
 // A mirror reflection (a delta component) of weight `weight`, chosen with probability p
-bool gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
+int gltf_mirror(float3 wo, float3 weight, float p, BsdfSample* bs) {
   bs->wi = (float3)(-wo.x, -wo.y, wo.z);
   bs->f = weight / wo.z;
   bs->pdf = p;
   bs->flags = BSDF_REFLECTION | BSDF_DELTA;
   bs->eta = 1.0f;
-  return p > 0.0f;
+  return p > 0.0f ? GLTF_SAMPLE_DONE : GLTF_SAMPLE_FAILED;
 }
 
+// A direction from a GGX lobe's visible normals
+int gltf_ggx_direction(Ggx g, float3 wo, float2 u, BsdfSample* bs) {
+  return ggx_reflection_sample(g, wo, u, &bs->wi) ? GLTF_SAMPLE_DIRECTION : GLTF_SAMPLE_FAILED;
+}
+
+// Each component's sample from wo (wo.z > 0); a mirror reflection crosses the coat twice
+int gltf_coat_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  if (ggx_is_delta(lobe->coat_ggx)) return gltf_mirror(wo, (float3)(gltf_coat_fresnel(b, wo.z)), g->w[GLTF_COAT], bs);
+  return gltf_ggx_direction(lobe->coat_ggx, wo, u, bs);
+}
+
+int gltf_metal_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  if (ggx_is_delta(lobe->ggx)) {
+    float3 weight = lobe->metallic * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z);
+    return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_METAL], bs);
+  }
+  return gltf_ggx_direction(lobe->ggx, wo, u, bs);
+}
+
+int gltf_spec_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  if (ggx_is_delta(lobe->ggx)) {
+    float3 fd = fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), wo.z);
+    float3 weight = (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fd;
+    return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_SPEC], bs);
+  }
+  return gltf_ggx_direction(lobe->ggx, wo, u, bs);
+}
+
+int gltf_diffuse_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  bs->wi = sample_cosine_hemisphere(u.x, u.y);
+  return GLTF_SAMPLE_DIRECTION;
+}
+
+int gltf_ms_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  bs->wi = sample_cosine_hemisphere(u.x, u.y);
+  return GLTF_SAMPLE_DIRECTION;
+}
+
+// A delta transmission crosses the coat once, at the angle of the direction outside
+int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  if (!bsdf_dielectric_sample(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
+    return GLTF_SAMPLE_FAILED;
+  if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
+  float att = bs->wi.z > 0.0f ? gltf_below(&g->coat, wo.z)
+                              : 1.0f - gltf_layer_albedo(&g->coat, b->entering ? wo.z : -bs->wi.z);
+  bs->f *= att * (1.0f - lobe->metallic) * lobe->transmission;
+  bs->pdf *= g->w[GLTF_GLASS];
+  return bs->pdf > 0.0f ? GLTF_SAMPLE_DONE : GLTF_SAMPLE_FAILED;
+}
+
+// A component by uc (its CDF over GLTF_COMPONENTS), sampled with uc rescaled to [0, 1)
+// within the component; a chosen direction is weighed by the whole mixture
 bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
   GltfAtWo at_wo = gltf_at_wo(b, wo.z);
-  GltfLayer coat = at_wo.coat;
-  GltfLobes w = at_wo.w;
-  float m = b->metallic, t = b->transmission;
-  // Component by uc (coat, metal, spec, diffuse, ms, glass); uc is then rescaled to [0, 1)
-  // within the component for reuse
-  float cdf[5] = {w.coat, w.coat + w.metal, w.coat + w.metal + w.spec, w.coat + w.metal + w.spec + w.diffuse,
-                  w.coat + w.metal + w.spec + w.diffuse + w.ms};
-  int c = 0;
-  while (c < 5 && uc >= cdf[c]) ++c;
-  float lo = c == 0 ? 0.0f : cdf[c - 1], width = (c == 5 ? 1.0f : cdf[c]) - lo;
+  const uint last = GLTF_COMPONENT_COUNT - 1u;
+  float cdf[GLTF_COMPONENT_COUNT - 1];
+  cdf[0] = at_wo.w[0];
+  for (uint k = 1u; k < last; ++k) cdf[k] = cdf[k - 1u] + at_wo.w[k];
+  uint c = 0u;
+  while (c < last && uc >= cdf[c]) ++c;
+  float lo = c == 0u ? 0.0f : cdf[c - 1u], width = (c == last ? 1.0f : cdf[c]) - lo;
   float uc2 = width > 0.0f ? clamp((uc - lo) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
-  float coat_att = gltf_below(&coat, wo.z);  // a mirror reflection's, twice through the coat
-  if (c == 0) {
-    if (ggx_is_delta(b->coat_ggx)) return gltf_mirror(wo, (float3)(gltf_coat_fresnel(b, wo.z)), w.coat, bs);
-    if (!ggx_reflection_sample(b->coat_ggx, wo, u, &bs->wi)) return false;
-  } else if (c == 1 || c == 2) {
-    if (ggx_is_delta(b->ggx)) {
-      float3 fd = fresnel_schlick(b->spec_f0, (float3)(b->spec_f90), wo.z);
-      float3 weight = c == 1 ? m * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z) : (1.0f - m) * (1.0f - t) * fd;
-      return gltf_mirror(wo, coat_att * weight, c == 1 ? w.metal : w.spec, bs);
-    }
-    if (!ggx_reflection_sample(b->ggx, wo, u, &bs->wi)) return false;
-  } else if (c == 3 || c == 4) {
-    bs->wi = sample_cosine_hemisphere(u.x, u.y);
-  } else {
-    if (!bsdf_dielectric_sample(b->ggx, b->eta, b->thin, b->base_color, wo, uc2, u, bs)) return false;
-    if (bs->flags & BSDF_DELTA) {
-      float att = bs->wi.z > 0.0f ? coat_att : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -bs->wi.z);
-      bs->f *= att * (1.0f - m) * t;
-      bs->pdf *= w.glass;
-      return bs->pdf > 0.0f;
-    }
+  int done = GLTF_SAMPLE_FAILED;
+  uint kind = 0u;
+#define GLTF_SAMPLE(id, name, flag)                         \
+  if (c == id) {                                            \
+    done = gltf_##name##_sample(b, &at_wo, wo, uc2, u, bs); \
+    kind = flag;                                            \
   }
+  GLTF_COMPONENTS(GLTF_SAMPLE)
+#undef GLTF_SAMPLE
+  if (done != GLTF_SAMPLE_DIRECTION) return done == GLTF_SAMPLE_DONE;
   bool transmits = bs->wi.z < 0.0f;
   bs->f = gltf_eval_at(b, &at_wo, wo, bs->wi, &bs->pdf);
-  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | (c == 3 ? BSDF_DIFFUSE : BSDF_GLOSSY);
-  bs->eta = transmits && !b->thin ? b->eta : 1.0f;
+  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | kind;
+  bs->eta = transmits && !b->lobe.gltf.thin ? b->lobe.gltf.eta : 1.0f;
   return bs->pdf > 0.0f;
 }
 
 // The kinds of lobe present
 uint bsdf_gltf_flags(const Bsdf* b) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
   uint flags = BSDF_REFLECTION;
-  bool plastic = b->metallic < 1.0f && b->transmission < 1.0f;
+  bool plastic = lobe->metallic < 1.0f && lobe->transmission < 1.0f;
   if (plastic && max_component(b->base_color) > 0.0f) flags |= BSDF_DIFFUSE;
-  bool spec_delta = ggx_is_delta(b->ggx), coat_delta = b->coat > 0.0f && ggx_is_delta(b->coat_ggx);
-  if (b->metallic > 0.0f || b->spec_f90 > 0.0f || b->transmission > 0.0f) flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
-  if (b->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
-  if (b->transmission > 0.0f && b->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
+  bool spec_delta = ggx_is_delta(lobe->ggx), coat_delta = lobe->coat > 0.0f && ggx_is_delta(lobe->coat_ggx);
+  if (lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->transmission > 0.0f) flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (lobe->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (lobe->transmission > 0.0f && lobe->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
   return flags;
+}
+
+// Alpha of the widest microfacet lobe: the specular one's, or the coat's where wider
+float bsdf_gltf_alpha(const Bsdf* b) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float a = sqrt(lobe->ggx.ax * lobe->ggx.ay);
+  if (lobe->coat > 0.0f) a = fmax(a, sqrt(lobe->coat_ggx.ax * lobe->coat_ggx.ay));
+  return a;
 }

@@ -1,16 +1,10 @@
-// Light types a scene has none of are compiled out (SceneFeatures: punctual lights,
-// the environment); emissive triangles are always in
-#ifndef CD_FEATURE_PUNCTUAL
-#define CD_FEATURE_PUNCTUAL 1
-#endif
-#ifndef CD_FEATURE_ENVIRONMENT
-#define CD_FEATURE_ENVIRONMENT 1
-#endif
-
 // Light sampling from a context (a surface point, or a point in a medium), through one
 // light-selection alias table with probabilities proportional to power. Directions and pdfs
 // are measured from ctx.p; a finite light's shadow ray ends at `target`, just off the
-// light's surface on ctx.p's side.
+// light's surface on ctx.p's side. Each light type has lights_NAME_sample and
+// lights_NAME_pdf; the dispatch on the type is generated from CD_LIGHTS
+// (cl/shared/device_types.h), and a type whose feature is off (SceneFeatures: punctual
+// lights, the environment) is compiled out.
 
 typedef struct {
   float3 p;
@@ -62,15 +56,16 @@ bool lights_environment_hemisphere(const LightSampleContext* ctx) {
 }
 
 // A map is importance-sampled over the whole sphere, whatever the context
-float lights_pdf_environment(const SceneData* sc, const LightSampleContext* ctx, float3 wi) {
+float lights_environment_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                             float3 wi) {
   __global const Light* env = lights_environment(sc);
   if (env && environment_map(env) != NO_TEXTURE) return environment_pdf(sc, env, wi);
   if (lights_environment_hemisphere(ctx)) return sample_cosine_hemisphere_pdf(dot(wi, ctx->n));
   return sample_uniform_sphere_pdf();
 }
 
-bool lights_sample_environment(const SceneData* sc, const LightSampleContext* ctx, float2 u,
-                               LightSample* ls) {
+bool lights_environment_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                               float2 u, LightSample* ls) {
   __global const Light* env = lights_environment(sc);
   if (env && environment_map(env) != NO_TEXTURE) {
     ls->wi = environment_sample(sc, env, u, &ls->pdf);
@@ -84,7 +79,7 @@ bool lights_sample_environment(const SceneData* sc, const LightSampleContext* ct
   } else {
     ls->wi = sample_uniform_sphere(u.x, u.y);
   }
-  ls->pdf = lights_pdf_environment(sc, ctx, ls->wi);
+  ls->pdf = lights_environment_pdf(sc, light, ctx, ls->wi);
   ls->radiance = lights_environment_radiance(sc, ls->wi);
   ls->at_infinity = true;
   return ls->pdf > 0.0f;
@@ -186,7 +181,7 @@ float lights_triangle_solid_angle_pdf(float3 p, float3 y, float3 n, float area) 
 
 // A point on the light's triangle, uniform in solid angle or in area (see above), with
 // its solid-angle pdf at ctx.p
-bool lights_sample_triangle(const SceneData* sc, __global const Light* light,
+bool lights_triangle_sample(const SceneData* sc, __global const Light* light,
                             const LightSampleContext* ctx, float2 u, LightSample* ls) {
   float3 v0, v1, v2;
   scene_prim_positions(sc, light->index, &v0, &v1, &v2);
@@ -220,9 +215,9 @@ bool lights_sample_triangle(const SceneData* sc, __global const Light* light,
   return ls->pdf > 0.0f && isfinite(ls->pdf);
 }
 
-// The pdf lights_sample_triangle would give for wi: where the ray from ctx.p along wi
+// The pdf lights_triangle_sample would give for wi: where the ray from ctx.p along wi
 // meets the light's triangle (0 if it misses)
-float lights_pdf_triangle(const SceneData* sc, __global const Light* light,
+float lights_triangle_pdf(const SceneData* sc, __global const Light* light,
                           const LightSampleContext* ctx, float3 wi) {
   float3 v0, v1, v2;
   scene_prim_positions(sc, light->index, &v0, &v1, &v2);
@@ -259,9 +254,9 @@ float lights_spot_falloff(__global const Light* light, float cos_axis) {
   return t * t;
 }
 
-// Point and spot lights: intensity I gives irradiance I / d^2 at ctx.p; the shadow ray
-// ends at the light's position
-bool lights_sample_point(__global const Light* light, const LightSampleContext* ctx, LightSample* ls) {
+// Point and spot lights: intensity I gives irradiance I / d^2 at ctx.p, a spot's scaled by
+// its cone profile; the shadow ray ends at the light's position
+bool lights_sample_position(__global const Light* light, const LightSampleContext* ctx, bool spot, LightSample* ls) {
   float3 pos = load3(light->params);
   float3 d = pos - ctx->p;
   float dist2 = dot(d, d);
@@ -269,7 +264,7 @@ bool lights_sample_point(__global const Light* light, const LightSampleContext* 
   float dist = sqrt(dist2);
   ls->wi = d / dist;
   float scale = lights_range_window(light->radiance[3], dist) / dist2;
-  if (light->type == LIGHT_SPOT) scale *= lights_spot_falloff(light, -dot(ls->wi, load3(light->params + 3)));
+  if (spot) scale *= lights_spot_falloff(light, -dot(ls->wi, load3(light->params + 3)));
   ls->radiance = load3(light->radiance) * scale;
   ls->pdf = 1.0f;
   ls->is_delta = true;
@@ -278,8 +273,19 @@ bool lights_sample_point(__global const Light* light, const LightSampleContext* 
   return scale > 0.0f && isfinite(scale);
 }
 
+bool lights_point_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float2 u,
+                         LightSample* ls) {
+  return lights_sample_position(light, ctx, false, ls);
+}
+
+bool lights_spot_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float2 u,
+                        LightSample* ls) {
+  return lights_sample_position(light, ctx, true, ls);
+}
+
 // Directional light: irradiance E at normal incidence from the one direction it comes from
-bool lights_sample_directional(__global const Light* light, LightSample* ls) {
+bool lights_directional_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                               float2 u, LightSample* ls) {
   ls->wi = -load3(light->params + 3);
   ls->radiance = load3(light->radiance);
   ls->pdf = 1.0f;
@@ -288,35 +294,36 @@ bool lights_sample_directional(__global const Light* light, LightSample* ls) {
   return true;
 }
 
+// A delta in direction: no sampled direction finds a punctual light
+float lights_point_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float3 wi) {
+  return 0.0f;
+}
+float lights_spot_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float3 wi) {
+  return 0.0f;
+}
+float lights_directional_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                             float3 wi) {
+  return 0.0f;
+}
+
+// Samples a direction toward `light` by its type
+bool lights_sample_light(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float2 u,
+                         LightSample* ls) {
+#define LIGHTS_SAMPLE(id, name, feature) \
+  if (feature && light->type == id) return lights_##name##_sample(sc, light, ctx, u, ls);
+  CD_LIGHTS(LIGHTS_SAMPLE)
+#undef LIGHTS_SAMPLE
+  return false;
+}
+
 // Picks a light by x_select (power-proportional alias table) and samples a direction toward it
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u,
                    LightSample* ls) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
   __global const Light* light = &sc->lights[sample_discrete_alias(sc->light_alias, n, x_select)];
-  bool ok;
   ls->is_delta = false;
-  switch (light->type) {
-    case LIGHT_TRIANGLE:
-      ok = lights_sample_triangle(sc, light, ctx, u, ls);
-      break;
-#if CD_FEATURE_ENVIRONMENT
-    case LIGHT_ENVIRONMENT:
-      ok = lights_sample_environment(sc, ctx, u, ls);
-      break;
-#endif
-#if CD_FEATURE_PUNCTUAL
-    case LIGHT_POINT:
-    case LIGHT_SPOT:
-      ok = lights_sample_point(light, ctx, ls);
-      break;
-    case LIGHT_DIRECTIONAL:
-      ok = lights_sample_directional(light, ls);
-      break;
-#endif
-    default:
-      ok = false;
-  }
+  bool ok = lights_sample_light(sc, light, ctx, u, ls);
   ls->pdf *= light->pmf;
   return ok && light->pmf > 0.0f;
 }
@@ -324,18 +331,9 @@ bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_se
 // The pdf with which lights_sample picks light `index` and direction wi from ctx
 float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index, float3 wi) {
   __global const Light* light = &sc->lights[index];
-  switch (light->type) {
-    case LIGHT_TRIANGLE:
-      return light->pmf * lights_pdf_triangle(sc, light, ctx, wi);
-#if CD_FEATURE_ENVIRONMENT
-    case LIGHT_ENVIRONMENT:
-      return light->pmf * lights_pdf_environment(sc, ctx, wi);
-#endif
-    case LIGHT_POINT:
-    case LIGHT_SPOT:
-    case LIGHT_DIRECTIONAL:
-      return 0.0f;  // a delta in direction: no sampled direction finds it
-    default:
-      return 0.0f;
-  }
+#define LIGHTS_PDF(id, name, feature) \
+  if (feature && light->type == id) return light->pmf * lights_##name##_pdf(sc, light, ctx, wi);
+  CD_LIGHTS(LIGHTS_PDF)
+#undef LIGHTS_PDF
+  return 0.0f;
 }

@@ -18,10 +18,6 @@
 // emission grid Medium.emission_grid names), so a ray crossing length d of a homogeneous
 // medium gathers emission (1 - exp(-sigma_t d)) / sigma_t.
 
-#ifndef CD_FEATURE_MEDIA
-#define CD_FEATURE_MEDIA 1
-#endif
-
 #define MEDIUM_STACK_SIZE 4
 #define MEDIA_WALK_MAX 32  // boundaries media_at_origin and shadow rays cross at most
 

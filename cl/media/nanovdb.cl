@@ -15,10 +15,6 @@
 //   world bounding box), which this file never calls, use it.
 // NanoVDB reads the float map (matf, invmatf, vecf) for world <-> index.
 
-#ifndef CD_FEATURE_NANOVDB
-#define CD_FEATURE_NANOVDB CD_PNANOVDB_AVAILABLE  // the test program: on when built with NanoVDB
-#endif
-
 #if CD_FEATURE_NANOVDB
 
 typedef uint uint32_t;

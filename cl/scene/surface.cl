@@ -1,16 +1,6 @@
 // Surface data at a point of a primitive: position, normals, texture coordinates, tangent
 // and vertex colour, interpolated from the per-vertex arrays.
 
-#ifndef CD_FEATURE_UVS
-#define CD_FEATURE_UVS 1
-#endif
-#ifndef CD_FEATURE_TANGENTS
-#define CD_FEATURE_TANGENTS 1
-#endif
-#ifndef CD_FEATURE_VERTEX_COLORS
-#define CD_FEATURE_VERTEX_COLORS 1
-#endif
-
 typedef struct {
   float3 p;
   float3 ng;  // geometric normal, turned to the side the ray came from

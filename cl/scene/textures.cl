@@ -3,10 +3,6 @@
 // filtering happens in linear space. Each material slot is a TextureRef: texture, UV set
 // and transform.
 
-#ifndef CD_FEATURE_TEXTURES
-#define CD_FEATURE_TEXTURES 1
-#endif
-
 int texture_wrap(int i, int n, uint mode) {
   if (mode == WRAP_CLAMP) return clamp(i, 0, n - 1);
   if (mode == WRAP_MIRROR) {

@@ -2,15 +2,48 @@
 // Included by the OpenCL program (first in the source list) and by the host inside
 // namespace candela::dev (host/device_types.hpp), which static_asserts every layout from
 // CD_LAYOUT below; the device-side layout test checks the same list on each device.
-// Only 4-byte scalars and arrays of them: no float3, no vector types, explicit padding.
+// Only 4-byte scalars, arrays of them and unions of such structs: no float3, no vector types,
+// explicit padding.
 
 #ifndef CANDELA_DEVICE_TYPES_H
 #define CANDELA_DEVICE_TYPES_H
 
-// Material types (switch-dispatched in bsdf.cl)
+// Kernel features: code a scene does without is compiled out of its kernel. CD_SCENE_FEATURES:
+// X(name, macro, default, needs), one entry per feature, generates SceneFeatures
+// (host/scene/scene.hpp: the field `name`, on when the scene has what `needs` says), the
+// build options -Dmacro=0|1 in this order (part of the program-cache key) and the kernel's
+// default without them, `#define macro default`, which host/device/kernel_sources.cpp
+// prepends to the program. Kernel code tests `#if macro`.
+#define CD_SCENE_FEATURES(X)                                                                       \
+  X(textures, CD_FEATURE_TEXTURES, 1, "some material slot has a texture")                          \
+  X(uvs, CD_FEATURE_UVS, 1, "some mesh has TEXCOORD_0 or TEXCOORD_1")                              \
+  X(tangents, CD_FEATURE_TANGENTS, 1, "some mesh has TANGENT")                                     \
+  X(vertex_colors, CD_FEATURE_VERTEX_COLORS, 1, "some COLOR_0 is not white")                       \
+  X(alpha, CD_FEATURE_ALPHA, 1, "a mesh's material is alpha-tested (alpha_tested)")                \
+  X(media, CD_FEATURE_MEDIA, 1, "a global medium, or a mesh's material with an interior medium")   \
+  X(nanovdb, CD_FEATURE_NANOVDB, CD_PNANOVDB_AVAILABLE, "a medium with a NanoVDB grid")            \
+  X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material shaded as MATERIAL_GLTF (kernel_type)") \
+  X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
+  X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
+  X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
+
+// Material types. CD_MATERIALS: X(id, name, feature), one entry per type, generates every
+// dispatch on Material.type and Bsdf.type (cl/bsdf/bsdf.cl; the host's compile step and name
+// table). Each type has its lobe in cl/bsdf/bsdf_NAME.cl with the five functions
+//   void bsdf_NAME_params(const SceneData*, __global const Material*, const SurfaceHit*, Bsdf*)
+//   uint bsdf_NAME_flags(const Bsdf*)
+//   float3 bsdf_NAME_eval(const Bsdf*, float3 wo, float3 wi, float* pdf)
+//   bool bsdf_NAME_sample(const Bsdf*, float3 wo, float uc, float2 u, BsdfSample*)
+//   float bsdf_NAME_alpha(const Bsdf*)
+// and on the host compile_material_NAME (host/compile/scene_compiler.cpp). `feature` is the
+// CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
 #define MATERIAL_DIFFUSE 0u  // Lambertian, albedo = base color
 #define MATERIAL_GLTF 1u  // glTF metallic-roughness with its KHR_materials_* extensions
 #define MATERIAL_CONDUCTOR 2u  // measured conductor: complex index eta + i k, GGX roughness
+#define CD_MATERIALS(X)                                  \
+  X(MATERIAL_DIFFUSE, diffuse, 1)                        \
+  X(MATERIAL_GLTF, gltf, CD_FEATURE_GLTF_BSDF)           \
+  X(MATERIAL_CONDUCTOR, conductor, CD_FEATURE_CONDUCTOR)
 
 // Material flags
 #define MATERIAL_DOUBLE_SIDED 1u
@@ -32,12 +65,24 @@
 #define TEX_ANISOTROPY 9  // RG direction in tangent space, B strength
 #define TEX_SLOTS 10
 
-// Light types (lights.cl)
+// Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
+// on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
+//   bool lights_NAME_sample(const SceneData*, __global const Light*, const LightSampleContext*,
+//                           float2 u, LightSample*)
+//   float lights_NAME_pdf(const SceneData*, __global const Light*, const LightSampleContext*, float3 wi)
+// in cl/lights/ and light_power_NAME on the host (host/compile/scene_compiler.cpp). `feature`
+// is the CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
 #define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
 #define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away: constant or a map
 #define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
 #define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
 #define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
+#define CD_LIGHTS(X)                                        \
+  X(LIGHT_TRIANGLE, triangle, 1)                            \
+  X(LIGHT_ENVIRONMENT, environment, CD_FEATURE_ENVIRONMENT) \
+  X(LIGHT_POINT, point, CD_FEATURE_PUNCTUAL)                \
+  X(LIGHT_SPOT, spot, CD_FEATURE_PUNCTUAL)                  \
+  X(LIGHT_DIRECTIONAL, directional, CD_FEATURE_PUNCTUAL)
 
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
@@ -131,22 +176,41 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Material, 464 bytes. Colours are linear RGB; factors multiply their texture slots.
+// Parameters of a MATERIAL_GLTF material, 48 bytes; factors multiply their texture slots
+typedef struct {
+  float ior;  // KHR_materials_ior (1.5)
+  float metallic, roughness, transmission;
+  float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
+  float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
+} GltfMaterial;
+
+// Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
+// (w unused), GGX roughness and KHR_materials_anisotropy as in GltfMaterial
+typedef struct {
+  float eta[4];
+  float k[4];
+  float roughness, anisotropy_strength, anisotropy_rotation;
+  unsigned int pad;
+} ConductorMaterial;
+
+// A material type's own parameters (Material.type selects the member), 48 bytes
+typedef union {
+  GltfMaterial gltf;
+  ConductorMaterial conductor;
+} MaterialParams;
+
+// Material, 416 bytes: what every type has, then its type's parameters. Colours are linear
+// RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;  // MATERIAL_*
   unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
   float alpha_cutoff;  // alphaMode MASK
-  float ior;  // KHR_materials_ior (1.5)
+  float normal_scale;
   float base_color[4];  // rgba factor
-  float emission[4];  // rgb radiance (factor x strength), w unused
-  float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
-  float conductor_eta[4];  // MATERIAL_CONDUCTOR: eta per channel
-  float conductor_k[4];  // MATERIAL_CONDUCTOR: k per channel
-  float metallic, roughness, transmission, normal_scale;
-  float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
-  TextureRef textures[TEX_SLOTS];  // TEX_* slots
+  float emission[3];  // rgb radiance (factor x strength)
   int medium;  // the medium inside a closed surface (into `media`), or NO_MEDIUM
-  unsigned int pad[3];
+  MaterialParams params;  // by type
+  TextureRef textures[TEX_SLOTS];  // TEX_* slots
 } Material;
 
 // A texture inside one of the shared texel arrays, 16 bytes.
@@ -312,11 +376,14 @@ typedef struct {
   FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
-  SIZE(Material, 464) FIELD(Material, ior, 12) FIELD(Material, base_color, 16)             \
-  FIELD(Material, emission, 32) FIELD(Material, specular_color, 48)                         \
-  FIELD(Material, conductor_k, 80) FIELD(Material, metallic, 96)                            \
-  FIELD(Material, clearcoat, 112) FIELD(Material, anisotropy_rotation, 124)                 \
-  FIELD(Material, textures, 128) FIELD(Material, medium, 448)                               \
+  SIZE(GltfMaterial, 48) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16) \
+  FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)          \
+  SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16)                               \
+  FIELD(ConductorMaterial, roughness, 32) FIELD(ConductorMaterial, pad, 44)                 \
+  SIZE(MaterialParams, 48)                                                                  \
+  SIZE(Material, 416) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)     \
+  FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)     \
+  FIELD(Material, textures, 96)                                                             \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
   SIZE(TexelF, 16)                                                                          \

@@ -1,11 +1,13 @@
 // Host view of cl/shared/device_types.h, the one definition of every struct that crosses to
 // the device, with its layout pinned down by static_asserts generated from CD_LAYOUT;
-// tests/layout_test.cpp checks the same list on each device. cl/shared/color.h brings the
-// colour helpers both sides share.
+// tests/device/layout_test.cpp checks the same list on each device. The name tables of the
+// material and light types come from their lists (CD_MATERIALS, CD_LIGHTS). cl/shared/color.h
+// brings the colour helpers both sides share.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <vector>
 
 namespace candela::dev {
@@ -42,4 +44,39 @@ constexpr unsigned kSceneBufferCount = 0 CD_SCENE_BUFFERS(CD_COUNT_BUFFER);
 #define CD_BUFFER_INDEX(type, name) name,
 enum class SceneBuffer : unsigned { CD_SCENE_BUFFERS(CD_BUFFER_INDEX) };
 #undef CD_BUFFER_INDEX
+
+// The ids of CD_MATERIALS and CD_LIGHTS number their lists: 0, 1, 2, ...
+constexpr bool numbers_the_list(std::initializer_list<unsigned> ids) {
+  unsigned n = 0;
+  for (unsigned id : ids)
+    if (id != n++) return false;
+  return true;
+}
+#define CD_TYPE_ID(id, name, feature) id,
+static_assert(numbers_the_list({CD_MATERIALS(CD_TYPE_ID)}), "CD_MATERIALS ids must be 0, 1, 2, ... in list order");
+static_assert(numbers_the_list({CD_LIGHTS(CD_TYPE_ID)}), "CD_LIGHTS ids must be 0, 1, 2, ... in list order");
+#undef CD_TYPE_ID
+
+// Number of material and light types
+#define CD_COUNT_TYPE(id, name, feature) +1
+constexpr unsigned kMaterialTypeCount = 0 CD_MATERIALS(CD_COUNT_TYPE);
+constexpr unsigned kLightTypeCount = 0 CD_LIGHTS(CD_COUNT_TYPE);
+#undef CD_COUNT_TYPE
+
+// Names of the material and light types (the name column of their lists), indexed by id
+#define CD_TYPE_NAME(id, name, feature) #name,
+constexpr const char* kMaterialTypeNames[] = {CD_MATERIALS(CD_TYPE_NAME)};
+constexpr const char* kLightTypeNames[] = {CD_LIGHTS(CD_TYPE_NAME)};
+#undef CD_TYPE_NAME
+
+// Names of the kernel features (the name column of CD_SCENE_FEATURES; SceneFeatures' fields)
+#define CD_FEATURE_NAME(name, macro, fallback, needs) #name,
+constexpr const char* kSceneFeatureNames[] = {CD_SCENE_FEATURES(CD_FEATURE_NAME)};
+#undef CD_FEATURE_NAME
+
+// The name of material or light type `type`; nullptr for an unknown one
+constexpr const char* material_type_name(unsigned type) {
+  return type < kMaterialTypeCount ? kMaterialTypeNames[type] : nullptr;
+}
+constexpr const char* light_type_name(unsigned type) { return type < kLightTypeCount ? kLightTypeNames[type] : nullptr; }
 }  // namespace candela::dev

@@ -70,34 +70,53 @@ dev::TextureRef compile_texture_ref(const TextureSlot& r) {
   return d;
 }
 
+// The parameters of each material type (CD_MATERIALS), into Material.params
+void compile_material_diffuse(const MaterialDesc&, dev::Material*) {}
+
+void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
+  dev::GltfMaterial& g = d->params.gltf;
+  g.ior = m.ior;
+  g.metallic = m.metallic;
+  g.roughness = m.roughness;
+  g.transmission = m.transmission;
+  for (int c = 0; c < 3; ++c) g.specular_color[c] = m.specular_color[c];
+  g.specular_color[3] = m.specular;
+  g.clearcoat = m.clearcoat;
+  g.clearcoat_roughness = m.clearcoat_roughness;
+  g.anisotropy_strength = m.anisotropy_strength;
+  g.anisotropy_rotation = m.anisotropy_rotation;
+}
+
+void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {
+  dev::ConductorMaterial& c = d->params.conductor;
+  for (int k = 0; k < 3; ++k) {
+    c.eta[k] = m.conductor_eta[k];
+    c.k[k] = m.conductor_k[k];
+  }
+  c.roughness = m.roughness;
+  c.anisotropy_strength = m.anisotropy_strength;
+  c.anisotropy_rotation = m.anisotropy_rotation;
+}
+
 void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
   for (const MaterialDesc& m : scene.materials) {
     dev::Material d{};
     d.type = m.kernel_type();
+    if (!dev::material_type_name(d.type)) throw Error("compile_scene: unknown material type " + std::to_string(d.type));
     d.flags = (m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.thin_walled ? MATERIAL_THIN_WALLED : 0u) |
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
     d.flags |= m.null_boundary ? MATERIAL_NULL_BOUNDARY : 0u;
     d.medium = NO_MEDIUM;  // compile_media sets the insides of closed surfaces
     d.alpha_cutoff = m.alpha_cutoff;
-    d.ior = m.ior;
-    for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
-    for (int c = 0; c < 3; ++c) {
-      d.emission[c] = m.emission[c];
-      d.specular_color[c] = m.specular_color[c];
-      d.conductor_eta[c] = m.conductor_eta[c];
-      d.conductor_k[c] = m.conductor_k[c];
-    }
-    d.specular_color[3] = m.specular;
-    d.metallic = m.metallic;
-    d.roughness = m.roughness;
-    d.transmission = m.transmission;
     d.normal_scale = m.normal_scale;
-    d.clearcoat = m.clearcoat;
-    d.clearcoat_roughness = m.clearcoat_roughness;
-    d.anisotropy_strength = m.anisotropy_strength;
-    d.anisotropy_rotation = m.anisotropy_rotation;
+    for (int c = 0; c < 4; ++c) d.base_color[c] = m.base_color[c];
+    for (int c = 0; c < 3; ++c) d.emission[c] = m.emission[c];
     for (int slot = 0; slot < TEX_SLOTS; ++slot) d.textures[slot] = compile_texture_ref(m.textures[slot]);
+#define CD_COMPILE_MATERIAL(id, name, feature) \
+  if (d.type == id) compile_material_##name(m, &d);
+    CD_MATERIALS(CD_COMPILE_MATERIAL)
+#undef CD_COMPILE_MATERIAL
     b->materials.push_back(d);
   }
 }
@@ -434,39 +453,49 @@ void check_extent(const Scene& scene, const CameraDesc& camera) {
     throw Error("the camera has no viewing direction (its node transform is degenerate or not finite)");
 }
 
+// Emitted power of each light type (CD_LIGHTS), as light_power documents
+double light_power_triangle(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale, double) {
+  // Diffuse emitter: power = pi * L * A per emitting side
+  const dev::Material& m = buffers.materials[buffers.prims[light.index].material];
+  double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
+  return kPi * lum * light.params[0] * ((m.flags & MATERIAL_DOUBLE_SIDED) ? 2.0 : 1.0);
+}
+
+// A constant environment's power through the scene's bounding sphere; a map's (params[0] a
+// texture) with its mean radiance luminance, passed as emission_scale
+double light_power_environment(const dev::Light& light, const dev::SceneBuffers&, double emission_scale,
+                               double scene_radius) {
+  bool map = int(light.params[0]) != NO_TEXTURE;
+  double lum = map ? emission_scale : dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+  return 4.0 * kPi * kPi * scene_radius * scene_radius * lum;
+}
+
+// Radiant intensity I over the sphere, or over the spot's profile. A finite range is left
+// out: the power is then an upper bound, which only costs variance.
+double light_power_point(const dev::Light& light, const dev::SceneBuffers&, double, double) {
+  double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+  return lum * (4.0 * kPi);
+}
+
+double light_power_spot(const dev::Light& light, const dev::SceneBuffers&, double, double) {
+  double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+  return lum * spot_solid_angle(light.params[6], light.params[7]);
+}
+
+// Irradiance E through the disc the scene's bounding sphere shows the light
+double light_power_directional(const dev::Light& light, const dev::SceneBuffers&, double, double scene_radius) {
+  return kPi * scene_radius * scene_radius * dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+}
+
 }  // namespace
 
 double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
                    double scene_radius) {
-  switch (light.type) {
-    case LIGHT_TRIANGLE: {
-      // Diffuse emitter: power = pi * L * A per emitting side
-      const dev::Material& m = buffers.materials[buffers.prims[light.index].material];
-      double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
-      return kPi * lum * light.params[0] * ((m.flags & MATERIAL_DOUBLE_SIDED) ? 2.0 : 1.0);
-    }
-    case LIGHT_ENVIRONMENT: {
-      // A constant environment's power through the scene's bounding sphere; a map's
-      // (params[0] a texture) with its mean radiance luminance, passed as emission_scale
-      bool map = int(light.params[0]) != NO_TEXTURE;
-      double lum = map ? emission_scale : dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-      return 4.0 * kPi * kPi * scene_radius * scene_radius * lum;
-    }
-    case LIGHT_POINT:
-    case LIGHT_SPOT: {
-      // Radiant intensity I over the sphere, or over the spot's profile. A finite range
-      // is left out: the power is then an upper bound, which only costs variance.
-      double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-      double solid_angle = light.type == LIGHT_POINT ? 4.0 * kPi : spot_solid_angle(light.params[6], light.params[7]);
-      return lum * solid_angle;
-    }
-    case LIGHT_DIRECTIONAL:
-      // Irradiance E through the disc the scene's bounding sphere shows the light
-      return kPi * scene_radius * scene_radius *
-             dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-    default:
-      throw Error("light_power: unknown light type " + std::to_string(light.type));
-  }
+#define CD_LIGHT_POWER(id, name, feature) \
+  if (light.type == id) return light_power_##name(light, buffers, emission_scale, scene_radius);
+  CD_LIGHTS(CD_LIGHT_POWER)
+#undef CD_LIGHT_POWER
+  throw Error("light_power: unknown light type " + std::to_string(light.type));
 }
 
 std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "base/device_types.hpp"
 #include "base/error.hpp"
 
 namespace candela {
@@ -73,8 +74,19 @@ std::string resolve_includes(const std::string& path, std::string text) {
   return text;
 }
 
+// The kernel's default of every CD_SCENE_FEATURES macro, for a build that does not set it
+std::string feature_defaults() {
+  std::string text;
+#define CD_FEATURE_DEFAULT(name, macro, fallback, needs) \
+  text += "#ifndef " #macro "\n#define " #macro " " #fallback "\n#endif\n";
+  CD_SCENE_FEATURES(CD_FEATURE_DEFAULT)
+#undef CD_FEATURE_DEFAULT
+  return text;
+}
+
 std::string program_source(bool with_tests) {
   std::string src = std::string("#define CD_PNANOVDB_AVAILABLE ") + (pnanovdb_header() ? "1" : "0") + "\n";
+  src += feature_defaults();
   for (const auto& f : embedded_kernel_files()) {
     if (is_system_header(f)) continue;
     bool is_test = std::string(f.path).rfind("tests/", 0) == 0;

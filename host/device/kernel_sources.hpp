@@ -21,7 +21,8 @@ void set_kernel_source_root(const std::string& root);
 // the text lacks what the edits expect
 std::string pnanovdb_opencl_text(std::string text);
 
-// The renderer program: every cl/ file in order, each starting with a #line marker
+// The renderer program: the kernel's default of every feature macro (CD_SCENE_FEATURES), then
+// every cl/ file in order, each starting with a #line marker
 std::string renderer_program_source();
 
 // The renderer program followed by the test kernels of tests/cl/

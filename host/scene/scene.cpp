@@ -8,21 +8,45 @@
 namespace candela {
 
 std::string SceneFeatures::build_options() const {
-  auto flag = [](const char* name, bool on) { return std::string(" -D") + name + (on ? "=1" : "=0"); };
-  return flag("CD_FEATURE_TEXTURES", textures).substr(1) + flag("CD_FEATURE_UVS", uvs) +
-         flag("CD_FEATURE_TANGENTS", tangents) + flag("CD_FEATURE_VERTEX_COLORS", vertex_colors) +
-         flag("CD_FEATURE_ALPHA", alpha) + flag("CD_FEATURE_MEDIA", media) +
-         flag("CD_FEATURE_NANOVDB", nanovdb) + flag("CD_FEATURE_GLTF_BSDF", gltf_bsdf) +
-         flag("CD_FEATURE_CONDUCTOR", conductor) + flag("CD_FEATURE_PUNCTUAL", punctual) +
-         flag("CD_FEATURE_ENVIRONMENT", environment);
+  std::string options;
+#define CD_FEATURE_OPTION(name, macro, fallback, needs) \
+  options += std::string(options.empty() ? "" : " ") + "-D" #macro + (name ? "=1" : "=0");
+  CD_SCENE_FEATURES(CD_FEATURE_OPTION)
+#undef CD_FEATURE_OPTION
+  return options;
 }
 
-bool SceneFeatures::covers(const SceneFeatures& n) const {
-  auto has = [](bool kernel, bool needed) { return kernel || !needed; };
-  return has(textures, n.textures) && has(uvs, n.uvs) && has(tangents, n.tangents) &&
-         has(vertex_colors, n.vertex_colors) && has(alpha, n.alpha) && has(media, n.media) &&
-         has(nanovdb, n.nanovdb) && has(gltf_bsdf, n.gltf_bsdf) && has(conductor, n.conductor) &&
-         has(punctual, n.punctual) && has(environment, n.environment);
+bool SceneFeatures::covers(const SceneFeatures& needed) const {
+  bool all = true;
+#define CD_FEATURE_COVERS(name, macro, fallback, needs) all = all && (name || !needed.name);
+  CD_SCENE_FEATURES(CD_FEATURE_COVERS)
+#undef CD_FEATURE_COVERS
+  return all;
+}
+
+std::vector<std::string> SceneFeatures::names() const {
+  std::vector<std::string> on;
+#define CD_FEATURE_NAME(name, macro, fallback, needs) \
+  if (name) on.push_back(#name);
+  CD_SCENE_FEATURES(CD_FEATURE_NAME)
+#undef CD_FEATURE_NAME
+  return on;
+}
+
+SceneFeatures SceneFeatures::all() {
+  SceneFeatures f;
+#define CD_FEATURE_ON(name, macro, fallback, needs) f.name = true;
+  CD_SCENE_FEATURES(CD_FEATURE_ON)
+#undef CD_FEATURE_ON
+  return f;
+}
+
+bool SceneFeatures::*SceneFeatures::flag(const std::string& macro) {
+#define CD_FEATURE_FLAG(name, macro_name, fallback, needs) \
+  if (macro == #macro_name) return &SceneFeatures::name;
+  CD_SCENE_FEATURES(CD_FEATURE_FLAG)
+#undef CD_FEATURE_FLAG
+  return nullptr;
 }
 
 uint32_t MaterialDesc::kernel_type() const {
@@ -69,6 +93,19 @@ Bounds Scene::bounds() const {
   return b;
 }
 
+namespace {
+
+// The feature that compiles material type `type` in (its CD_MATERIALS entry); nullptr: always in
+bool SceneFeatures::*material_feature(uint32_t type) {
+#define CD_MATERIAL_FEATURE(id, name, feature) \
+  if (type == id) return SceneFeatures::flag(#feature);
+  CD_MATERIALS(CD_MATERIAL_FEATURE)
+#undef CD_MATERIAL_FEATURE
+  return nullptr;
+}
+
+}  // namespace
+
 SceneFeatures Scene::features() const {
   SceneFeatures f;
   for (const auto& m : materials)
@@ -79,9 +116,9 @@ SceneFeatures Scene::features() const {
     for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
     f.alpha |= materials.at(m.material).alpha_tested();
     f.media |= materials.at(m.material).medium >= 0;
-    // BSDFs of the materials meshes use (the loader's default material may go unused)
-    f.gltf_bsdf |= materials.at(m.material).kernel_type() == MATERIAL_GLTF;
-    f.conductor |= materials.at(m.material).kernel_type() == MATERIAL_CONDUCTOR;
+    // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
+    // loader's default material may go unused)
+    if (bool SceneFeatures::*flag = material_feature(materials.at(m.material).kernel_type())) f.*flag = true;
   }
   f.media |= global_medium >= 0;
   for (const auto& m : media) f.nanovdb |= f.media && m.is_nanovdb();

@@ -166,29 +166,24 @@ struct Bounds {
   float radius() const { return 0.5f * glm::length(hi - lo); }
 };
 
-// Coarse scene features that select kernel code at build time (part of the cache key)
+// Coarse scene features that select kernel code at build time (part of the cache key): one
+// flag per entry of CD_SCENE_FEATURES (cl/shared/device_types.h), on when the scene has what
+// the entry's `needs` says (Scene::features)
 struct SceneFeatures {
-  bool textures = false;  // some material slot has a texture
-  bool uvs = false;  // some mesh has TEXCOORD_0 or TEXCOORD_1
-  bool tangents = false;  // some mesh has TANGENT
-  bool vertex_colors = false;  // some COLOR_0 is not white
-  bool alpha = false;  // some mesh's material is alpha-tested (MaterialDesc::alpha_tested)
-  bool media = false;  // a global medium, or a mesh whose material has an interior medium
-  bool nanovdb = false;  // a medium with a NanoVDB grid (CD_FEATURE_NANOVDB)
-  bool gltf_bsdf = false;  // a material the kernel shades as MATERIAL_GLTF (MaterialDesc::kernel_type)
-  bool conductor = false;  // a MATERIAL_CONDUCTOR material
-  bool punctual = false;  // an emitting KHR_lights_punctual light
-  bool environment = false;  // an environment map or a constant background
+#define CD_FEATURE_FIELD(name, macro, fallback, needs) bool name = false;
+  CD_SCENE_FEATURES(CD_FEATURE_FIELD)
+#undef CD_FEATURE_FIELD
+  // -DMACRO=0|1 for every feature, in list order
   std::string build_options() const;
   // Does this kernel have every feature `needed` names?
   bool covers(const SceneFeatures& needed) const;
+  // The names of the features on, in list order
+  std::vector<std::string> names() const;
   // Every flag on: the generic kernel, correct for any scene (--generic)
-  static SceneFeatures all() {
-    SceneFeatures f;
-    f.textures = f.uvs = f.tangents = f.vertex_colors = f.alpha = f.media = f.nanovdb = true;
-    f.gltf_bsdf = f.conductor = f.punctual = f.environment = true;
-    return f;
-  }
+  static SceneFeatures all();
+  // The flag of the feature whose kernel macro is `macro` (a feature column of CD_MATERIALS
+  // or CD_LIGHTS); nullptr for any other text, such as "1" (always compiled in)
+  static bool SceneFeatures::*flag(const std::string& macro);
 };
 
 struct Scene {

@@ -157,7 +157,7 @@ ReferenceLobe conductor_reference(HostGgx g, glm::dvec3 eta, glm::dvec3 k) {
 // glTF metallic-roughness (glTF 2.0 Appendix B with KHR_materials_specular, _ior,
 // _transmission, _clearcoat, _anisotropy) as a weighted sum of lobes: coat over
 // metal + plastic (specular + Lambert) + glass. Its pdf is the kernel's mixture, with
-// component probabilities estimated at wo (cl/bsdf/bsdf_gltf.cl, gltf_lobes).
+// component probabilities estimated at wo (cl/bsdf/bsdf_gltf.cl, gltf_at_wo).
 struct GltfReference {
   glm::dvec3 base, f0;
   double metallic, transmission, ior, f90, coat;
@@ -166,11 +166,13 @@ struct GltfReference {
 
   explicit GltfReference(const dev::Material& m)
       : base(m.base_color[0], m.base_color[1], m.base_color[2]),
-        metallic(m.metallic), transmission(m.transmission), ior(m.ior), f90(m.specular_color[3]),
-        coat(m.clearcoat), thin((m.flags & MATERIAL_THIN_WALLED) != 0u),
-        ggx(HostGgx::from(m.roughness, m.anisotropy_strength)), coat_ggx(HostGgx::from(m.clearcoat_roughness, 0.0)) {
+        metallic(m.params.gltf.metallic), transmission(m.params.gltf.transmission), ior(m.params.gltf.ior),
+        f90(m.params.gltf.specular_color[3]), coat(m.params.gltf.clearcoat), thin((m.flags & MATERIAL_THIN_WALLED) != 0u),
+        ggx(HostGgx::from(m.params.gltf.roughness, m.params.gltf.anisotropy_strength)),
+        coat_ggx(HostGgx::from(m.params.gltf.clearcoat_roughness, 0.0)) {
     double r = (ior - 1.0) / (ior + 1.0);
-    f0 = glm::min(r * r * glm::dvec3(m.specular_color[0], m.specular_color[1], m.specular_color[2]), 1.0) * f90;
+    const float* tint = m.params.gltf.specular_color;
+    f0 = glm::min(r * r * glm::dvec3(tint[0], tint[1], tint[2]), 1.0) * f90;
   }
   double coat_fresnel(double c) const { return coat * (0.04 + 0.96 * schlick_weight(c)); }
   // Without the albedo table a layer's albedo is its Schlick term at mu; what lies below
@@ -268,8 +270,10 @@ dev::Material make_material(unsigned type, glm::dvec3 base_color) {
   m.type = type;
   for (int c = 0; c < 3; ++c) m.base_color[c] = float(base_color[c]);
   m.base_color[3] = 1.0f;
-  m.ior = 1.5f;
-  for (float& s : m.specular_color) s = 1.0f;  // KHR_materials_specular defaults
+  if (type == MATERIAL_GLTF) {
+    m.params.gltf.ior = 1.5f;
+    for (float& s : m.params.gltf.specular_color) s = 1.0f;  // KHR_materials_specular defaults
+  }
   m.normal_scale = 1.0f;
   for (dev::TextureRef& t : m.textures) {
     t.index = NO_TEXTURE;
@@ -281,9 +285,9 @@ dev::Material make_material(unsigned type, glm::dvec3 base_color) {
 // glTF metallic-roughness with the given factors; the rest default
 dev::Material gltf(glm::dvec3 base, double metallic, double roughness, double transmission = 0.0, bool thin = false) {
   dev::Material m = make_material(MATERIAL_GLTF, base);
-  m.metallic = float(metallic);
-  m.roughness = float(roughness);
-  m.transmission = float(transmission);
+  m.params.gltf.metallic = float(metallic);
+  m.params.gltf.roughness = float(roughness);
+  m.params.gltf.transmission = float(transmission);
   if (thin) m.flags |= MATERIAL_THIN_WALLED;
   return m;
 }
@@ -293,13 +297,16 @@ const glm::dvec3 kGoldEta(0.143119, 0.374957, 1.44248), kGoldK(3.98316, 2.38572,
 dev::Material gold(double roughness, double anisotropy = 0.0) {
   dev::Material m = make_material(MATERIAL_CONDUCTOR, glm::dvec3(1.0));
   for (int c = 0; c < 3; ++c) {
-    m.conductor_eta[c] = float(kGoldEta[c]);
-    m.conductor_k[c] = float(kGoldK[c]);
+    m.params.conductor.eta[c] = float(kGoldEta[c]);
+    m.params.conductor.k[c] = float(kGoldK[c]);
   }
-  m.roughness = float(roughness);
-  m.anisotropy_strength = float(anisotropy);
+  m.params.conductor.roughness = float(roughness);
+  m.params.conductor.anisotropy_strength = float(anisotropy);
   return m;
 }
+
+// A glTF material's index of refraction; 1.5 for the other types (make_material's default)
+float ior(const dev::Material& m) { return m.type == MATERIAL_GLTF ? m.params.gltf.ior : 1.5f; }
 
 MaterialCase diffuse(glm::dvec3 albedo) {
   return {"diffuse", make_material(MATERIAL_DIFFUSE, albedo), true, [albedo](double) { return albedo; },
@@ -308,7 +315,7 @@ MaterialCase diffuse(glm::dvec3 albedo) {
 
 // Microfacet lobes lose the samples reflected below the horizon: their pdf integrates to less than 1
 MaterialCase conductor_case(std::string name, dev::Material m, CellSpec cells) {
-  HostGgx g = HostGgx::from(m.roughness, m.anisotropy_strength);
+  HostGgx g = HostGgx::from(m.params.conductor.roughness, m.params.conductor.anisotropy_strength);
   return {name, m, false, {}, conductor_reference(g, kGoldEta, kGoldK), cells, {}};
 }
 
@@ -325,18 +332,18 @@ MaterialCase delta_case(std::string name, dev::Material m, std::function<std::op
 std::vector<MaterialCase> make_materials() {
   const glm::dvec3 orange(0.8, 0.5, 0.2), brass(0.95, 0.64, 0.54), white(1.0);
   dev::Material metal_aniso = gltf(brass, 1.0, 0.4);
-  metal_aniso.anisotropy_strength = 0.7f;
-  metal_aniso.anisotropy_rotation = 0.6f;
+  metal_aniso.params.gltf.anisotropy_strength = 0.7f;
+  metal_aniso.params.gltf.anisotropy_rotation = 0.6f;
   dev::Material coat = gltf(orange, 0.0, 0.6);
-  coat.clearcoat = 1.0f;
-  coat.clearcoat_roughness = 0.2f;
+  coat.params.gltf.clearcoat = 1.0f;
+  coat.params.gltf.clearcoat_roughness = 0.2f;
   dev::Material smooth_coat = gltf(brass, 1.0, 0.5);
-  smooth_coat.clearcoat = 1.0f;
+  smooth_coat.params.gltf.clearcoat = 1.0f;
   dev::Material smooth_plastic = gltf(orange, 0.0, 0.0);
   dev::Material mixture = gltf({0.9, 0.7, 0.5}, 0.5, 0.4, 0.5);
   dev::Material coat_glass = gltf(white, 0.0, 0.3, 1.0);
-  coat_glass.clearcoat = 1.0f;
-  coat_glass.clearcoat_roughness = 0.3f;
+  coat_glass.params.gltf.clearcoat = 1.0f;
+  coat_glass.params.gltf.clearcoat_roughness = 0.3f;
   auto gold_mirror = [](double c) {
     return glm::dvec3(fresnel_conductor(c, kGoldEta.x, kGoldK.x), fresnel_conductor(c, kGoldEta.y, kGoldK.y),
                       fresnel_conductor(c, kGoldEta.z, kGoldK.z));
@@ -453,8 +460,16 @@ Oriented orient(const Geometry& g) {
 Frame shading_frame(const Geometry& g, const Oriented& o, const dev::Material& m) {
   glm::dvec3 n = o.ns, t = glm::normalize(g.tangent - glm::dot(g.tangent, n) * n);
   glm::dvec3 b = glm::cross(n, t) * (o.front ? 1.0 : -1.0);
-  if (m.anisotropy_strength > 0.0f) {
-    double r = m.anisotropy_rotation;
+  float strength = 0.0f, rotation = 0.0f;  // KHR_materials_anisotropy of a glTF or conductor material
+  if (m.type == MATERIAL_GLTF) {
+    strength = m.params.gltf.anisotropy_strength;
+    rotation = m.params.gltf.anisotropy_rotation;
+  } else if (m.type == MATERIAL_CONDUCTOR) {
+    strength = m.params.conductor.anisotropy_strength;
+    rotation = m.params.conductor.anisotropy_rotation;
+  }
+  if (strength > 0.0f) {
+    double r = rotation;
     t = glm::normalize(std::cos(r) * t + std::sin(r) * b);
   }
   return {t, glm::cross(n, t), n};
@@ -662,7 +677,7 @@ struct SphereCells {
 // The axis of one side's cells: ns, wo mirrored or refracted about ns, or straight
 // through (-wo)
 glm::dvec3 focus_axis(Focus focus, const Geometry& g, const Oriented& o, const dev::Material& m) {
-  double eta = o.front ? m.ior : 1.0 / m.ior;
+  double eta = o.front ? ior(m) : 1.0 / ior(m);
   switch (focus) {
     case Focus::Mirror:
       return mirror(g.wo, o.ns);
@@ -753,7 +768,7 @@ Geometry seen_from(Geometry g, glm::dvec3 wo) {
 }
 
 bool has_transmission(const dev::Material& m) {
-  return m.type == MATERIAL_GLTF && m.transmission > 0.0f && m.metallic < 1.0f;
+  return m.type == MATERIAL_GLTF && m.params.gltf.transmission > 0.0f && m.params.gltf.metallic < 1.0f;
 }
 
 // Known kernel bugs met by a test: bug -> the rows it kept out. A row is
@@ -783,7 +798,7 @@ double tolerance(const MaterialCase& mat, const Geometry& g, const Oriented& o, 
   const dev::Material& m = mat.material;
   if (!has_transmission(m)) return tol;
   Frame f = shading_frame(g, o, m);
-  double eta = o.front ? m.ior : 1.0 / m.ior;
+  double eta = o.front ? ior(m) : 1.0 / ior(m);
   return tol + dielectric_tolerance(eta, m.flags & MATERIAL_THIN_WALLED, f.local(wo), f.local(wi));
 }
 
@@ -892,10 +907,10 @@ void check_reciprocity(const BsdfRun& run, const MaterialCase& mat, KnownBugs& b
         ADD_FAILURE() << "reflection pair " << i << " channel " << c << ": " << v[i].s[c] << " vs " << v[n + i].s[c];
   }
   EXPECT_EQ(bad, 0u);
-  if (!has_transmission(m) || m.roughness == 0.0f || bugs.find(mat, "reciprocity", g)) return;
+  if (!has_transmission(m) || m.params.gltf.roughness == 0.0f || bugs.find(mat, "reciprocity", g)) return;
   // (outside, inside) pairs and their reverses
   glm::dvec3 outward = o.front ? o.ng : -o.ng;
-  double eta_in = (m.flags & MATERIAL_THIN_WALLED) ? 1.0 : m.ior;
+  double eta_in = (m.flags & MATERIAL_THIN_WALLED) ? 1.0 : ior(m);
   for (size_t i = 0; i < n; ++i) {
     glm::dvec3 a = on_side(1.0), b = on_side(-1.0);
     if (glm::dot(a, outward) < 0.0) std::swap(a, b);
@@ -1069,7 +1084,7 @@ TEST_F(BsdfHarness, NarrowCellsRejectAWrongRoughness) {
 // ... and a refracted lobe from one refracted with another index
 TEST_F(BsdfHarness, RefractionCellsRejectAWrongIor) {
   dev::Material glass = gltf(glm::dvec3(1.0), 0.0, 0.3, 1.0), other = glass;
-  other.ior = 1.45f;
+  other.params.gltf.ior = 1.45f;
   ChiSquare chi2 = mismatched_chi_square(rig(), glass, other, kGeometries[3], kNarrow);
   EXPECT_LT(chi2.p_value, 1e-6) << "chi2 " << chi2.statistic << " dof " << chi2.dof;
 }
@@ -1275,7 +1290,7 @@ TEST_P(BsdfDelta, SmoothGltf) {
     {
       SCOPED_TRACE("coat over rough metal");
       dev::Material m = gltf(base, 1.0, 0.5);
-      m.clearcoat = 1.0f;
+      m.params.gltf.clearcoat = 1.0f;
       glm::dvec3 coat(0.04 + 0.96 * schlick_weight(c));
       check_delta(sample(*r, m, g), {{"mirror", wr, true, 1.0, {}, {}, coat}}, false);
     }
@@ -1352,8 +1367,8 @@ std::vector<EnergyLobe> energy_lobes() {
   const glm::dvec3 white(1.0);
   auto coat = [=](double r) {
     dev::Material m = gltf(white, 0.0, r);
-    m.clearcoat = 1.0f;
-    m.clearcoat_roughness = float(r);
+    m.params.gltf.clearcoat = 1.0f;
+    m.params.gltf.clearcoat_roughness = float(r);
     return m;
   };
   return {
@@ -1366,8 +1381,8 @@ std::vector<EnergyLobe> energy_lobes() {
       {"coat_plastic_white", coat, false, ""},
       {"smooth_coat_metal_white", [=](double r) {
          dev::Material m = coat(r);
-         m.metallic = 1.0f;
-         m.clearcoat_roughness = 0.0f;
+         m.params.gltf.metallic = 1.0f;
+         m.params.gltf.clearcoat_roughness = 0.0f;
          return m;
        }, false, ""},
       {"mixture_white", [=](double r) { return gltf(white, 0.5, r, 0.5); }, false, ""},

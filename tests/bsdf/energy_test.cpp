@@ -49,11 +49,16 @@ struct Mean {
 dev::Material material(unsigned type, glm::dvec3 base, double roughness) {
   dev::Material m{};
   m.type = type;
-  for (int c = 0; c < 3; ++c) m.base_color[c] = m.specular_color[c] = float(base[c]);
+  for (int c = 0; c < 3; ++c) m.base_color[c] = float(base[c]);
   m.base_color[3] = 1.0f;
-  m.specular_color[3] = 1.0f;
-  m.ior = 1.5f;
-  m.roughness = float(roughness);
+  if (type == MATERIAL_GLTF) {
+    for (int c = 0; c < 3; ++c) m.params.gltf.specular_color[c] = float(base[c]);
+    m.params.gltf.specular_color[3] = 1.0f;
+    m.params.gltf.ior = 1.5f;
+    m.params.gltf.roughness = float(roughness);
+  } else {
+    m.params.conductor.roughness = float(roughness);
+  }
   for (dev::TextureRef& t : m.textures) {
     t.index = NO_TEXTURE;
     t.m[0] = t.m[4] = 1.0f;
@@ -64,23 +69,23 @@ dev::Material material(unsigned type, glm::dvec3 base, double roughness) {
 // glTF metal (metallic 1) of base colour `base`
 dev::Material metal(glm::dvec3 base, double roughness, double anisotropy = 0.0) {
   dev::Material m = material(MATERIAL_GLTF, base, roughness);
-  m.metallic = 1.0f;
-  m.anisotropy_strength = float(anisotropy);
+  m.params.gltf.metallic = 1.0f;
+  m.params.gltf.anisotropy_strength = float(anisotropy);
   return m;
 }
 
 // glTF dielectric (metallic 0, ior 1.5, specular 1) of base colour `base`
 dev::Material plastic(glm::dvec3 base, double roughness) {
   dev::Material m = material(MATERIAL_GLTF, base, roughness);
-  for (int c = 0; c < 3; ++c) m.specular_color[c] = 1.0f;
+  for (int c = 0; c < 3; ++c) m.params.gltf.specular_color[c] = 1.0f;
   return m;
 }
 
 dev::Material conductor(glm::dvec3 eta, glm::dvec3 k, double roughness) {
   dev::Material m = material(MATERIAL_CONDUCTOR, glm::dvec3(1.0), roughness);
   for (int c = 0; c < 3; ++c) {
-    m.conductor_eta[c] = float(eta[c]);
-    m.conductor_k[c] = float(k[c]);
+    m.params.conductor.eta[c] = float(eta[c]);
+    m.params.conductor.k[c] = float(k[c]);
   }
   return m;
 }
@@ -325,7 +330,7 @@ TEST(Energy, WhitePlasticReflectsOneAtEveryAngle) {
     for (double theta : {0.0, 45.0, 75.0, 88.0}) {
       dev::Material white = plastic(glm::dvec3(1.0), roughness);
       dev::Material tinted = white;
-      tinted.specular_color[0] = 3.0f;  // f0 = 0.12 in red: A is the largest channel's
+      tinted.params.gltf.specular_color[0] = 3.0f;  // f0 = 0.12 in red: A is the largest channel's
       tinted.base_color[2] = 0.3f;
       auto with = r.albedo(white, true, at_angle(theta), seed++, kSamples / 2);
       auto without = r.albedo(white, false, at_angle(theta), seed++, kSamples / 2);
