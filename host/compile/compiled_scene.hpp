@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "base/device_types.hpp"
-#include "scene/scene.hpp"  // SceneFeatures only
+#include "base/scene_features.hpp"
 
 namespace candela {
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/device_types.hpp"
+#include "base/scene_features.hpp"
 
 namespace candela {
 
@@ -164,26 +165,6 @@ struct Bounds {
   bool empty() const { return lo.x > hi.x; }
   glm::vec3 center() const { return 0.5f * (lo + hi); }
   float radius() const { return 0.5f * glm::length(hi - lo); }
-};
-
-// Coarse scene features that select kernel code at build time (part of the cache key): one
-// flag per entry of CD_SCENE_FEATURES (cl/shared/device_types.h), on when the scene has what
-// the entry's `needs` says (Scene::features)
-struct SceneFeatures {
-#define CD_FEATURE_FIELD(name, macro, fallback, needs) bool name = false;
-  CD_SCENE_FEATURES(CD_FEATURE_FIELD)
-#undef CD_FEATURE_FIELD
-  // -DMACRO=0|1 for every feature, in list order
-  std::string build_options() const;
-  // Does this kernel have every feature `needed` names?
-  bool covers(const SceneFeatures& needed) const;
-  // The names of the features on, in list order
-  std::vector<std::string> names() const;
-  // Every flag on: the generic kernel, correct for any scene (--generic)
-  static SceneFeatures all();
-  // The flag of the feature whose kernel macro is `macro` (a feature column of CD_MATERIALS
-  // or CD_LIGHTS); nullptr for any other text, such as "1" (always compiled in)
-  static bool SceneFeatures::*flag(const std::string& macro);
 };
 
 struct Scene {
