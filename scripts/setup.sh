@@ -10,7 +10,7 @@ CANDELA_PACKAGES=(
   mesa-opencl-icd
   libtinygltf-dev nlohmann-json3-dev
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
-  googletest libgtest-dev
+  googletest libgtest-dev clang-format
   python3-numpy python3-openimageio python3-matplotlib python3-pil
 )
 # A script sourcing this may add packages (scripts/fuzz: clang and libFuzzer)

@@ -12,7 +12,7 @@ struct SceneData;
 bool scene_alpha_passes(const struct SceneData* sc, uint prim, float b1, float b2, Ray ray);
 
 CD_ALWAYS_INLINE bool bvh_leaf_triangle_hit(const WatertightRay* r, __global const BvhTriangle* tri, float tmax,
-                           float* t, float* b1, float* b2) {
+                                            float* t, float* b1, float* b2) {
   return intersect_triangle(r, load3(tri->v0), load3(tri->v1), load3(tri->v2), tmax, t, b1, b2);
 }
 
@@ -36,20 +36,20 @@ float4 bvh_max4(float4 a, float4 b) { return a > b ? a : b; }
 float4 bvh_min4(float4 a, float4 b) { return a < b ? a : b; }
 
 // Orders (d[a], c[a]) and (d[b], c[b]) by distance
-#define BVH_SORT2(da, ca, db, cb)   \
-  {                                 \
-    bool s_ = db < da;              \
-    float dt_ = s_ ? db : da;       \
-    int ct_ = s_ ? cb : ca;         \
-    db = s_ ? da : db;              \
-    cb = s_ ? ca : cb;              \
-    da = dt_;                       \
-    ca = ct_;                       \
+#define BVH_SORT2(da, ca, db, cb) \
+  {                               \
+    bool s_ = db < da;            \
+    float dt_ = s_ ? db : da;     \
+    int ct_ = s_ ? cb : ca;       \
+    db = s_ ? da : db;            \
+    cb = s_ ? ca : cb;            \
+    da = dt_;                     \
+    ca = ct_;                     \
   }
 
 // Closest hit in (0, tmax), or with any_hit the first hit found; `sc` goes to the alpha test
-Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes,
-                  __global const BvhTriangle* tris, Ray ray, float tmax, bool any_hit) {
+Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
+                  float tmax, bool any_hit) {
   Hit hit;
   hit.t = tmax;
   hit.prim = -1;
@@ -127,7 +127,7 @@ Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes,
   }
 }
 
-bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes,
-                  __global const BvhTriangle* tris, Ray ray, float tmax) {
+bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
+                  float tmax) {
   return bvh_intersect(sc, nodes, tris, ray, tmax, true).prim >= 0;
 }

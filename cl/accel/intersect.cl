@@ -4,7 +4,7 @@
 
 typedef struct {
   float3 org;
-  uint4 perm;  // (kx, ky, kz, 3): the ray direction's largest axis goes to z
+  uint4 perm;    // (kx, ky, kz, 3): the ray direction's largest axis goes to z
   float3 shear;  // (Sx, Sy, Sz)
 } WatertightRay;
 
@@ -57,8 +57,8 @@ float edge_function(float px, float py, float qx, float qy) {
 #endif
 
 // Hit in (0, tmax)? On a hit sets *t and the barycentric weights of v1 and v2.
-CD_ALWAYS_INLINE bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax,
-                        float* t, float* b1, float* b2) {
+CD_ALWAYS_INLINE bool intersect_triangle(const WatertightRay* r, float3 v0, float3 v1, float3 v2, float tmax, float* t,
+                                         float* b1, float* b2) {
   // No fused multiply-adds: keeps the edge values and t as the paper rounds them
 #pragma OPENCL FP_CONTRACT OFF
   float3 a = permute3(v0 - r->org, r->perm);
@@ -75,8 +75,7 @@ CD_ALWAYS_INLINE bool intersect_triangle(const WatertightRay* r, float3 v0, floa
   float det = u + v + w;
   if (det == 0.0f) return false;
   float tt = u * (r->shear.z * a.z) + v * (r->shear.z * b.z) + w * (r->shear.z * c.z);
-  if (det > 0.0f ? (tt <= 0.0f || tt >= tmax * det) : (tt >= 0.0f || tt <= tmax * det))
-    return false;
+  if (det > 0.0f ? (tt <= 0.0f || tt >= tmax * det) : (tt >= 0.0f || tt <= tmax * det)) return false;
   float inv_det = 1.0f / det;
   *t = tt * inv_det;
   *b1 = v * inv_det;

@@ -11,8 +11,7 @@
 float dielectric_sheet_reflectance(float r) { return 2.0f * r / (1.0f + r); }
 
 // The non-delta part: f(wo, wi) and the pdf of bsdf_dielectric_sample
-float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo, float3 wi,
-                            float* pdf) {
+float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
   if (ggx_is_delta(g) || wo.z <= 0.0f || wi.z == 0.0f) return (float3)(0.0f);
   if (wi.z > 0.0f || thin) {
@@ -42,8 +41,7 @@ float3 bsdf_dielectric_eval(Ggx g, float eta, bool thin, float3 tint, float3 wo,
 }
 
 // Smooth interface: reflect with probability R, else refract (or pass a thin sheet)
-bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo, float uc,
-                                   BsdfSample* bs) {
+bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo, float uc, BsdfSample* bs) {
   float r = fresnel_dielectric(wo.z, eta);
   if (thin) r = dielectric_sheet_reflectance(r);
   bs->eta = 1.0f;
@@ -67,8 +65,7 @@ bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo,
   return true;
 }
 
-bool bsdf_dielectric_sample(Ggx g, float eta, bool thin, float3 tint, float3 wo, float uc,
-                            float2 u, BsdfSample* bs) {
+bool bsdf_dielectric_sample(Ggx g, float eta, bool thin, float3 tint, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
   if (ggx_is_delta(g)) return bsdf_dielectric_sample_smooth(eta, thin, tint, wo, uc, bs);
   float3 h = ggx_sample_visible(g, wo, u);

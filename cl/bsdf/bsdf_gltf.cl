@@ -39,6 +39,8 @@
 #define GLTF_DIFFUSE 3u
 #define GLTF_MS 4u
 #define GLTF_GLASS 5u
+// One entry per line, columns aligned:
+// clang-format off
 #define GLTF_COMPONENTS(X)               \
   X(GLTF_COAT, coat, BSDF_GLOSSY)        \
   X(GLTF_METAL, metal, BSDF_GLOSSY)      \
@@ -46,13 +48,14 @@
   X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE) \
   X(GLTF_MS, ms, BSDF_GLOSSY)            \
   X(GLTF_GLASS, glass, BSDF_GLOSSY)
+// clang-format on
 #define GLTF_COUNT_COMPONENT(id, name, kind) +1
 #define GLTF_COMPONENT_COUNT (0 GLTF_COMPONENTS(GLTF_COUNT_COMPONENT))
 
 // What a component's sample did
-#define GLTF_SAMPLE_FAILED 0  // nothing: the path ends
+#define GLTF_SAMPLE_FAILED 0     // nothing: the path ends
 #define GLTF_SAMPLE_DIRECTION 1  // chose bs->wi, which the whole mixture weighs
-#define GLTF_SAMPLE_DONE 2  // a complete sample of a delta component
+#define GLTF_SAMPLE_DONE 2       // a complete sample of a delta component
 
 // The material at the hit: factors times textures; KHR_materials_specular gives
 // F0 = min(F0(ior) x colour, 1) x specular and F90 = specular. Where the textures put no
@@ -97,9 +100,9 @@ typedef struct {
   GgxEnergy e;  // its table lookup (table 0: a delta lobe, or no compensation)
   float3 f0;
   float f90;
-  float3 f_ms;  // colour of its multiple-scattering term; 0 without one
-  float a_o;  // its albedo A(mu_o), largest channel
-  float a_avg;  // 2 integral of A mu dmu, largest channel
+  float3 f_ms;      // colour of its multiple-scattering term; 0 without one
+  float a_o;        // its albedo A(mu_o), largest channel
+  float a_avg;      // 2 integral of A mu dmu, largest channel
   bool normalized;  // weight what lies below by W / (1 - a_avg)
 } GltfLayer;
 
@@ -158,7 +161,9 @@ float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
 }
 
 // Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor, at the coat lobe's wo.h
-float gltf_coat_fresnel(const Bsdf* b, float cos_i) { return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i)); }
+float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
+  return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i));
+}
 
 // What depends on wo alone: the albedo-table lookups, the layers and the mixture weights
 // (computed once per sample: bsdf_gltf_sample evaluates with the ones it sampled with)
@@ -220,7 +225,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   const float* w = g->w;
   float m = lobe->metallic, t = lobe->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
-  float cos_h = wo.z;  // wo.h of reflections
+  float cos_h = wo.z;             // wo.h of reflections
   float d = 0.0f, p = 0.0f;
   if (wi.z > 0.0f) {
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
@@ -245,7 +250,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   }
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
   // direction outside
-  float3 f = under * (wi.z > 0.0f ? gltf_below(&coat, wi.z) : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -wi.z));
+  float3 f =
+      under * (wi.z > 0.0f ? gltf_below(&coat, wi.z) : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -wi.z));
   if (wi.z > 0.0f && lobe->coat > 0.0f && !ggx_is_delta(lobe->coat_ggx)) {
     float coat_p, coat_h;
     float coat_d = ggx_reflection_eval(lobe->coat_ggx, wo, wi, &coat_p, &coat_h);
@@ -320,8 +326,8 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   if (!bsdf_dielectric_sample(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
     return GLTF_SAMPLE_FAILED;
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
-  float att = bs->wi.z > 0.0f ? gltf_below(&g->coat, wo.z)
-                              : 1.0f - gltf_layer_albedo(&g->coat, b->entering ? wo.z : -bs->wi.z);
+  float att =
+      bs->wi.z > 0.0f ? gltf_below(&g->coat, wo.z) : 1.0f - gltf_layer_albedo(&g->coat, b->entering ? wo.z : -bs->wi.z);
   bs->f *= att * (1.0f - lobe->metallic) * lobe->transmission;
   bs->pdf *= g->w[GLTF_GLASS];
   return bs->pdf > 0.0f ? GLTF_SAMPLE_DONE : GLTF_SAMPLE_FAILED;
@@ -364,7 +370,8 @@ uint bsdf_gltf_flags(const Bsdf* b) {
   bool plastic = lobe->metallic < 1.0f && lobe->transmission < 1.0f;
   if (plastic && max_component(b->base_color) > 0.0f) flags |= BSDF_DIFFUSE;
   bool spec_delta = ggx_is_delta(lobe->ggx), coat_delta = lobe->coat > 0.0f && ggx_is_delta(lobe->coat_ggx);
-  if (lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->transmission > 0.0f) flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->transmission > 0.0f)
+    flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (lobe->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (lobe->transmission > 0.0f && lobe->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
   return flags;

@@ -83,8 +83,8 @@ __kernel void energy_ggx_albedo_table(__global float* table, uint n) {
 // E = 1 (E5 is then unused).
 typedef struct {
   __global const float* table;  // 0: no compensation
-  float alpha;  // isotropic alpha of the lobe
-  int row;  // roughness cell [row, row + 1] and the weight of row + 1
+  float alpha;                  // isotropic alpha of the lobe
+  int row;                      // roughness cell [row, row + 1] and the weight of row + 1
   float t;
   float e_o, e_avg;
   float e5_o, e5_avg;

@@ -32,9 +32,7 @@ float ggx_lambda(Ggx g, float3 w) {
 float ggx_g1(Ggx g, float3 w) { return 1.0f / (1.0f + ggx_lambda(g, w)); }
 
 // Height-correlated masking-shadowing G(wo, wi) = 1 / (1 + Lambda(wo) + Lambda(wi))
-float ggx_g(Ggx g, float3 wo, float3 wi) {
-  return 1.0f / (1.0f + ggx_lambda(g, wo) + ggx_lambda(g, wi));
-}
+float ggx_g(Ggx g, float3 wo, float3 wi) { return 1.0f / (1.0f + ggx_lambda(g, wo) + ggx_lambda(g, wi)); }
 
 // Density of visible normals seen from w: D_w(m) = G1(w) max(0, w.m) D(m) / |w.z|
 float ggx_visible_d(Ggx g, float3 w, float3 m) {

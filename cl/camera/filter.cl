@@ -3,9 +3,7 @@
 // is the image convolved with the filter (no weights, no negative lobes, no splatting).
 
 // Inverse CDF of the tent 1 - |x| on [-1, 1]
-float filter_tent_offset(float u) {
-  return u < 0.5f ? sqrt(2.0f * u) - 1.0f : 1.0f - sqrt(2.0f - 2.0f * u);
-}
+float filter_tent_offset(float u) { return u < 0.5f ? sqrt(2.0f * u) - 1.0f : 1.0f - sqrt(2.0f - 2.0f * u); }
 
 // Where in pixel (0, 0) .. (1, 1) a sample lands (the offset from the centre is this
 // minus 1/2; tent and Gaussian reach into neighbouring pixels), from two uniforms in [0, 1)

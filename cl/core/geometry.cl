@@ -18,9 +18,7 @@ typedef struct {
   float3 t, b, n;
 } Frame;
 
-float3 frame_to_local(const Frame* f, float3 v) {
-  return (float3)(dot(v, f->t), dot(v, f->b), dot(v, f->n));
-}
+float3 frame_to_local(const Frame* f, float3 v) { return (float3)(dot(v, f->t), dot(v, f->b), dot(v, f->n)); }
 
 float3 frame_from_local(const Frame* f, float3 v) { return v.x * f->t + v.y * f->b + v.z * f->n; }
 

@@ -76,9 +76,9 @@ float rng_uint_to_float(uint x) { return (float)(x >> 8) * 0x1.0p-24f; }
 // ---- Independent sampler ------------------------------------------------------------
 
 typedef struct {
-  uint4 key;  // pixel, sample, hashed seed, block counter
+  uint4 key;    // pixel, sample, hashed seed, block counter
   uint4 block;  // four outputs of the last hash
-  uint used;  // outputs of `block` already handed out
+  uint used;    // outputs of `block` already handed out
 } RngIndependent;
 
 RngIndependent rng_independent_init(uint pixel, uint sample, uint seed) {
@@ -95,10 +95,7 @@ uint rng_independent_next_uint(RngIndependent* r) {
     r->key.w += 1u;
     r->used = 0u;
   }
-  uint x = r->used == 0u ? r->block.x
-         : r->used == 1u ? r->block.y
-         : r->used == 2u ? r->block.z
-                         : r->block.w;
+  uint x = r->used == 0u ? r->block.x : r->used == 1u ? r->block.y : r->used == 2u ? r->block.z : r->block.w;
   r->used += 1u;
   return x;
 }
@@ -162,9 +159,9 @@ uint2 rng_sobol_pair(uint pixel, uint sample_reversed, uint hashed_seed, uint pa
 // of the even pairs 0, 2, 4, ..., 2D draws (rng_next_2d) one whole odd pair 1, 3, 5, ...
 typedef struct {
   uint pixel, sample_reversed, seed;  // seed hashed
-  uint dimension_1d;  // 1D draws so far; 1D draw d is coordinate d % 2 of pair 2 (d / 2)
-  uint pending;  // the second coordinate of the current even pair, when dimension_1d is odd
-  uint draws_2d;  // 2D draws so far: the next is pair 2 draws_2d + 1
+  uint dimension_1d;                  // 1D draws so far; 1D draw d is coordinate d % 2 of pair 2 (d / 2)
+  uint pending;                       // the second coordinate of the current even pair, when dimension_1d is odd
+  uint draws_2d;                      // 2D draws so far: the next is pair 2 draws_2d + 1
 } RngSobol;
 
 RngSobol rng_sobol_init(uint pixel, uint sample, uint seed) {

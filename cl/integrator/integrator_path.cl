@@ -29,14 +29,14 @@
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
   Ray ray;
-  float3 beta;  // throughput
-  float3 radiance;  // light gathered so far
-  uint depth;  // scattering events so far
+  float3 beta;           // throughput
+  float3 radiance;       // light gathered so far
+  uint depth;            // scattering events so far
   bool specular_bounce;  // emission the ray finds counts: the camera ray, a delta lobe's
                          // ray, or one from a vertex that took no light sample
-  float eta_scale;  // product of eta^2 over transmissions, so roulette sees radiance scale
-  int medium;  // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
-  MediumStack media;  // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+  float eta_scale;       // product of eta^2 over transmissions, so roulette sees radiance scale
+  int medium;            // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
+  MediumStack media;     // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
 } PathState;
 
 PathState path_start(const SceneData* sc, Ray ray) {
@@ -82,8 +82,8 @@ float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const
 // them: a sample of another light contributes nothing here). `media`: the media on wo's
 // side; a shadow ray through the surface enters (or leaves) `interior`, the medium inside
 // the surface.
-float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf,
-                         float3 wo, bool delta_only, const MediumStack* media, int interior, Rng* rng) {
+float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
+                         bool delta_only, const MediumStack* media, int interior, Rng* rng) {
   uint x_select = rng_next_uint(rng);
   float2 u = rng_next_2d(rng);
   LightSample ls;
@@ -116,8 +116,7 @@ bool path_survives_roulette(PathState* ps, uint rr_depth, Rng* rng) {
 
 #if CD_FEATURE_MEDIA
 // Next-event estimate at a point p in a medium of phase asymmetry g, toward wo
-float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 wo, const MediumStack* media,
-                                Rng* rng) {
+float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 wo, const MediumStack* media, Rng* rng) {
   LightSampleContext ctx;
   ctx.p = p;
   ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
@@ -147,7 +146,7 @@ int path_medium_step(const SceneData* sc, PathState* ps, float tmax, bool nee, R
   float2 u = rng_next_2d(rng);
   float pdf;
   float3 wi = phase_sample(g, wo, u, &pdf);  // exact sampling: the weight f / pdf is 1
-  ps->specular_bounce = !nee;  // emission found next counts unless light sampling took it
+  ps->specular_bounce = !nee;                // emission found next counts unless light sampling took it
   if (!path_survives_roulette(ps, sc->params->rr_depth, rng)) return MEDIUM_ABSORBED;
   ps->ray.org = p;
   ps->ray.dir = wi;
@@ -190,8 +189,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       continue;
     }
 #endif
-    if (counts_emission)
-      ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
+    if (counts_emission) ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
     if (ps.depth >= params->max_depth) break;
 
     float3 wo = -ps.ray.dir;
@@ -201,8 +199,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     // Light sampling, except at lobes that are all delta (no light sample can find them)
     // and where the strategy leaves area and environment lights to the sampled ray
     bool samples_lights = strategy != STRATEGY_BSDF && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u;
-    bool near_specular = strategy == STRATEGY_AUTO && (flags & BSDF_DIFFUSE) == 0u &&
-                         bsdf_widest_alpha(&bsdf) <= AUTO_BSDF_ALPHA;
+    bool near_specular =
+        strategy == STRATEGY_AUTO && (flags & BSDF_DIFFUSE) == 0u && bsdf_widest_alpha(&bsdf) <= AUTO_BSDF_ALPHA;
     if (samples_lights) {
       LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
       ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, near_specular, &ps.media,

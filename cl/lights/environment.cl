@@ -80,7 +80,7 @@ float environment_pdf(const SceneData* sc, __global const Light* light, float3 d
 float environment_sample_cdf(__global const float* cdf, int n, float u, int* index) {
   float total = cdf[n];
   float x = fmin(u * total, nextafter(total, 0.0f));  // x < total: a cell of positive step
-  int lo = 0, hi = n - 1;  // the largest i with cdf[i] <= x
+  int lo = 0, hi = n - 1;                             // the largest i with cdf[i] <= x
   while (lo < hi) {
     int mid = (lo + hi + 1) / 2;
     if (cdf[mid] <= x)

@@ -8,18 +8,18 @@
 
 typedef struct {
   float3 p;
-  float3 n;  // geometric normal on the side light is gathered from; 0 at a point in a medium
-  float3 ns;  // shading normal on the same side; 0 in a medium
+  float3 n;        // geometric normal on the side light is gathered from; 0 at a point in a medium
+  float3 ns;       // shading normal on the same side; 0 in a medium
   bool transmits;  // the BSDF (or phase function) also scatters light arriving from behind n
 } LightSampleContext;
 
 typedef struct {
-  float3 wi;  // unit direction from ctx.p toward the light
-  float3 radiance;  // emitted radiance arriving along -wi (intensity for delta lights)
-  float pdf;  // solid-angle pdf of wi including the selection probability (delta: pmf)
-  bool is_delta;  // a punctual or directional light: no BSDF-sampled ray can hit it
+  float3 wi;         // unit direction from ctx.p toward the light
+  float3 radiance;   // emitted radiance arriving along -wi (intensity for delta lights)
+  float pdf;         // solid-angle pdf of wi including the selection probability (delta: pmf)
+  bool is_delta;     // a punctual or directional light: no BSDF-sampled ray can hit it
   bool at_infinity;  // shadow ray along wi without end
-  float3 target;  // finite lights: the sampled point, moved off the light toward ctx.p
+  float3 target;     // finite lights: the sampled point, moved off the light toward ctx.p
 } LightSample;
 
 LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) {
@@ -93,8 +93,8 @@ bool lights_environment_sample(const SceneData* sc, __global const Light* light,
 // trigonometry costs time: on the Cornell box, whose light subtends about 0.05 sr from the
 // floor, it lowers the error by 7 % for 12 % more CPU time, a loss. Below the threshold
 // (small or distant triangles, where 1/r^2 and the cosine hardly vary over the triangle,
-// and the spherical formulas lose precision in float) area sampling is used. CD_TRIANGLE_SAMPLING_AREA (a build option) keeps area sampling
-// everywhere, for comparison (README "Light sampling").
+// and the spherical formulas lose precision in float) area sampling is used. CD_TRIANGLE_SAMPLING_AREA (a build option)
+// keeps area sampling everywhere, for comparison (README "Light sampling").
 #ifndef LIGHTS_SPHERICAL_MIN_SOLID_ANGLE
 #define LIGHTS_SPHERICAL_MIN_SOLID_ANGLE 0.1f
 #endif
@@ -181,8 +181,8 @@ float lights_triangle_solid_angle_pdf(float3 p, float3 y, float3 n, float area) 
 
 // A point on the light's triangle, uniform in solid angle or in area (see above), with
 // its solid-angle pdf at ctx.p
-bool lights_triangle_sample(const SceneData* sc, __global const Light* light,
-                            const LightSampleContext* ctx, float2 u, LightSample* ls) {
+bool lights_triangle_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float2 u,
+                            LightSample* ls) {
   float3 v0, v1, v2;
   scene_prim_positions(sc, light->index, &v0, &v1, &v2);
   float area;
@@ -217,8 +217,7 @@ bool lights_triangle_sample(const SceneData* sc, __global const Light* light,
 
 // The pdf lights_triangle_sample would give for wi: where the ray from ctx.p along wi
 // meets the light's triangle (0 if it misses)
-float lights_triangle_pdf(const SceneData* sc, __global const Light* light,
-                          const LightSampleContext* ctx, float3 wi) {
+float lights_triangle_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float3 wi) {
   float3 v0, v1, v2;
   scene_prim_positions(sc, light->index, &v0, &v1, &v2);
   Ray r = {ctx->p, wi};
@@ -317,8 +316,7 @@ bool lights_sample_light(const SceneData* sc, __global const Light* light, const
 }
 
 // Picks a light by x_select (power-proportional alias table) and samples a direction toward it
-bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u,
-                   LightSample* ls) {
+bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u, LightSample* ls) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
   __global const Light* light = &sc->lights[sample_discrete_alias(sc->light_alias, n, x_select)];

@@ -35,9 +35,7 @@ MediumStack media_stack_empty(void) {
   return st;
 }
 
-int media_current(const MediumStack* st) {
-  return st->count > 0u ? st->entered[st->count - 1u] : GLOBAL_MEDIUM;
-}
+int media_current(const MediumStack* st) { return st->count > 0u ? st->entered[st->count - 1u] : GLOBAL_MEDIUM; }
 
 // The ray crosses a boundary whose interior is `medium`: entering (from the front face)
 // or leaving
@@ -70,7 +68,7 @@ bool media_front_face(const SceneData* sc, uint prim, float3 dir) {
 // A boundary left from the back face that was not entered on the way encloses the origin;
 // the farthest of them is the outermost.
 MediumStack media_at_origin(const SceneData* sc, Ray ray) {
-  Ray r = ray;  // walked along: never assign to a struct parameter (README, Kernel portability)
+  Ray r = ray;                    // walked along: never assign to a struct parameter (README, Kernel portability)
   int inside[MEDIUM_STACK_SIZE];  // media enclosing the origin, innermost first
   uint n_inside = 0u;
   MediumStack passed = media_stack_empty();  // entered along the ray, not yet left
@@ -113,8 +111,7 @@ float media_weighted_length1(float s, float d) {
 }
 
 float3 media_weighted_length(float3 s, float d) {
-  return (float3)(media_weighted_length1(s.x, d), media_weighted_length1(s.y, d),
-                  media_weighted_length1(s.z, d));
+  return (float3)(media_weighted_length1(s.x, d), media_weighted_length1(s.y, d), media_weighted_length1(s.z, d));
 }
 
 // Density of a MEDIUM_GRID at p: trilinear between the grid's nodes, which span the box
@@ -182,9 +179,9 @@ bool media_grid_span(__global const Medium* m, Ray r, float tmax, float* t0, flo
 float media_exp_step(float rate, Rng* rng) { return -log(1.0f - rng_next(rng)) / rate; }
 
 // What happened along a ray segment in a medium
-#define MEDIUM_PASSED 0  // the ray reached the surface (or escaped); beta holds the weight
+#define MEDIUM_PASSED 0     // the ray reached the surface (or escaped); beta holds the weight
 #define MEDIUM_SCATTERED 1  // a real scattering event at *p; beta holds the weight
-#define MEDIUM_ABSORBED 2  // the path ends in the medium (delta tracking's absorption)
+#define MEDIUM_ABSORBED 2   // the path ends in the medium (delta tracking's absorption)
 
 // Homogeneous medium: the free-flight distance is sampled from one channel's sigma_t,
 // the channel chosen uniformly, so the pdf of a distance t is the average over channels of
@@ -192,8 +189,7 @@ float media_exp_step(float rate, Rng* rng) { return -log(1.0f - rng_next(rng)) /
 // tmax) (one-sample MIS over the channels; unbiased for chromatic media). The weight is
 // sigma_s T(t) / pdf at a scattering event and T(tmax) / P(pass) at the surface. Without
 // scattering nothing is sampled and the weight is T(tmax) exactly.
-int media_sample_homogeneous(__global const Medium* m, Ray r, float tmax, Rng* rng, float3* beta,
-                             float3* p) {
+int media_sample_homogeneous(__global const Medium* m, Ray r, float tmax, Rng* rng, float3* beta, float3* p) {
   float3 sigma_t = media_sigma_t(m), sigma_s = media_sigma_s(m);
   if (max_component(sigma_s) <= 0.0f) {
     if (max_component(sigma_t) > 0.0f) *beta *= media_exp(-sigma_t * tmax);
@@ -216,8 +212,8 @@ int media_sample_homogeneous(__global const Medium* m, Ray r, float tmax, Rng* r
 // Walks the majorant cells of a grid medium that a ray crosses, in order (3D DDA, Amanatides
 // and Woo 1987): `t` is where the current cell's part of the span starts.
 typedef struct {
-  float t, t1;  // current position and the end of the span inside the box
-  float3 t_next;  // ray distance to the next cell boundary along each axis
+  float t, t1;     // current position and the end of the span inside the box
+  float3 t_next;   // ray distance to the next cell boundary along each axis
   float3 t_delta;  // ray distance across one cell along each axis
   int3 cell, step, size;
   uint offset;  // the medium's first majorant cell in `densities`
@@ -256,9 +252,18 @@ bool media_dda_advance(MediaDda* it) {
   int axis = tn.x <= tn.y && tn.x <= tn.z ? 0 : tn.y <= tn.z ? 1 : 2;
   float t_end = axis == 0 ? tn.x : axis == 1 ? tn.y : tn.z;
   it->t = fmax(it->t, fmin(t_end, it->t1));
-  if (axis == 0) { it->cell.x += it->step.x; it->t_next.x += it->t_delta.x; }
-  if (axis == 1) { it->cell.y += it->step.y; it->t_next.y += it->t_delta.y; }
-  if (axis == 2) { it->cell.z += it->step.z; it->t_next.z += it->t_delta.z; }
+  if (axis == 0) {
+    it->cell.x += it->step.x;
+    it->t_next.x += it->t_delta.x;
+  }
+  if (axis == 1) {
+    it->cell.y += it->step.y;
+    it->t_next.y += it->t_delta.y;
+  }
+  if (axis == 2) {
+    it->cell.z += it->step.z;
+    it->t_next.z += it->t_delta.z;
+  }
   bool inside = all(it->cell >= (int3)(0)) && all(it->cell < it->size);
   if (!inside) it->t = it->t1;
   return inside;
@@ -291,8 +296,8 @@ bool media_dda_collision(const SceneData* sc, MediaDda* it, Rng* rng, float* sig
 // collision adds beta x emission(t) / sigma_bar, an unbiased estimate of the integral of
 // T(t) emission(t) (tentative collisions happen at rate sigma_bar while the path goes on);
 // emission(t) is emission x density, or emission x the emission grid (Medium.emission_grid).
-int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, float tmax, Rng* rng,
-                      float3* beta, float3* radiance, float3* p) {
+int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, float tmax, Rng* rng, float3* beta,
+                      float3* radiance, float3* p) {
   MediaGridRay g = media_grid_ray(sc, m, r);
   MediaDda it;
   if (!media_dda_start(m, g.r, tmax, &it)) return MEDIUM_PASSED;
@@ -308,7 +313,7 @@ int media_sample_grid(const SceneData* sc, __global const Medium* m, Ray r, floa
       float e = em ? media_density(sc, em, r.org + it.t * r.dir) : d;
       *radiance += *beta * emission * (e / sigma_bar);
     }
-    float3 sa = d * sigma_a, ss = d * sigma_s, sn = fmax((float3)(sigma_bar) - sa - ss, 0.0f);
+    float3 sa = d * sigma_a, ss = d * sigma_s, sn = fmax((float3)(sigma_bar)-sa - ss, 0.0f);
     float pa = media_average(sa) / sigma_bar, ps = media_average(ss) / sigma_bar;
     float u = rng_next(rng);
     if (u < pa) return MEDIUM_ABSORBED;
@@ -335,8 +340,8 @@ float3 media_homogeneous_emission(__global const Medium* m, float tmax) {
 // the ray escapes): adds the medium's emission along the segment to *radiance (weighted by
 // *beta; the light media emit is found this way under every strategy) and samples where
 // the path scatters next.
-int media_sample_segment(const SceneData* sc, int medium, Ray r, float tmax, Rng* rng, float3* beta,
-                         float3* radiance, float3* p) {
+int media_sample_segment(const SceneData* sc, int medium, Ray r, float tmax, Rng* rng, float3* beta, float3* radiance,
+                         float3* p) {
   __global const Medium* m = &sc->media[medium];
   if (m->type != MEDIUM_HOMOGENEOUS) return media_sample_grid(sc, m, r, tmax, rng, beta, radiance, p);
   *radiance += *beta * media_homogeneous_emission(m, tmax);

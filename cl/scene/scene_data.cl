@@ -2,7 +2,7 @@
 // one struct, and geometry looked up by stable primitive index.
 
 #define CD_SCENE_FIELD(type, name) __global const type* name;
-#define CD_SCENE_PARAM(type, name) __global const type* name,
+#define CD_SCENE_PARAM(type, name) __global const type *name,
 #define CD_SCENE_INIT(type, name) name,
 
 typedef struct SceneData {

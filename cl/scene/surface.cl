@@ -3,11 +3,11 @@
 
 typedef struct {
   float3 p;
-  float3 ng;  // geometric normal, turned to the side the ray came from
-  float3 ns;  // shading normal, on the same side as ng
-  float3 tangent;  // shading tangent direction (TANGENT, else dp/du); 0 when unknown
-  float tangent_sign;  // glTF bitangent = tangent_sign * (n x tangent), front face
-  float4 uvs;  // TEXCOORD_0 in xy, TEXCOORD_1 in zw
+  float3 ng;            // geometric normal, turned to the side the ray came from
+  float3 ns;            // shading normal, on the same side as ng
+  float3 tangent;       // shading tangent direction (TANGENT, else dp/du); 0 when unknown
+  float tangent_sign;   // glTF bitangent = tangent_sign * (n x tangent), front face
+  float4 uvs;           // TEXCOORD_0 in xy, TEXCOORD_1 in zw
   float3 vertex_color;  // COLOR_0, white without CD_FEATURE_VERTEX_COLORS
   uint prim;
   uint material;
@@ -28,8 +28,8 @@ float4 surface_uvs(const SceneData* sc, __global const Prim* pr, float b1, float
 
 // Tangent (xyz) and bitangent sign (w) from glTF TANGENT when the vertices have one, else
 // dp/du from TEXCOORD_0 with sign +1 (as the glTF sample viewer derives them)
-float4 surface_tangent(const SceneData* sc, __global const Prim* pr, float b1, float b2, float3 p0,
-                       float3 p1, float3 p2) {
+float4 surface_tangent(const SceneData* sc, __global const Prim* pr, float b1, float b2, float3 p0, float3 p1,
+                       float3 p2) {
   float b0 = 1.0f - b1 - b2;
 #if CD_FEATURE_TANGENTS
   float4 t0 = vload4(pr->v[0], sc->tangents);
@@ -57,8 +57,8 @@ SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3
   s.ng = triangle_normal_area(v0, v1, v2, &area);
   s.front = dot(s.ng, ray_dir) < 0.0f;
   if (!s.front) s.ng = -s.ng;
-  float3 n = b0 * vload3(pr->v[0], sc->normals) + b1 * vload3(pr->v[1], sc->normals) +
-             b2 * vload3(pr->v[2], sc->normals);
+  float3 n =
+      b0 * vload3(pr->v[0], sc->normals) + b1 * vload3(pr->v[1], sc->normals) + b2 * vload3(pr->v[2], sc->normals);
   float len = length(n);
   s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
@@ -67,8 +67,8 @@ SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3
   s.tangent = tangent.xyz;
   s.tangent_sign = tangent.w;
 #if CD_FEATURE_VERTEX_COLORS
-  s.vertex_color = b0 * vload3(pr->v[0], sc->colors) + b1 * vload3(pr->v[1], sc->colors) +
-                   b2 * vload3(pr->v[2], sc->colors);
+  s.vertex_color =
+      b0 * vload3(pr->v[0], sc->colors) + b1 * vload3(pr->v[1], sc->colors) + b2 * vload3(pr->v[2], sc->colors);
 #else
   s.vertex_color = (float3)(1.0f);
 #endif

@@ -23,8 +23,7 @@ float4 texture_texel(const SceneData* sc, __global const TextureInfo* tex, int x
   if (tex->flags & TEXTURE_FLOAT) return vload4(0, sc->texelsf[i].rgba);
   Texel8 c = sc->texels8[i];
   if (tex->flags & TEXTURE_SRGB)
-    return (float4)(sc->srgb_to_linear[c.r], sc->srgb_to_linear[c.g], sc->srgb_to_linear[c.b],
-                    c.a / 255.0f);
+    return (float4)(sc->srgb_to_linear[c.r], sc->srgb_to_linear[c.g], sc->srgb_to_linear[c.b], c.a / 255.0f);
   return (float4)(c.r, c.g, c.b, c.a) / 255.0f;
 }
 
@@ -55,8 +54,8 @@ float4 textures_lookup(const SceneData* sc, __global const TextureRef* ref, floa
 #if CD_FEATURE_TEXTURES
   if (ref->index != NO_TEXTURE) {
     float2 uv = ref->texcoord == 1u ? uvs.zw : uvs.xy;
-    float2 st = (float2)(ref->m[0] * uv.x + ref->m[1] * uv.y + ref->m[2],
-                         ref->m[3] * uv.x + ref->m[4] * uv.y + ref->m[5]);
+    float2 st =
+        (float2)(ref->m[0] * uv.x + ref->m[1] * uv.y + ref->m[2], ref->m[3] * uv.x + ref->m[4] * uv.y + ref->m[5]);
     return texture_sample(sc, &sc->textures[ref->index], st);
   }
 #endif

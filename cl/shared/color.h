@@ -11,9 +11,7 @@
 #endif
 
 // Relative luminance of linear Rec. 709 / sRGB primaries
-static inline float luminance_rgb(float r, float g, float b) {
-  return 0.2126f * r + 0.7152f * g + 0.0722f * b;
-}
+static inline float luminance_rgb(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 // sRGB transfer function to linear (IEC 61966-2-1)
 static inline float srgb_to_linear(float c) {

@@ -14,6 +14,8 @@
 // build options -Dmacro=0|1 in this order (part of the program-cache key) and the kernel's
 // default without them, `#define macro default`, which host/device/kernel_sources.cpp
 // prepends to the program. Kernel code tests `#if macro`.
+// One entry per line, columns aligned:
+// clang-format off
 #define CD_SCENE_FEATURES(X)                                                                       \
   X(textures, CD_FEATURE_TEXTURES, 1, "some material slot has a texture")                          \
   X(uvs, CD_FEATURE_UVS, 1, "some mesh has TEXCOORD_0 or TEXCOORD_1")                              \
@@ -26,6 +28,7 @@
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
+// clang-format on
 
 // Material types. CD_MATERIALS: X(id, name, feature), one entry per type, generates every
 // dispatch on Material.type and Bsdf.type (cl/bsdf/bsdf.cl; the host's compile step and name
@@ -37,19 +40,22 @@
 //   float bsdf_NAME_alpha(const Bsdf*)
 // and on the host compile_material_NAME (host/compile/scene_compiler.cpp). `feature` is the
 // CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
-#define MATERIAL_DIFFUSE 0u  // Lambertian, albedo = base color
-#define MATERIAL_GLTF 1u  // glTF metallic-roughness with its KHR_materials_* extensions
+#define MATERIAL_DIFFUSE 0u    // Lambertian, albedo = base color
+#define MATERIAL_GLTF 1u       // glTF metallic-roughness with its KHR_materials_* extensions
 #define MATERIAL_CONDUCTOR 2u  // measured conductor: complex index eta + i k, GGX roughness
-#define CD_MATERIALS(X)                                  \
-  X(MATERIAL_DIFFUSE, diffuse, 1)                        \
-  X(MATERIAL_GLTF, gltf, CD_FEATURE_GLTF_BSDF)           \
+// One entry per line, columns aligned:
+// clang-format off
+#define CD_MATERIALS(X)                        \
+  X(MATERIAL_DIFFUSE, diffuse, 1)              \
+  X(MATERIAL_GLTF, gltf, CD_FEATURE_GLTF_BSDF) \
   X(MATERIAL_CONDUCTOR, conductor, CD_FEATURE_CONDUCTOR)
+// clang-format on
 
 // Material flags
 #define MATERIAL_DOUBLE_SIDED 1u
-#define MATERIAL_THIN_WALLED 2u  // transmission through a sheet (no KHR_materials_volume)
-#define MATERIAL_ALPHA_MASK 4u  // alphaMode MASK: cut out below alpha_cutoff
-#define MATERIAL_ALPHA_BLEND 8u  // alphaMode BLEND: stochastic opacity
+#define MATERIAL_THIN_WALLED 2u     // transmission through a sheet (no KHR_materials_volume)
+#define MATERIAL_ALPHA_MASK 4u      // alphaMode MASK: cut out below alpha_cutoff
+#define MATERIAL_ALPHA_BLEND 8u     // alphaMode BLEND: stochastic opacity
 #define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
 
 // Texture slots of a material (Material.textures)
@@ -57,12 +63,12 @@
 #define TEX_METALLIC_ROUGHNESS 1  // B metallic, G roughness
 #define TEX_NORMAL 2
 #define TEX_EMISSION 3
-#define TEX_TRANSMISSION 4  // R
-#define TEX_SPECULAR 5  // A
-#define TEX_SPECULAR_COLOR 6  // RGB
-#define TEX_CLEARCOAT 7  // R
+#define TEX_TRANSMISSION 4         // R
+#define TEX_SPECULAR 5             // A
+#define TEX_SPECULAR_COLOR 6       // RGB
+#define TEX_CLEARCOAT 7            // R
 #define TEX_CLEARCOAT_ROUGHNESS 8  // G
-#define TEX_ANISOTROPY 9  // RG direction in tangent space, B strength
+#define TEX_ANISOTROPY 9           // RG direction in tangent space, B strength
 #define TEX_SLOTS 10
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
@@ -72,17 +78,20 @@
 //   float lights_NAME_pdf(const SceneData*, __global const Light*, const LightSampleContext*, float3 wi)
 // in cl/lights/ and light_power_NAME on the host (host/compile/scene_compiler.cpp). `feature`
 // is the CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
-#define LIGHT_TRIANGLE 0u  // an emissive triangle (area light)
+#define LIGHT_TRIANGLE 0u     // an emissive triangle (area light)
 #define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away: constant or a map
-#define LIGHT_POINT 2u  // KHR_lights_punctual point: radiant intensity from a point
-#define LIGHT_SPOT 3u  // KHR_lights_punctual spot: a point light restricted to a smooth cone
+#define LIGHT_POINT 2u        // KHR_lights_punctual point: radiant intensity from a point
+#define LIGHT_SPOT 3u         // KHR_lights_punctual spot: a point light restricted to a smooth cone
 #define LIGHT_DIRECTIONAL 4u  // KHR_lights_punctual directional: parallel light from infinity
+// One entry per line, columns aligned:
+// clang-format off
 #define CD_LIGHTS(X)                                        \
   X(LIGHT_TRIANGLE, triangle, 1)                            \
   X(LIGHT_ENVIRONMENT, environment, CD_FEATURE_ENVIRONMENT) \
   X(LIGHT_POINT, point, CD_FEATURE_PUNCTUAL)                \
   X(LIGHT_SPOT, spot, CD_FEATURE_PUNCTUAL)                  \
   X(LIGHT_DIRECTIONAL, directional, CD_FEATURE_PUNCTUAL)
+// clang-format on
 
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
@@ -90,13 +99,13 @@
 #define STRATEGY_AUTO 2u  // per vertex: nee at rough or diffuse BSDFs, bsdf at near-specular ones
 
 // Camera projections (camera.cl)
-#define CAMERA_PERSPECTIVE 0u  // pinhole, or a thin lens when lens_radius > 0
+#define CAMERA_PERSPECTIVE 0u   // pinhole, or a thin lens when lens_radius > 0
 #define CAMERA_ORTHOGRAPHIC 1u  // parallel rays along forward
 
 // Pixel filters (filter.cl), importance-sampled: film samples are offset from the pixel
 // centre with the filter's density, so each pixel stays an unweighted mean
-#define FILTER_BOX 0u  // uniform over the pixel (|dx|, |dy| < 1/2)
-#define FILTER_TENT 1u  // separable tent of radius 1 pixel
+#define FILTER_BOX 0u       // uniform over the pixel (|dx|, |dy| < 1/2)
+#define FILTER_TENT 1u      // separable tent of radius 1 pixel
 #define FILTER_GAUSSIAN 2u  // isotropic Gaussian, sigma 1/2 pixel, not truncated
 
 // Texture flags: wrap modes (glTF sampler wrapS in bits 0-7, wrapT in bits 8-15),
@@ -104,8 +113,8 @@
 #define WRAP_REPEAT 0u
 #define WRAP_CLAMP 1u
 #define WRAP_MIRROR 2u
-#define TEXTURE_SRGB 0x10000u  // RGBA8 texels hold sRGB-encoded colour (alpha linear)
-#define TEXTURE_FLOAT 0x20000u  // texels live in the float texel array, else in the RGBA8 one
+#define TEXTURE_SRGB 0x10000u     // RGBA8 texels hold sRGB-encoded colour (alpha linear)
+#define TEXTURE_FLOAT 0x20000u    // texels live in the float texel array, else in the RGBA8 one
 #define TEXTURE_NEAREST 0x40000u  // nearest-texel lookup (glTF magFilter NEAREST), else bilinear
 
 // GGX albedo table (cl/bsdf/energy.cl): two halves of GGX_ALBEDO_HALF floats, E (F = 1) then E5
@@ -124,7 +133,7 @@
 
 // Medium types (media.cl)
 #define MEDIUM_HOMOGENEOUS 0u
-#define MEDIUM_GRID 1u  // coefficients scaled by a dense density grid (trilinear), delta tracking
+#define MEDIUM_GRID 1u     // coefficients scaled by a dense density grid (trilinear), delta tracking
 #define MEDIUM_NANOVDB 2u  // as MEDIUM_GRID, the density from a NanoVDB float grid (nanovdb.cl)
 
 // 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
@@ -150,7 +159,7 @@ typedef struct {
 
 // A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
 #define BVH_TRI_ALPHA_TEST 1u  // hits must pass scene_alpha_passes (alphaMode MASK / BLEND)
-#define BVH_TRI_LAST 2u  // the last triangle of its leaf
+#define BVH_TRI_LAST 2u        // the last triangle of its leaf
 typedef struct {
   float v0[3];
   unsigned int prim;  // stable primitive index (Prim array)
@@ -171,7 +180,7 @@ typedef struct {
 // KHR_texture_transform applied in the kernel: uv' = (m[0] u + m[1] v + m[2],
 // m[3] u + m[4] v + m[5]).
 typedef struct {
-  int index;  // into TextureInfo, or NO_TEXTURE
+  int index;              // into TextureInfo, or NO_TEXTURE
   unsigned int texcoord;  // 0 or 1
   float m[6];
 } TextureRef;
@@ -202,14 +211,14 @@ typedef union {
 // Material, 416 bytes: what every type has, then its type's parameters. Colours are linear
 // RGB; factors multiply their texture slots.
 typedef struct {
-  unsigned int type;  // MATERIAL_*
+  unsigned int type;   // MATERIAL_*
   unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
   float alpha_cutoff;  // alphaMode MASK
   float normal_scale;
-  float base_color[4];  // rgba factor
-  float emission[3];  // rgb radiance (factor x strength)
-  int medium;  // the medium inside a closed surface (into `media`), or NO_MEDIUM
-  MaterialParams params;  // by type
+  float base_color[4];             // rgba factor
+  float emission[3];               // rgb radiance (factor x strength)
+  int medium;                      // the medium inside a closed surface (into `media`), or NO_MEDIUM
+  MaterialParams params;           // by type
   TextureRef textures[TEX_SLOTS];  // TEX_* slots
 } Material;
 
@@ -265,7 +274,7 @@ typedef struct {
   unsigned int index;
   unsigned int pad0;
   float radiance[4];  // rgb
-  float params[8];  // per-type parameters, see above
+  float params[8];    // per-type parameters, see above
 } Light;
 
 // A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
@@ -277,21 +286,21 @@ typedef struct {
 // around them); rays are mapped to index space once per segment (the map is affine, so the
 // ray parameter t is the same in both spaces).
 typedef struct {
-  float sigma_a[4];  // absorption, rgb (w unused)
-  float sigma_s[4];  // scattering, rgb
-  float emission[3];  // emitted radiance per unit length, rgb
+  float sigma_a[4];            // absorption, rgb (w unused)
+  float sigma_s[4];            // scattering, rgb
+  float emission[3];           // emitted radiance per unit length, rgb
   unsigned int emission_grid;  // 0: emission x density; else the media record (a MEDIUM_GRID,
                                // density_scale = emission_scale, no majorant) whose grid
                                // scales emission in place of the density
-  float g;  // Henyey-Greenstein asymmetry, in (-1, 1)
-  unsigned int type;  // MEDIUM_*
-  float density_scale;  // MEDIUM_GRID: density = scale x grid value
-  float majorant;  // MEDIUM_GRID: bound of density x max channel of sigma_t over the box
-  unsigned int grid_offset;  // MEDIUM_GRID: first value in `densities`, x fastest, then y, z
-  unsigned int grid_size[3];  // MEDIUM_GRID: nodes along x, y, z (each >= 2)
-  float grid_min[4];  // MEDIUM_GRID: the box the nodes span (w unused); density 0 outside
+  float g;                     // Henyey-Greenstein asymmetry, in (-1, 1)
+  unsigned int type;           // MEDIUM_*
+  float density_scale;         // MEDIUM_GRID: density = scale x grid value
+  float majorant;              // MEDIUM_GRID: bound of density x max channel of sigma_t over the box
+  unsigned int grid_offset;    // MEDIUM_GRID: first value in `densities`, x fastest, then y, z
+  unsigned int grid_size[3];   // MEDIUM_GRID: nodes along x, y, z (each >= 2)
+  float grid_min[4];           // MEDIUM_GRID: the box the nodes span (w unused); density 0 outside
   float grid_max[4];
-  unsigned int majorant_offset;  // MEDIUM_GRID: first majorant cell in `densities`
+  unsigned int majorant_offset;   // MEDIUM_GRID: first majorant cell in `densities`
   unsigned int majorant_size[3];  // MEDIUM_GRID: cells along x, y, z splitting the box evenly;
                                   // each holds a bound of sigma_t over its part of the box
 } Medium;
@@ -307,7 +316,7 @@ typedef struct {
 typedef struct {
   float origin[3];
   unsigned int type;  // CAMERA_*
-  float forward[3];  // unit
+  float forward[3];   // unit
   float lens_radius;  // thin-lens aperture radius in scene units; 0 = pinhole
   float right[3];
   float focus_distance;  // thin lens: distance of the sharp plane along forward
@@ -322,16 +331,16 @@ typedef struct {
   unsigned int height;
   unsigned int seed;
   unsigned int max_depth;  // scattering events; 0 = emission seen directly only
-  unsigned int strategy;  // STRATEGY_*
+  unsigned int strategy;   // STRATEGY_*
   unsigned int num_lights;
-  int environment_light;  // index of the LIGHT_ENVIRONMENT light, or NO_LIGHT
-  unsigned int rr_depth;  // Russian roulette starts after this many bounces
-  unsigned int sample_begin;  // first sample index of this launch
-  unsigned int sample_count;  // samples per pixel in this launch
-  unsigned int pixel_begin;  // first pixel of this launch (row-major)
-  unsigned int pixel_end;  // one past the last pixel of this launch
+  int environment_light;             // index of the LIGHT_ENVIRONMENT light, or NO_LIGHT
+  unsigned int rr_depth;             // Russian roulette starts after this many bounces
+  unsigned int sample_begin;         // first sample index of this launch
+  unsigned int sample_count;         // samples per pixel in this launch
+  unsigned int pixel_begin;          // first pixel of this launch (row-major)
+  unsigned int pixel_end;            // one past the last pixel of this launch
   unsigned int energy_compensation;  // 1: multiple-scattering compensation of GGX lobes (energy.cl)
-  unsigned int filter;  // FILTER_*: the density of film sample offsets (filter.cl)
+  unsigned int filter;               // FILTER_*: the density of film sample offsets (filter.cl)
 } RenderParams;
 
 // Every scene buffer, in kernel-argument order: X(element type, name). This one list
@@ -342,6 +351,8 @@ typedef struct {
 // grids of MEDIUM_NANOVDB media, each a NanoVDB buffer starting on a 32-byte boundary. env_distribution holds
 // the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. ggx_albedo is no part
 // of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
+// One entry per line, columns aligned:
+// clang-format off
 #define CD_SCENE_BUFFERS(X)  \
   X(BvhNode, bvh_nodes)      \
   X(BvhTriangle, bvh_tris)   \
@@ -358,49 +369,50 @@ typedef struct {
   X(TexelF, texelsf)         \
   X(float, srgb_to_linear)   \
   X(Light, lights)           \
-  X(AliasBin, light_alias)  \
+  X(AliasBin, light_alias)   \
   X(float, env_distribution) \
   X(Medium, media)           \
   X(float, densities)        \
   X(unsigned int, nanovdb)   \
   X(float, ggx_albedo)
+// clang-format on
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
 // FIELD(type, field, offset). The host static_asserts these; tests/cl checks them on
 // each device.
-#define CD_LAYOUT(SIZE, FIELD)                                                              \
-  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32)                      \
-  FIELD(BvhNode, hi_y, 48) FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80)                \
-  FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)                                        \
-  SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16)             \
-  FIELD(BvhTriangle, flags, 28) FIELD(BvhTriangle, v2, 32)                                  \
-  SIZE(Prim, 16) FIELD(Prim, material, 12)                                                  \
-  SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)               \
-  SIZE(GltfMaterial, 48) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16) \
-  FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)          \
-  SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16)                               \
-  FIELD(ConductorMaterial, roughness, 32) FIELD(ConductorMaterial, pad, 44)                 \
-  SIZE(MaterialParams, 48)                                                                  \
-  SIZE(Material, 416) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)     \
-  FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)     \
-  FIELD(Material, textures, 96)                                                             \
-  SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                       \
-  SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                       \
-  SIZE(TexelF, 16)                                                                          \
-  SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                               \
-  SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)    \
-  FIELD(Light, params, 32)                                                                  \
-  SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48) \
-  FIELD(Medium, emission_grid, 44)                                                          \
-  FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68) FIELD(Medium, grid_min, 80)       \
-  FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)                           \
-  FIELD(Medium, majorant_size, 116)                                                         \
-  SIZE(Camera, 64) FIELD(Camera, type, 12) FIELD(Camera, forward, 16)                      \
-  FIELD(Camera, lens_radius, 28) FIELD(Camera, right, 32) FIELD(Camera, focus_distance, 44) \
-  FIELD(Camera, up, 48) FIELD(Camera, pad0, 60)                                             \
-  SIZE(RenderParams, 120) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)  \
-  FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)              \
-  FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)                 \
-  FIELD(RenderParams, energy_compensation, 112) FIELD(RenderParams, filter, 116)
+// One entry per line, columns aligned:
+// clang-format off
+#define CD_LAYOUT(SIZE, FIELD)                                                                                \
+  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32) FIELD(BvhNode, hi_y, 48)               \
+    FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80) FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)      \
+  SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16) FIELD(BvhTriangle, flags, 28) \
+    FIELD(BvhTriangle, v2, 32)                                                                                \
+  SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \
+  SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)                                 \
+  SIZE(GltfMaterial, 48) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
+    FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
+  SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
+    FIELD(ConductorMaterial, pad, 44)                                                                         \
+  SIZE(MaterialParams, 48)                                                                                    \
+  SIZE(Material, 416) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
+    FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
+    FIELD(Material, textures, 96)                                                                             \
+  SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \
+  SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
+  SIZE(TexelF, 16)                                                                                            \
+  SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                                                 \
+  SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)                      \
+    FIELD(Light, params, 32)                                                                                  \
+  SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48)               \
+    FIELD(Medium, emission_grid, 44) FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68)                 \
+    FIELD(Medium, grid_min, 80) FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)               \
+    FIELD(Medium, majorant_size, 116)                                                                         \
+  SIZE(Camera, 64) FIELD(Camera, type, 12) FIELD(Camera, forward, 16) FIELD(Camera, lens_radius, 28)          \
+    FIELD(Camera, right, 32) FIELD(Camera, focus_distance, 44) FIELD(Camera, up, 48) FIELD(Camera, pad0, 60)  \
+  SIZE(RenderParams, 120) FIELD(RenderParams, width, 64) FIELD(RenderParams, strategy, 80)                    \
+    FIELD(RenderParams, environment_light, 88) FIELD(RenderParams, rr_depth, 92)                              \
+    FIELD(RenderParams, pixel_begin, 104) FIELD(RenderParams, pixel_end, 108)                                 \
+    FIELD(RenderParams, energy_compensation, 112) FIELD(RenderParams, filter, 116)
+// clang-format on
 
 #endif  // CANDELA_DEVICE_TYPES_H

@@ -32,9 +32,9 @@ std::string self_executable() {
 namespace {
 
 struct Child {
-  int status = -1;  // exit status, or 128 + signal
+  int status = -1;       // exit status, or 128 + signal
   double seconds = 0.0;  // wall clock, process start to exit
-  std::string log;  // its stdout and stderr
+  std::string log;       // its stdout and stderr
 };
 
 // Runs argv[0] with argv and the extra environment, its output into log_path
@@ -203,10 +203,22 @@ class DeviceRenders {
 
   // `candela render` into DIR/NAME.exr (and its variance with `outputs`) and DIR/NAME.json
   Child render(const std::string& name, uint32_t spp, uint32_t seed, bool outputs) const {
-    std::vector<std::string> v = {exe_, "render", args_.scene, "-o", (dir_ / (name + ".exr")).string(),
-                                  "--stats", (dir_ / (name + ".json")).string(), "--spp", std::to_string(spp),
-                                  "--width", std::to_string(args_.width), "--seed", std::to_string(seed),
-                                  "--device", run_.selector, "-q"};
+    std::vector<std::string> v = {exe_,
+                                  "render",
+                                  args_.scene,
+                                  "-o",
+                                  (dir_ / (name + ".exr")).string(),
+                                  "--stats",
+                                  (dir_ / (name + ".json")).string(),
+                                  "--spp",
+                                  std::to_string(spp),
+                                  "--width",
+                                  std::to_string(args_.width),
+                                  "--seed",
+                                  std::to_string(seed),
+                                  "--device",
+                                  run_.selector,
+                                  "-q"};
     if (args_.height > 0) v.insert(v.end(), {"--height", std::to_string(args_.height)});
     if (outputs) v.insert(v.end(), {"--variance", (dir_ / (name + "-variance.exr")).string()});
     v.insert(v.end(), args_.render_options.begin(), args_.render_options.end());
@@ -342,7 +354,8 @@ void compare_device(const CompareArgs& args, const DeviceRun& ref, const DeviceR
     return;
   }
   if (r.spp != ref.spp)
-    throw Error("device '" + r.selector + "' rendered " + std::to_string(r.spp) + " spp, not " + std::to_string(ref.spp));
+    throw Error("device '" + r.selector + "' rendered " + std::to_string(r.spp) + " spp, not " +
+                std::to_string(ref.spp));
   ErrorMetrics err = image_error(r.image, ref.image);
   ZTest t = z_test(ref.image, ref.variance, r.image, r.variance);
   c->consistent = c->consistent && t.consistent;
@@ -352,22 +365,20 @@ void compare_device(const CompareArgs& args, const DeviceRun& ref, const DeviceR
   for (const auto& why : t.reasons) c->notes.push_back(std::to_string(i) + " " + r.selector + ": " + why);
   jd["against_first"] = {{"rel_mse", err.rel_mse}, {"mse", err.mse}, {"mae", err.mae}, {"z_test", ztest_json(t)}};
   if (args.same_seed)
-    c->notes.push_back(std::to_string(i) + " " + r.selector + ": same seed: the z-test's independence assumption does not hold");
+    c->notes.push_back(std::to_string(i) + " " + r.selector +
+                       ": same seed: the z-test's independence assumption does not hold");
   if (r.has_same_seed) add_same_seed_result(ref, r, &jd, c);
   c->devices.push_back(jd);
 }
 
 void write_comparison_json(const CompareArgs& args, const DeviceRun& ref, const Comparison& c) {
   ZTestRule rule;
-  nlohmann::json j = {{"scene", args.scene},
-                      {"width", ref.image.width},
-                      {"height", ref.image.height},
-                      {"spp", ref.spp},
-                      {"same_seed", args.same_seed},
-                      {"render_options", args.render_options},
-                      {"devices", c.devices},
-                      {"rule", {{"z2_slack", rule.z2_slack}, {"tail_allowance", rule.tail_allowance}}},
-                      {"consistent", c.consistent}};
+  nlohmann::json j = {
+      {"scene", args.scene},         {"width", ref.image.width},
+      {"height", ref.image.height},  {"spp", ref.spp},
+      {"same_seed", args.same_seed}, {"render_options", args.render_options},
+      {"devices", c.devices},        {"rule", {{"z2_slack", rule.z2_slack}, {"tail_allowance", rule.tail_allowance}}},
+      {"consistent", c.consistent}};
   std::ofstream f(args.json);
   if (!(f << j.dump(2) << "\n")) throw Error("cannot write " + args.json);
 }

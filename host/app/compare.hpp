@@ -16,12 +16,12 @@ struct CompareArgs {
   uint32_t spp = 64;
   int width = 64, height = 0;  // height 0: from the camera's aspect ratio
   uint32_t seed = 0;
-  bool same_seed = false;  // every device renders seed `seed` (breaks the z-test's independence)
-  bool determinism_check = true;  // also render the first device's seed on the others
-  std::vector<std::string> device_args;  // "I:OPTIONS": extra render options for device I
+  bool same_seed = false;                   // every device renders seed `seed` (breaks the z-test's independence)
+  bool determinism_check = true;            // also render the first device's seed on the others
+  std::vector<std::string> device_args;     // "I:OPTIONS": extra render options for device I
   std::vector<std::string> render_options;  // passed to every render
-  std::string json;  // write the results here
-  std::string keep;  // keep the images in this directory
+  std::string json;                         // write the results here
+  std::string keep;                         // keep the images in this directory
   bool quiet = false;
 };
 

@@ -16,14 +16,16 @@ CLI::App* add_compare_command(CLI::App* app, CompareCommand* c) {
   cmd->add_option("--devices", c->devices, "Comma-separated device selectors, the first is the reference")->required();
   cmd->add_option("--spp", a.spp, "Samples per pixel on every device (default 64)")->check(CLI::Range(2u, 1u << 24));
   cmd->add_option("--width", a.width, "Image width (default 64)")->check(CLI::Range(1, 65536));
-  cmd->add_option("--height", a.height, "Image height (default from the camera's aspect ratio)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--height", a.height, "Image height (default from the camera's aspect ratio)")
+      ->check(CLI::Range(1, 65536));
   cmd->add_option("--seed", a.seed, "Seed of the first device; device I renders seed + I (default 0)");
   cmd->add_flag("--same-seed", a.same_seed,
                 "Render the same seed on every device (correlated noise: the z-test no longer applies)");
   cmd->add_flag("!--no-determinism-check", a.determinism_check,
                 "Skip the extra render of the first device's seed on the other devices");
-  cmd->add_option("--device-args", a.device_args,
-                  "I:OPTIONS: extra render options for the device at position I, e.g. '1:--strategy bsdf' (repeatable)");
+  cmd->add_option(
+      "--device-args", a.device_args,
+      "I:OPTIONS: extra render options for the device at position I, e.g. '1:--strategy bsdf' (repeatable)");
   cmd->add_option("--json", a.json, "Also write the results as JSON to this file");
   cmd->add_option("--keep", a.keep, "Keep each device's image and variance image in this directory");
   cmd->add_flag("-q,--quiet", a.quiet, "No progress lines");

@@ -86,7 +86,8 @@ Input read_input(const std::string& path) {
   if (!ends_with_exr(path)) throw Error("cannot merge " + path + ": merge reads .exr images written by candela render");
   Input x{path, read_rgb_image(path, "image"), 0, {}};
   if (!x.img.metadata.count("spp"))
-    throw Error("cannot merge " + path + ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
+    throw Error("cannot merge " + path +
+                ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
   if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
     throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
   x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
@@ -119,8 +120,8 @@ std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>> disjoint_ranges(co
   for (size_t k = 1; k < all.size(); ++k)
     if (all[k].first.first < all[k - 1].first.second)
       throw Error("cannot merge: overlapping sample ranges: " + in[all[k - 1].second].path + " holds " +
-                  format_range(all[k - 1].first) + ", " + in[all[k].second].path + " holds " + format_range(all[k].first) +
-                  " (give each shard its own --sample-offset)");
+                  format_range(all[k - 1].first) + ", " + in[all[k].second].path + " holds " +
+                  format_range(all[k].first) + " (give each shard its own --sample-offset)");
   return all;
 }
 
@@ -148,7 +149,8 @@ std::string ranges_text(const std::vector<std::pair<std::pair<uint64_t, uint64_t
       merged.push_back(r);
   }
   std::string text;
-  for (const auto& r : merged) text += (text.empty() ? "" : ",") + std::to_string(r.first) + ":" + std::to_string(r.second);
+  for (const auto& r : merged)
+    text += (text.empty() ? "" : ",") + std::to_string(r.first) + ":" + std::to_string(r.second);
   *first = merged.front().first;
   return text;
 }
@@ -164,8 +166,8 @@ std::map<std::string, std::string> merged_metadata(const std::vector<Input>& in,
     if (auto it = x.img.metadata.find("seconds"); it != x.img.metadata.end()) seconds += std::atof(it->second.c_str());
     if (auto it = x.img.metadata.find("dropped_samples"); it != x.img.metadata.end())
       dropped += std::strtoull(it->second.c_str(), nullptr, 10);
-    if (auto it = x.img.metadata.find("device"); it != x.img.metadata.end() &&
-                                                 std::find(devices.begin(), devices.end(), it->second) == devices.end())
+    if (auto it = x.img.metadata.find("device");
+        it != x.img.metadata.end() && std::find(devices.begin(), devices.end(), it->second) == devices.end())
       devices.push_back(it->second);
   }
   std::string device_text;
@@ -199,7 +201,8 @@ int run_merge(const MergeArgs& args) {
   write_image(args.output, film, meta);
   std::printf("wrote %s\n", args.output.c_str());
   if (!args.quiet)
-    std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total, ranges.c_str());
+    std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total,
+                ranges.c_str());
   return 0;
 }
 

@@ -11,7 +11,7 @@ namespace candela {
 
 struct MergeArgs {
   std::vector<std::string> inputs;  // .exr files written by `candela render`
-  std::string output;  // .exr
+  std::string output;               // .exr
   bool quiet = false;
 };
 

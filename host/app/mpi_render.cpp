@@ -74,7 +74,9 @@ void mpi_abort(int code) {
 #else
 
 namespace {
-[[noreturn]] void no_mpi() { throw Error("--mpi: this candela was built without MPI (configure with -DCANDELA_MPI=ON)"); }
+[[noreturn]] void no_mpi() {
+  throw Error("--mpi: this candela was built without MPI (configure with -DCANDELA_MPI=ON)");
+}
 }  // namespace
 
 bool mpi_built_in() { return false; }
@@ -113,7 +115,8 @@ uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
   if (!g_mpi) return a->sample_offset;
   if (*spp == 0) throw Error("--mpi needs --spp: each rank renders a fixed block of the sample indices");
   if (*spp < uint32_t(g_mpi->size()))
-    throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) + " ranks");
+    throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) +
+                " ranks");
   uint32_t begin = 0, count = 0;
   mpi_block(*spp, g_mpi->rank(), g_mpi->size(), &begin, &count);
   if (g_mpi->rank() != 0) a->quiet = true;

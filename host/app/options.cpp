@@ -12,8 +12,8 @@ glm::vec3 parse_vec3(const std::string& text, const std::string& option) {
   std::stringstream ss(text);
   glm::vec3 v;
   char comma1 = 0, comma2 = 0;
-  if (!(ss >> v.x >> comma1 >> v.y >> comma2 >> v.z) || comma1 != ',' || comma2 != ',' ||
-      !(ss >> std::ws).eof() || !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+  if (!(ss >> v.x >> comma1 >> v.y >> comma2 >> v.z) || comma1 != ',' || comma2 != ',' || !(ss >> std::ws).eof() ||
+      !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
     throw Error(option + " expects three comma-separated numbers, e.g. 1,0.5,0; got '" + text + "'");
   return v;
 }

@@ -1,10 +1,10 @@
 // The render's progress bar (progress.hpp).
 #include "app/progress.hpp"
 
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <string>
-#include <unistd.h>
 
 namespace candela {
 namespace {
@@ -50,8 +50,10 @@ void ProgressBar::update(const RenderProgress& p) {
   std::string bar = std::string(filled, '#') + std::string(width - filled, '-');
   std::string shares = shares_ ? format_device_shares(p) : "";
   std::string target = p.spp_target ? "/" + std::to_string(p.spp_target) : "";
-  std::fprintf(stderr, terminal_ ? "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s%s   " : "[%s] %u%s spp  %.2f Msamples/s  ETA %s%s\n",
-               bar.c_str(), p.spp_done, target.c_str(), rate * 1e-6, format_duration(eta).c_str(), shares.c_str());
+  std::fprintf(
+      stderr,
+      terminal_ ? "\r[%s] %u%s spp  %.2f Msamples/s  ETA %s%s   " : "[%s] %u%s spp  %.2f Msamples/s  ETA %s%s\n",
+      bar.c_str(), p.spp_done, target.c_str(), rate * 1e-6, format_duration(eta).c_str(), shares.c_str());
   std::fflush(stderr);
   drawn_ = true;
 }

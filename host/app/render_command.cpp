@@ -51,11 +51,15 @@ void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
 // The scene's lighting: background, environment map, default light
 void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
   auto* background_opt =
-      render->add_option("--background", a.background, "Constant background radiance R,G,B (replaces the scene's background and environment map)");
+      render->add_option("--background", a.background,
+                         "Constant background radiance R,G,B (replaces the scene's background and environment map)");
   render->add_option("--env", a.env, "Equirectangular environment map (.hdr, .exr, .png, .jpg), replacing the scene's")
       ->excludes(background_opt);
-  render->add_option("--env-strength", a.env_strength, "Environment map strength, a radiance scale (default 1, or the scene's)");
-  render->add_option("--env-rotation", a.env_rotation, "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)");
+  render->add_option("--env-strength", a.env_strength,
+                     "Environment map strength, a radiance scale (default 1, or the scene's)");
+  render->add_option(
+      "--env-rotation", a.env_rotation,
+      "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)");
   render->add_flag("--no-default-light", a.no_default_light,
                    "Keep a scene without any light black instead of lighting it with the built-in sky");
 }
@@ -66,8 +70,9 @@ void add_camera_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
   render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)");
-  render->add_option("--aperture", a.aperture,
-                     "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)");
+  render->add_option(
+      "--aperture", a.aperture,
+      "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)");
   render->add_option("--focus-distance", a.focus_distance,
                      "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
                      "camera's extras, else the scene bounds' centre)");
@@ -79,21 +84,29 @@ void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--time", a.time, "Render for this many seconds instead of a sample count")
       ->check(CLI::PositiveNumber)
       ->excludes(spp_opt);
-  render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")->check(CLI::Range(1, 65536));
-  render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")->check(CLI::Range(1, 65536));
-  render->add_option("--device", a.device, "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once");
+  render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")
+      ->check(CLI::Range(1, 65536));
+  render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")
+      ->check(CLI::Range(1, 65536));
+  render->add_option(
+      "--device", a.device,
+      "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first "
+      "CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once");
   render->add_option("--seed", a.seed, "Random seed (default 0)");
-  render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")->check(CLI::Range(0u, 100000u));
+  render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")
+      ->check(CLI::Range(0u, 100000u));
   render->add_option("--strategy", a.strategy,
                      enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else nee");
-  render->add_flag("--no-energy-compensation", a.no_energy_compensation,
-                   "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
+  render->add_flag(
+      "--no-energy-compensation", a.no_energy_compensation,
+      "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
 }
 
 void check_variance_path(const RenderArgs& a) {
   if (a.variance.empty()) return;
   std::string ext = lowercase(a.variance.size() >= 4 ? a.variance.substr(a.variance.size() - 4) : "");
-  if (ext != ".exr") throw Error("--variance must name an .exr file (the variance is linear float data): " + a.variance);
+  if (ext != ".exr")
+    throw Error("--variance must name an .exr file (the variance is linear float data): " + a.variance);
 }
 
 void check_sample_offset(const RenderArgs& a, uint32_t spp) {
@@ -130,8 +143,8 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
 // those features read).
 Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& settings,
                        const std::vector<DeviceEntry>& devices) {
-  auto compiled = std::make_shared<CompiledScene>(a.generic ? compile_scene(*scene, SceneFeatures::all())
-                                                            : compile_scene(*scene));
+  auto compiled =
+      std::make_shared<CompiledScene>(a.generic ? compile_scene(*scene, SceneFeatures::all()) : compile_scene(*scene));
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
   *scene = Scene();
   return Renderer(devices, std::move(compiled), camera, settings, true);
@@ -144,8 +157,7 @@ RenderResult render_with_progress(Renderer& renderer, const RenderArgs& a, const
   ProgressBar bar(!a.quiet, double(settings.width) * settings.height);
   bar.show_device_shares(renderer.worker_count() > 1);
   RenderResult r = renderer.render(
-      first_sample, spp, a.time, [&](const RenderProgress& p) { bar.update(p); },
-      [] { return g_interrupted.load(); });
+      first_sample, spp, a.time, [&](const RenderProgress& p) { bar.update(p); }, [] { return g_interrupted.load(); });
   bar.finish();
   std::signal(SIGINT, SIG_DFL);
   return r;
@@ -179,13 +191,17 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   RenderArgs& a = *args;
   auto* render = app->add_subcommand("render", "Render a glTF scene");
   render->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
-  render->add_option("-o,--output", a.outputs, "Output image: .exr (linear), .png or .jpg (tone-mapped sRGB, --tonemap); repeatable")->required();
+  render
+      ->add_option("-o,--output", a.outputs,
+                   "Output image: .exr (linear), .png or .jpg (tone-mapped sRGB, --tonemap); repeatable")
+      ->required();
   add_sampling_render_options(render, a);
   add_lighting_render_options(render, a);
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
   render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear");
-  render->add_option("--tonemap", a.tonemap,
-                     "Display transform of PNG/JPEG outputs: neutral (Khronos PBR Neutral, default), agx (as Blender 4) or clamp");
+  render->add_option(
+      "--tonemap", a.tonemap,
+      "Display transform of PNG/JPEG outputs: neutral (Khronos PBR Neutral, default), agx (as Blender 4) or clamp");
   add_camera_render_options(render, a);
   render->add_option("--filter", a.filter, "Pixel filter: " + enum_names(kPixelFilterNames, true));
   render->add_option("--sampler", a.sampler, "Random numbers: " + enum_names(kSamplerNames, true));

@@ -57,8 +57,7 @@ void set_lens(const RenderArgs& a, std::optional<float> look_at_distance, Camera
 
 void apply_camera_options(const RenderArgs& a, Scene* scene) {
   check_camera_options(a);
-  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov || a.aperture ||
-             a.focus_distance;
+  bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov || a.aperture || a.focus_distance;
   if (!any) return;
   CameraDesc cam = scene->camera ? *scene->camera : framing_camera(*scene);
   std::optional<float> look_at_distance = aim_camera(a, &cam);
@@ -81,7 +80,9 @@ void apply_background_options(const RenderArgs& a, Scene* scene) {
 void add_default_light(const RenderArgs& a, Scene* scene) {
   if (scene->has_light() || scene->environment) return;
   if (a.no_default_light) {
-    std::fprintf(stderr, "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
+    std::fprintf(
+        stderr,
+        "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
   } else {
     std::fprintf(stderr, "%s\n", kBuiltinSkyNote);
     scene->environment = builtin_sky();
@@ -92,7 +93,8 @@ void add_default_light(const RenderArgs& a, Scene* scene) {
 void apply_environment_options(const RenderArgs& a, Scene* scene) {
   if (!scene->environment) {
     if (a.env_strength || a.env_rotation)
-      std::fprintf(stderr, "warning: --env-strength and --env-rotation apply to an environment map; the scene has none\n");
+      std::fprintf(stderr,
+                   "warning: --env-strength and --env-rotation apply to an environment map; the scene has none\n");
     return;
   }
   EnvironmentDesc& env = *scene->environment;
@@ -109,8 +111,10 @@ void apply_environment_options(const RenderArgs& a, Scene* scene) {
 void warn_unreachable_lights(const RenderArgs& a, const Scene& scene) {
   size_t n = scene.punctual_light_count();
   if (n > 0 && parse_enum(kStrategyNames, "--strategy", a.strategy) == Strategy::Bsdf)
-    std::fprintf(stderr, "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee or auto\n", n,
-                 n == 1 ? "" : "s", n == 1 ? "s" : "");
+    std::fprintf(
+        stderr,
+        "warning: the scene's %zu punctual light%s contribute%s nothing under --strategy bsdf; use nee or auto\n", n,
+        n == 1 ? "" : "s", n == 1 ? "s" : "");
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 // The record of one render, as --stats JSON and as image metadata (report.hpp).
 #include "app/report.hpp"
 
+#include <sys/resource.h>
 #include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sys/resource.h>
 
 #include "app/mpi_render.hpp"
 #include "app/render_command.hpp"
@@ -43,9 +43,7 @@ nlohmann::json devices_json(const std::vector<DeviceShare>& shares) {
   return list;
 }
 
-double per_triangle(size_t bytes, size_t triangles) {
-  return double(bytes) / double(std::max<size_t>(1, triangles));
-}
+double per_triangle(size_t bytes, size_t triangles) { return double(bytes) / double(std::max<size_t>(1, triangles)); }
 
 // The render's settings and what it did
 void record_render(const RenderArgs& a, const RenderSettings& settings, const RenderResult& r, RenderReport* out) {

@@ -48,8 +48,8 @@ void check_writable_path(const std::string& path) {
 void write_file_atomically(const std::string& path, const void* data, size_t size) {
   static std::atomic<unsigned> counter{0};
   fs::path target(path);
-  fs::path tmp = folder_of(path) / ("." + target.filename().string() + ".candela-" + std::to_string(::getpid()) +
-                                    "-" + std::to_string(counter++));
+  fs::path tmp = folder_of(path) / ("." + target.filename().string() + ".candela-" + std::to_string(::getpid()) + "-" +
+                                    std::to_string(counter++));
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw Error("cannot write " + path + ": " + std::strerror(errno));
   bool ok = write_all(fd, static_cast<const char*>(data), size) && ::fsync(fd) == 0;

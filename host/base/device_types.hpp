@@ -78,5 +78,7 @@ constexpr const char* kSceneFeatureNames[] = {CD_SCENE_FEATURES(CD_FEATURE_NAME)
 constexpr const char* material_type_name(unsigned type) {
   return type < kMaterialTypeCount ? kMaterialTypeNames[type] : nullptr;
 }
-constexpr const char* light_type_name(unsigned type) { return type < kLightTypeCount ? kLightTypeNames[type] : nullptr; }
+constexpr const char* light_type_name(unsigned type) {
+  return type < kLightTypeCount ? kLightTypeNames[type] : nullptr;
+}
 }  // namespace candela::dev

@@ -43,12 +43,12 @@ const char* cl_error_name(int code) {
 }
 
 std::string cl_error_message(const std::string& what, int code) {
-  std::string msg = "OpenCL error in " + what + ": " + cl_error_name(code) + " (" +
-                    std::to_string(code) + ")";
-  if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_RESOURCES ||
-      code == CL_OUT_OF_HOST_MEMORY || code == CL_INVALID_BUFFER_SIZE)
-    msg += ": the device ran out of memory or resources (or, on some GPUs, the kernel faulted "
-           "or hit a watchdog); try a smaller image or scene, or another --device";
+  std::string msg = "OpenCL error in " + what + ": " + cl_error_name(code) + " (" + std::to_string(code) + ")";
+  if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_RESOURCES || code == CL_OUT_OF_HOST_MEMORY ||
+      code == CL_INVALID_BUFFER_SIZE)
+    msg +=
+        ": the device ran out of memory or resources (or, on some GPUs, the kernel faulted "
+        "or hit a watchdog); try a smaller image or scene, or another --device";
   return msg;
 }
 

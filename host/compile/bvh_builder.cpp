@@ -15,7 +15,7 @@ namespace {
 
 constexpr int kBins = 16;
 constexpr int kMaxLeafSize = 8;
-constexpr float kTraversalCost = 1.0f;  // relative to one triangle test
+constexpr float kTraversalCost = 1.0f;                // relative to one triangle test
 constexpr float kEmptyLo = 1e30f, kEmptyHi = -1e30f;  // an unused child slot's box
 // Ranges of at least this many refs bin on every thread during the serial top phase
 constexpr uint32_t kParallelBinning = 32768;
@@ -212,7 +212,8 @@ class Builder {
   // fn(begin, end) over [0, n) in up to threads_ contiguous chunks of at least `grain`
   template <class Fn>
   void parallel_for(size_t n, Fn fn, size_t grain = 4096) {
-    parallel_for_indexed(n, [&](int, size_t b, size_t e) { fn(b, e); }, grain);
+    parallel_for_indexed(
+        n, [&](int, size_t b, size_t e) { fn(b, e); }, grain);
   }
   template <class Fn>
   void parallel_for_indexed(size_t n, Fn fn, size_t grain = 4096) {
@@ -222,7 +223,8 @@ class Builder {
       return;
     }
     std::vector<std::thread> pool;
-    for (int i = 1; i < t; ++i) pool.emplace_back([&, i] { fn(i, n * size_t(i) / size_t(t), n * size_t(i + 1) / size_t(t)); });
+    for (int i = 1; i < t; ++i)
+      pool.emplace_back([&, i] { fn(i, n * size_t(i) / size_t(t), n * size_t(i + 1) / size_t(t)); });
     fn(0, 0, n / size_t(t));
     for (std::thread& th : pool) th.join();
   }
@@ -562,7 +564,7 @@ class Builder {
   const int threads_;
   uint32_t job_refs_ = kMinJobRefs;
   std::atomic<int> busy_{1};  // threads at work in the top phase (the caller's included)
-  std::vector<Ref> refs_;  // refs_[i]: primitive stored at leaf position i once built
+  std::vector<Ref> refs_;     // refs_[i]: primitive stored at leaf position i once built
   Bvh bvh_;
 };
 

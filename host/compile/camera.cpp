@@ -12,8 +12,8 @@ dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
     // Up is parallel to the view: use the world axis least aligned with it
     glm::vec3 a = glm::abs(f);
     glm::vec3 axis = a.x <= a.y && a.x <= a.z ? glm::vec3(1, 0, 0)
-                     : a.y <= a.z            ? glm::vec3(0, 1, 0)
-                                             : glm::vec3(0, 0, 1);
+                     : a.y <= a.z             ? glm::vec3(0, 1, 0)
+                                              : glm::vec3(0, 0, 1);
     r = glm::cross(f, axis);
   }
   r = glm::normalize(r);

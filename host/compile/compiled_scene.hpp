@@ -13,8 +13,8 @@ namespace candela {
 
 // A density grid as the device holds it (--stats)
 struct GridMemory {
-  std::string source;  // "dense" (an inline grid) or the NanoVDB/OpenVDB file and grid
-  size_t grid_bytes = 0;  // the NanoVDB buffer, or the dense values
+  std::string source;         // "dense" (an inline grid) or the NanoVDB/OpenVDB file and grid
+  size_t grid_bytes = 0;      // the NanoVDB buffer, or the dense values
   size_t majorant_bytes = 0;  // its majorant cells
 };
 
@@ -26,9 +26,9 @@ struct CompiledScene {
   size_t triangles = 0, vertices = 0;
   int bvh_depth = 0;
   double bvh_build_seconds = 0.0;
-  double bvh_sah_cost = 0.0;  // sah_cost of the BVH (bvh_builder.hpp)
+  double bvh_sah_cost = 0.0;     // sah_cost of the BVH (bvh_builder.hpp)
   double compile_seconds = 0.0;  // everything, the BVH included
-  size_t device_bytes = 0;  // buffers.bytes() as compiled (kept by release_host_arrays)
+  size_t device_bytes = 0;       // buffers.bytes() as compiled (kept by release_host_arrays)
 
   // Frees the host copies of the scene buffers, `lights` aside (Renderer::lights), once
   // every device has its own: they are most of the host memory a large mesh takes

@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 
+#include "base/error.hpp"
 #include "compile/bvh_builder.hpp"
 #include "compile/environment_distribution.hpp"
 #include "scene/environment.hpp"
-#include "base/error.hpp"
 
 namespace candela {
 namespace {
@@ -20,9 +20,7 @@ constexpr float kMaxCoordinate = 1e15f;
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 template <int N, typename V>
 void append(std::vector<float>* out, const V& v) {
@@ -151,7 +149,8 @@ constexpr int kMajorantCells = 16;
 void compile_nanovdb_grid(const MediumDesc& m, float scale, dev::Medium* d, dev::SceneBuffers* b) {
   d->type = MEDIUM_NANOVDB;
   b->nanovdb.resize((b->nanovdb.size() + 7) / 8 * 8, 0u);
-  if (b->nanovdb.size() + m.nanovdb.size() > size_t(UINT32_MAX)) throw Error("the scene's NanoVDB grids hold more than 16 GiB");
+  if (b->nanovdb.size() + m.nanovdb.size() > size_t(UINT32_MAX))
+    throw Error("the scene's NanoVDB grids hold more than 16 GiB");
   d->grid_offset = uint32_t(b->nanovdb.size());
   b->nanovdb.insert(b->nanovdb.end(), m.nanovdb.begin(), m.nanovdb.end());
   float peak = *std::max_element(m.majorant_density.begin(), m.majorant_density.end());
@@ -161,7 +160,8 @@ void compile_nanovdb_grid(const MediumDesc& m, float scale, dev::Medium* d, dev:
     d->grid_max[k] = m.grid_max[k];
     d->majorant_size[k] = uint32_t(m.majorant_size[k]);
   }
-  if (b->densities.size() + m.majorant_density.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+  if (b->densities.size() + m.majorant_density.size() > size_t(UINT32_MAX))
+    throw Error("the scene's density grids hold more than 2^32 values");
   d->majorant_offset = uint32_t(b->densities.size());
   for (float v : m.majorant_density) b->densities.push_back(scale * v);
 }
@@ -172,7 +172,8 @@ dev::Medium compile_emission_grid(const MediumDesc& m, dev::SceneBuffers* b, std
   dev::Medium e{};
   e.type = MEDIUM_GRID;
   e.density_scale = m.emission_scale;
-  if (b->densities.size() + m.emission_grid.size() > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+  if (b->densities.size() + m.emission_grid.size() > size_t(UINT32_MAX))
+    throw Error("the scene's density grids hold more than 2^32 values");
   e.grid_offset = uint32_t(b->densities.size());
   b->densities.insert(b->densities.end(), m.emission_grid.begin(), m.emission_grid.end());
   for (int k = 0; k < 3; ++k) {
@@ -218,7 +219,8 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vecto
     grids->push_back({m.grid_source, m.nanovdb.size() * sizeof(uint32_t), m.majorant_density.size() * sizeof(float)});
   } else if (m.is_grid()) {
     d.type = MEDIUM_GRID;
-    if (b->densities.size() + m.density.size() + kMajorantCells * kMajorantCells * kMajorantCells > size_t(UINT32_MAX)) throw Error("the scene's density grids hold more than 2^32 values");
+    if (b->densities.size() + m.density.size() + kMajorantCells * kMajorantCells * kMajorantCells > size_t(UINT32_MAX))
+      throw Error("the scene's density grids hold more than 2^32 values");
     d.grid_offset = uint32_t(b->densities.size());
     b->densities.insert(b->densities.end(), m.density.begin(), m.density.end());
     glm::vec3 sigma_t = m.sigma_a + m.sigma_s;
@@ -242,8 +244,8 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vecto
       *hi = std::min(int(std::ceil(double(c + 1) / cells[axis] * n)), m.grid_size[axis] - 1);
     };
     glm::dvec3 cell_size = (glm::dvec3(m.grid_max) - glm::dvec3(m.grid_min)) / glm::dvec3(cells);
-    bool emits_by_grid = m.has_emission_grid() && std::max({m.emission.x, m.emission.y, m.emission.z}) > 0.0f &&
-                         m.emission_scale > 0.0f;
+    bool emits_by_grid =
+        m.has_emission_grid() && std::max({m.emission.x, m.emission.y, m.emission.z}) > 0.0f && m.emission_scale > 0.0f;
     float emission_rate = float(1.0 / std::min({cell_size.x, cell_size.y, cell_size.z}));
     for (int cz = 0; cz < cells.z; ++cz)
       for (int cy = 0; cy < cells.y; ++cy)
@@ -280,7 +282,8 @@ dev::Medium compile_medium(const MediumDesc& m, dev::SceneBuffers* b, std::vecto
 void compile_media(const Scene& scene, const SceneFeatures& f, dev::SceneBuffers* b, std::vector<GridMemory>* grids) {
   if (!f.media) return;  // the kernel reads neither buffer nor Material.medium
   for (const MediumDesc& m : scene.media)
-    if (m.is_nanovdb() && !f.nanovdb) throw Error("compile_scene: the kernel features leave out NanoVDB grids the scene has");
+    if (m.is_nanovdb() && !f.nanovdb)
+      throw Error("compile_scene: the kernel features leave out NanoVDB grids the scene has");
   b->media.push_back(dev::Medium{});
   std::vector<dev::Medium> emission_grids;  // after every other record; Medium.emission_grid
   for (size_t i = 0; i < scene.media.size(); ++i) {
@@ -484,7 +487,8 @@ double light_power_spot(const dev::Light& light, const dev::SceneBuffers&, doubl
 
 // Irradiance E through the disc the scene's bounding sphere shows the light
 double light_power_directional(const dev::Light& light, const dev::SceneBuffers&, double, double scene_radius) {
-  return kPi * scene_radius * scene_radius * dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
+  return kPi * scene_radius * scene_radius *
+         dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
 }
 
 }  // namespace
@@ -559,8 +563,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   CompiledScene c;
   c.features = features;
   const SceneFeatures needed = scene.features();
-  if (!features.covers(needed))
-    throw Error("compile_scene: the kernel features leave out some the scene needs");
+  if (!features.covers(needed)) throw Error("compile_scene: the kernel features leave out some the scene needs");
   check_extent(scene, resolve_camera(scene));
   compile_geometry(scene, c.features, &c.buffers);
   compile_materials(scene, &c.buffers);

@@ -25,7 +25,7 @@ std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::
 // is the mean luminance of a triangle light's emissive texture (1 without one), or an
 // environment map's mean radiance luminance (strength included);
 // `scene_radius` bounds the scene for environment lights.
-double light_power(const dev::Light& light, const dev::SceneBuffers& buffers,
-                   double emission_scale, double scene_radius);
+double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
+                   double scene_radius);
 
 }  // namespace candela

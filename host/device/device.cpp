@@ -120,13 +120,12 @@ DeviceEntry select_device(const std::string& selector) {
   size_t index = 0;
   if (parse_index(sel, &index)) {
     if (index < devices.size()) return devices[index];
-    throw Error("--device " + selector + ": there are only " + std::to_string(devices.size()) +
-                " OpenCL devices:\n" + format_device_table(devices));
+    throw Error("--device " + selector + ": there are only " + std::to_string(devices.size()) + " OpenCL devices:\n" +
+                format_device_table(devices));
   }
   auto dot = sel.find('.');
   size_t p = 0, d = 0;
-  if (dot != std::string::npos && parse_index(sel.substr(0, dot), &p) &&
-      parse_index(sel.substr(dot + 1), &d)) {
+  if (dot != std::string::npos && parse_index(sel.substr(0, dot), &p) && parse_index(sel.substr(dot + 1), &d)) {
     for (const auto& e : devices)
       if (e.platform_index == p && e.device_index == d) return e;
     throw Error("--device " + selector + ": no such platform.device; available devices:\n" +
@@ -146,15 +145,15 @@ DeviceEntry select_device(const std::string& selector) {
 std::string format_device_table(const std::vector<DeviceEntry>& devices) {
   std::ostringstream os;
   char line[512];
-  std::snprintf(line, sizeof line, "%-4s %-6s %-4s %-12s %5s %9s  %s\n", "#", "select", "type",
-                "opencl", "units", "memory", "device (platform)");
+  std::snprintf(line, sizeof line, "%-4s %-6s %-4s %-12s %5s %9s  %s\n", "#", "select", "type", "opencl", "units",
+                "memory", "device (platform)");
   os << line;
   for (const auto& d : devices) {
     std::string cl_version = d.version.rfind("OpenCL ", 0) == 0 ? d.version.substr(7) : d.version;
     cl_version = cl_version.substr(0, cl_version.find(' '));
-    std::snprintf(line, sizeof line, "%-4zu %-6s %-4s %-12s %5u %6.1f GiB  %s\n", d.global_index,
-                  d.selector().c_str(), d.type.c_str(), ("OpenCL " + cl_version).c_str(),
-                  d.compute_units, d.global_memory / 1073741824.0, d.description().c_str());
+    std::snprintf(line, sizeof line, "%-4zu %-6s %-4s %-12s %5u %6.1f GiB  %s\n", d.global_index, d.selector().c_str(),
+                  d.type.c_str(), ("OpenCL " + cl_version).c_str(), d.compute_units, d.global_memory / 1073741824.0,
+                  d.description().c_str());
     os << line;
   }
   return os.str();

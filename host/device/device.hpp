@@ -18,9 +18,9 @@ struct DeviceEntry {
   unsigned compute_units = 0;
   unsigned long long global_memory = 0;
   unsigned long long max_alloc = 0;  // largest single buffer
-  std::string opencl_c_version;  // e.g. "OpenCL C 1.2 ..."
+  std::string opencl_c_version;      // e.g. "OpenCL C 1.2 ..."
 
-  std::string selector() const;  // "P.D"
+  std::string selector() const;     // "P.D"
   std::string description() const;  // "name (platform)"
 };
 

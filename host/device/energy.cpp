@@ -13,8 +13,8 @@ namespace {
 
 constexpr size_t kBytes = GGX_ALBEDO_SIZE * sizeof(float);
 
-std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue,
-                                 const cl::Program& program, cl::Buffer* buffer) {
+std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
+                                 cl::Buffer* buffer) {
   *buffer = cl::Buffer(context, CL_MEM_READ_WRITE, kBytes);
   cl::Kernel albedo(program, "energy_ggx_albedo_table"), average(program, "energy_ggx_average_table");
   albedo.setArg(0, *buffer);
@@ -31,8 +31,8 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
 
 }  // namespace
 
-GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue,
-                                const cl::Program& program, const std::string& program_cache_file) {
+GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
+                                const std::string& program_cache_file) {
   auto start = std::chrono::steady_clock::now();
   GgxAlbedoTable t;
   std::string path = program_cache_file.empty() ? "" : program_cache_file + ".ggx_albedo";

@@ -17,7 +17,7 @@ struct GgxAlbedoTable {
 // The table for `program`, whose cache entry is `program_cache_file`
 // (ProgramBuild::cache_file; empty: no cache): loaded from beside it, else computed on the
 // device and stored there
-GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue,
-                                const cl::Program& program, const std::string& program_cache_file);
+GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
+                                const std::string& program_cache_file);
 
 }  // namespace candela

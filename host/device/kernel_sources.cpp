@@ -23,8 +23,7 @@ std::string file_text(const EmbeddedKernelFile& f) {
   if (source_root().empty()) return f.text;
   // "cl/x.cl" -> DIR/x.cl; "tests/cl/x.cl" -> DIR/../tests/cl/x.cl
   std::string rel = f.path;
-  std::string path = rel.rfind("cl/", 0) == 0 ? source_root() + "/" + rel.substr(3)
-                                                : source_root() + "/../" + rel;
+  std::string path = rel.rfind("cl/", 0) == 0 ? source_root() + "/" + rel.substr(3) : source_root() + "/../" + rel;
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot read kernel source " + path + " (from --kernel-dir / CANDELA_KERNEL_DIR)");
   std::ostringstream ss;
@@ -106,8 +105,12 @@ std::string program_source(bool with_tests) {
 // tables become __constant (OpenCL C 1.2 keeps program-scope data in the constant space).
 std::string pnanovdb_opencl_text(std::string text) {
   bool ok = replace_line(&text, "#include <stdint.h>", "");
-  ok = replace_line(&text, "#define PNANOVDB_STATIC_CONST static const", "#define PNANOVDB_STATIC_CONST __constant") && ok;
-  if (!ok) throw Error("nanovdb/PNanoVDB.h: not the layout candela adapts to OpenCL C (its stdint.h include and PNANOVDB_STATIC_CONST)");
+  ok = replace_line(&text, "#define PNANOVDB_STATIC_CONST static const", "#define PNANOVDB_STATIC_CONST __constant") &&
+       ok;
+  if (!ok)
+    throw Error(
+        "nanovdb/PNanoVDB.h: not the layout candela adapts to OpenCL C (its stdint.h include and "
+        "PNANOVDB_STATIC_CONST)");
   return text;
 }
 

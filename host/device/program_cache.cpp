@@ -1,12 +1,12 @@
 #include "device/program_cache.hpp"
 
+#include <unistd.h>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -29,8 +29,8 @@ std::string hex64(uint64_t v) {
 
 std::string cache_key(const DeviceEntry& d, const std::string& source, const std::string& options) {
   std::string key;
-  for (const std::string& part : {d.platform_name, d.platform_version, d.name, d.version,
-                                  d.driver_version, options, std::string(CANDELA_VERSION)}) {
+  for (const std::string& part : {d.platform_name, d.platform_version, d.name, d.version, d.driver_version, options,
+                                  std::string(CANDELA_VERSION)}) {
     key += part;
     key += '\x1f';
   }
@@ -47,8 +47,7 @@ std::vector<unsigned char> read_entry(const std::string& path) {
   if (ok) {
     uint64_t stored;
     std::memcpy(&stored, data.data() + sizeof kMagic, 8);
-    std::string_view payload(reinterpret_cast<const char*>(data.data() + header),
-                             data.size() - header);
+    std::string_view payload(reinterpret_cast<const char*>(data.data() + header), data.size() - header);
     ok = stored == fnv1a64(payload);
   }
   if (!ok) {
@@ -84,8 +83,7 @@ void write_entry(const std::string& path, const std::vector<unsigned char>& bina
 }
 
 bool try_build_from_binary(const cl::Context& context, const DeviceEntry& device,
-                           const std::vector<unsigned char>& binary, const std::string& options,
-                           cl::Program* out) {
+                           const std::vector<unsigned char>& binary, const std::string& options, cl::Program* out) {
   try {
     cl::Program::Binaries bins{binary};
     std::vector<cl_int> status;
@@ -107,15 +105,13 @@ void write_cache_entry(const std::string& path, const std::vector<unsigned char>
 
 std::string kernel_cache_dir() {
   if (const char* dir = std::getenv("CANDELA_CACHE_DIR")) return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-    return std::string(xdg) + "/candela/kernels";
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return std::string(home) + "/.cache/candela/kernels";
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/candela/kernels";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/candela/kernels";
   return "";
 }
 
-ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device,
-                           const std::string& source, const std::string& options) {
+ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
+                           const std::string& options) {
   auto start = std::chrono::steady_clock::now();
   ProgramBuild result;
   std::string dir = kernel_cache_dir();
@@ -123,8 +119,7 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
 
   if (!result.cache_file.empty()) {
     std::vector<unsigned char> binary = read_entry(result.cache_file);
-    if (!binary.empty() &&
-        try_build_from_binary(context, device, binary, options, &result.program)) {
+    if (!binary.empty() && try_build_from_binary(context, device, binary, options, &result.program)) {
       result.from_cache = true;
     } else if (!binary.empty()) {
       std::error_code ec;
@@ -142,8 +137,8 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
         log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device.device);
       } catch (const cl::Error&) {
       }
-      throw Error("OpenCL kernel build failed on " + device.description() + " (" +
-                  cl_error_name(e.err()) + "), build log:\n" + log);
+      throw Error("OpenCL kernel build failed on " + device.description() + " (" + cl_error_name(e.err()) +
+                  "), build log:\n" + log);
     }
     result.program = program;
     if (!result.cache_file.empty()) {
@@ -154,8 +149,7 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
       }
     }
   }
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

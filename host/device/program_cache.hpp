@@ -22,8 +22,8 @@ struct ProgramBuild {
 // Builds `source` with `options` for the device, through the cache. A corrupt or
 // rejected cache entry falls back to a source build. A failed source build throws
 // Error with the device's build log.
-ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device,
-                           const std::string& source, const std::string& options);
+ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
+                           const std::string& options);
 
 std::string kernel_cache_dir();
 

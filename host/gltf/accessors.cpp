@@ -67,8 +67,8 @@ uint32_t decode_uint(const unsigned char* p, int ctype, bool) {
 // after checking every byte lies inside the view and the buffer (no overflow possible:
 // only subtractions of checked values and one division).
 template <typename T, typename Decode>
-void read_view(const tinygltf::Model& model, int view_index, size_t offset, size_t count, int ncomp,
-               int ctype, bool normalized, Decode decode, std::vector<T>* out) {
+void read_view(const tinygltf::Model& model, int view_index, size_t offset, size_t count, int ncomp, int ctype,
+               bool normalized, Decode decode, std::vector<T>* out) {
   if (view_index < 0 || view_index >= (int)model.bufferViews.size())
     throw Error("glTF accessor refers to a missing bufferView");
   const tinygltf::BufferView& view = model.bufferViews[view_index];
@@ -96,20 +96,19 @@ void read_view(const tinygltf::Model& model, int view_index, size_t offset, size
 
 // Accessor elements as T (count * components values), sparse substitution applied
 template <typename T, typename Decode>
-std::vector<T> read_accessor_as(const tinygltf::Model& model, int index, int want_components,
-                                Decode decode) {
+std::vector<T> read_accessor_as(const tinygltf::Model& model, int index, int want_components, Decode decode) {
   if (index < 0 || index >= (int)model.accessors.size())
     throw Error("glTF accessor " + std::to_string(index) + " does not exist");
   const tinygltf::Accessor& acc = model.accessors[index];
   int comps = tinygltf::GetNumComponentsInType(acc.type);
   if (comps <= 0) throw Error("glTF accessor " + std::to_string(index) + " has an invalid type");
   if (want_components > 0 && comps != want_components)
-    throw Error("glTF accessor " + std::to_string(index) + " has " + std::to_string(comps) +
-                " components, expected " + std::to_string(want_components));
+    throw Error("glTF accessor " + std::to_string(index) + " has " + std::to_string(comps) + " components, expected " +
+                std::to_string(want_components));
   std::vector<T> values;
   if (acc.bufferView >= 0) {
-    read_view(model, acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType,
-              acc.normalized, decode, &values);
+    read_view(model, acc.bufferView, acc.byteOffset, acc.count, comps, acc.componentType, acc.normalized, decode,
+              &values);
   } else {
     if (acc.count > kMaxZeroFilledValues / size_t(comps))
       throw Error("glTF accessor " + std::to_string(index) + " is too large for one without a bufferView (" +
@@ -122,10 +121,10 @@ std::vector<T> read_accessor_as(const tinygltf::Model& model, int index, int wan
       throw Error("glTF sparse accessor " + std::to_string(index) + " is malformed");
     std::vector<uint32_t> idx;
     std::vector<T> vals;
-    read_view(model, acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset),
-              size_t(acc.sparse.count), 1, acc.sparse.indices.componentType, false, decode_uint, &idx);
-    read_view(model, acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset),
-              size_t(acc.sparse.count), comps, acc.componentType, acc.normalized, decode, &vals);
+    read_view(model, acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), size_t(acc.sparse.count), 1,
+              acc.sparse.indices.componentType, false, decode_uint, &idx);
+    read_view(model, acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), size_t(acc.sparse.count),
+              comps, acc.componentType, acc.normalized, decode, &vals);
     for (size_t i = 0; i < idx.size(); ++i) {
       if (idx[i] >= acc.count) throw Error("glTF sparse accessor index out of range");
       for (int c = 0; c < comps; ++c) values[size_t(idx[i]) * comps + c] = vals[i * comps + c];

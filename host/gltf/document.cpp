@@ -94,7 +94,8 @@ const std::string& prepare_document(const std::string& data, bool binary, const 
     json_size = std::min<size_t>(length, data.size() - 20);
   }
   if (json_depth(data.data() + json_begin, json_size, kMaxJsonDepth) > kMaxJsonDepth)
-    throw Error("cannot load glTF scene " + name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    throw Error("cannot load glTF scene " + name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                " levels");
   return add_missing_spot_objects(data, json_begin, json_size, binary, patched) ? *patched : data;
 }
 

@@ -23,7 +23,8 @@ void read_environment(ReadContext& ctx, const tinygltf::Value& env) {
     if (!env.Has(key)) return fallback;
     const tinygltf::Value& v = env.Get(key);
     double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!std::isfinite(x) || std::fabs(x) > 1e30) throw Error(std::string(what) + "." + key + " must be a finite number");
+    if (!std::isfinite(x) || std::fabs(x) > 1e30)
+      throw Error(std::string(what) + "." + key + " must be a finite number");
     return float(x);
   };
   e.strength = number("strength", 1.0f);
@@ -33,7 +34,8 @@ void read_environment(ReadContext& ctx, const tinygltf::Value& env) {
 }
 
 void read_strategy(ReadContext& ctx, const tinygltf::Value& st) {
-  if (!st.IsString() || (st.Get<std::string>() != "nee" && st.Get<std::string>() != "bsdf" && st.Get<std::string>() != "auto"))
+  if (!st.IsString() ||
+      (st.Get<std::string>() != "nee" && st.Get<std::string>() != "bsdf" && st.Get<std::string>() != "auto"))
     throw Error("scene extras candela.strategy must be \"nee\", \"bsdf\" or \"auto\"");
   ctx.scene.strategy = st.Get<std::string>();
 }
@@ -50,8 +52,7 @@ void read_global_medium(ReadContext& ctx, const tinygltf::Value& v) {
 }
 
 void read_background(ReadContext& ctx, const tinygltf::Value& bg) {
-  if (!bg.IsArray() || bg.ArrayLen() != 3)
-    throw Error("scene extras candela.background must be an array of 3 numbers");
+  if (!bg.IsArray() || bg.ArrayLen() != 3) throw Error("scene extras candela.background must be an array of 3 numbers");
   for (int i = 0; i < 3; ++i) {
     if (!bg.Get(i).IsNumber()) throw Error("scene extras candela.background must hold numbers");
     ctx.scene.background[i] = float(bg.Get(i).GetNumberAsDouble());

@@ -55,8 +55,8 @@ ImageFormat image_header(const unsigned char* p, size_t n, uint64_t* w, uint64_t
 // tinygltf's image decoding (to RGBA) behind those checks. An image that fails them or
 // does not decode is left empty, never an error: `errors` (std::map<int, std::string>,
 // the user data) records why, and a texture using it falls back or is dropped.
-bool load_checked_image(tinygltf::Image* image, const int index, std::string*, std::string* warn,
-                        int req_width, int req_height, const unsigned char* bytes, int size, void* errors) {
+bool load_checked_image(tinygltf::Image* image, const int index, std::string*, std::string* warn, int req_width,
+                        int req_height, const unsigned char* bytes, int size, void* errors) {
   std::string why;
   uint64_t w = 0, h = 0;
   int channel_bytes = 1;

@@ -20,7 +20,8 @@ void read_color(const tinygltf::Light& gl, const std::string& what, Warnings* wa
   if (gl.color.size() != 3) throw Error(what + ": color must hold 3 numbers");
   for (int c = 0; c < 3; ++c) {
     l->color[c] = float(gl.color[size_t(c)]);
-    if (!(l->color[c] >= 0.0f && std::isfinite(l->color[c]))) throw Error(what + ": color must be finite and non-negative");
+    if (!(l->color[c] >= 0.0f && std::isfinite(l->color[c])))
+      throw Error(what + ": color must be finite and non-negative");
   }
   if (l->color.x > 1.0f || l->color.y > 1.0f || l->color.z > 1.0f)
     warn->add(what + ": color components above 1 are outside the extension's range; used as given");
@@ -43,7 +44,8 @@ PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, W
   l.type = light_type(gl, what);
   read_color(gl, what, warn, &l);
   l.intensity = float(gl.intensity);
-  if (!(l.intensity >= 0.0f && std::isfinite(l.intensity))) throw Error(what + ": intensity must be finite and non-negative");
+  if (!(l.intensity >= 0.0f && std::isfinite(l.intensity)))
+    throw Error(what + ": intensity must be finite and non-negative");
   // tinygltf reads an absent range as 0: both mean infinite
   l.range = float(gl.range);
   if (!(l.range >= 0.0f && std::isfinite(l.range))) throw Error(what + ": range must be greater than 0");
@@ -67,7 +69,8 @@ void read_node_light(ReadContext& ctx, int node_index, const tinygltf::Value& ex
     throw Error(where + " refers to a missing KHR_lights_punctual light");
   PunctualLightDesc l = read_punctual_light(ctx.model.lights[size_t(index)], size_t(index), &ctx.warn);
   l.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
-  if (!(std::isfinite(l.position.x) && std::isfinite(l.position.y) && std::isfinite(l.position.z))) throw Error(where + ": the light's position is not finite");
+  if (!(std::isfinite(l.position.x) && std::isfinite(l.position.y) && std::isfinite(l.position.z)))
+    throw Error(where + ": the light's position is not finite");
   if (l.type != PunctualType::Point) {
     glm::vec3 dir = glm::vec3(world * glm::vec4(0, 0, -1, 0));
     float len = glm::length(dir);

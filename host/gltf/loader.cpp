@@ -15,10 +15,16 @@ namespace candela {
 namespace gltf {
 
 bool supported_extension(const std::string& name) {
-  static const std::set<std::string> kSupported = {
-      "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_mesh_quantization",
-      "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
-      "KHR_materials_volume", "KHR_materials_clearcoat", "KHR_materials_anisotropy", "KHR_lights_punctual"};
+  static const std::set<std::string> kSupported = {"KHR_materials_emissive_strength",
+                                                   "KHR_texture_transform",
+                                                   "KHR_mesh_quantization",
+                                                   "KHR_materials_ior",
+                                                   "KHR_materials_specular",
+                                                   "KHR_materials_transmission",
+                                                   "KHR_materials_volume",
+                                                   "KHR_materials_clearcoat",
+                                                   "KHR_materials_anisotropy",
+                                                   "KHR_lights_punctual"};
   return kSupported.count(name) > 0;
 }
 
@@ -29,7 +35,8 @@ void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
     if (!supported_extension(ext)) warn->add("glTF extension " + ext + " is not supported yet and is ignored");
   for (const auto& ext : model.extensionsRequired)
     if (!supported_extension(ext))
-      warn->add("the scene requires glTF extension " + ext + ", which candela does not support: the image may be wrong");
+      warn->add("the scene requires glTF extension " + ext +
+                ", which candela does not support: the image may be wrong");
   if (!model.animations.empty()) warn->add("animations are ignored (the first frame is rendered)");
   if (!model.skins.empty()) warn->add("skins are ignored (meshes render in their bind pose)");
 }
@@ -67,8 +74,7 @@ tinygltf::Model parse_model(const std::string& data, const std::string& base_dir
   bool binary = data.compare(0, 4, "glTF") == 0;
   std::string patched;  // the file with defaults tinygltf needs written in, if any
   const std::string& bytes = prepare_document(data, binary, name, &patched);
-  bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, warn,
-                                               reinterpret_cast<const unsigned char*>(bytes.data()),
+  bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, warn, reinterpret_cast<const unsigned char*>(bytes.data()),
                                                unsigned(bytes.size()), base_dir)
                    : gltf.LoadASCIIFromString(&model, &err, warn, bytes.data(), unsigned(bytes.size()), base_dir);
   if (!ok) {

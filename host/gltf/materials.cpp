@@ -61,7 +61,9 @@ void read_emission(ReadContext& ctx, const tinygltf::Material& gm, const std::st
 }
 
 void read_alpha(const tinygltf::Material& gm, MaterialDesc* m) {
-  m->alpha_mode = gm.alphaMode == "MASK" ? AlphaMode::Mask : gm.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+  m->alpha_mode = gm.alphaMode == "MASK"    ? AlphaMode::Mask
+                  : gm.alphaMode == "BLEND" ? AlphaMode::Blend
+                                            : AlphaMode::Opaque;
   m->alpha_cutoff = float(gm.alphaCutoff);
 }
 
@@ -98,7 +100,8 @@ void read_clearcoat(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc
   set_texture_slot(ctx, m, TEX_CLEARCOAT, cc, "clearcoatTexture", false);
   set_texture_slot(ctx, m, TEX_CLEARCOAT_ROUGHNESS, cc, "clearcoatRoughnessTexture", false);
   if (cc.Has("clearcoatNormalTexture"))
-    ctx.warn.add("KHR_materials_clearcoat clearcoatNormalTexture is not supported yet: the coat uses the base's normal");
+    ctx.warn.add(
+        "KHR_materials_clearcoat clearcoatNormalTexture is not supported yet: the coat uses the base's normal");
 }
 
 void read_anisotropy(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
@@ -138,7 +141,8 @@ void add_volume_absorption(const tinygltf::Material& gm, const std::string& name
   if (!(distance > 0.0)) throw Error(name + ": KHR_materials_volume attenuationDistance must be positive");
   for (int c = 0; c < 3; ++c) {
     double color = number_or(vol, "attenuationColor", c, 1.0);
-    if (!(color >= 0.0 && color <= 1.0)) throw Error(name + ": KHR_materials_volume attenuationColor must lie in [0, 1]");
+    if (!(color >= 0.0 && color <= 1.0))
+      throw Error(name + ": KHR_materials_volume attenuationColor must lie in [0, 1]");
     if (std::isfinite(distance)) md->sigma_a[c] += float(color > 0.0 ? -std::log(color) / distance : 1e30);
   }
 }
@@ -149,12 +153,14 @@ void add_volume_absorption(const tinygltf::Material& gm, const std::string& name
 void read_interior(ReadContext& ctx, const tinygltf::Material& gm, const std::string& name, MaterialDesc* m) {
   bool has_extra = gm.extras.Has("candela") && gm.extras.Get("candela").Has("medium");
   MediumDesc md;
-  if (has_extra) md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", ctx.base_dir);
+  if (has_extra)
+    md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", ctx.base_dir);
   bool solid = m->transmission > 0.0f && !m->thin_walled;
   if (solid) {
     add_volume_absorption(gm, name, &md);
   } else if (has_extra && m->transmission > 0.0f) {
-    ctx.warn.add(name + ": a thin-walled material (no KHR_materials_volume thickness) has no interior: its medium is ignored");
+    ctx.warn.add(name +
+                 ": a thin-walled material (no KHR_materials_volume thickness) has no interior: its medium is ignored");
     return;
   } else if (has_extra) {
     m->null_boundary = true;
@@ -167,7 +173,8 @@ void read_interior(ReadContext& ctx, const tinygltf::Material& gm, const std::st
 
 void check_ranges(const std::string& name, MaterialDesc* m) {
   auto in = [&](float v, float lo, float hi, const char* what) {
-    if (!(v >= lo && v <= hi)) throw Error(name + ": " + what + " must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (!(v >= lo && v <= hi))
+      throw Error(name + ": " + what + " must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   };
   for (int c = 0; c < 4; ++c) in(m->base_color[c], 0.0f, 1.0f, "baseColorFactor");
   in(m->metallic, 0.0f, 1.0f, "metallicFactor");

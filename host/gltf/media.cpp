@@ -51,7 +51,6 @@ void read_emission_grid(const tinygltf::Value& v, const std::string& where, Medi
                   ", max " + std::to_string(m->grid_max[k]) + " on axis " + std::to_string(k) + ")");
 }
 
-
 // [r, g, b] of finite non-negative numbers at v[key], if there
 void read_rgb(const tinygltf::Value& v, const std::string& where, const char* key, glm::vec3* out) {
   if (!v.Has(key)) return;

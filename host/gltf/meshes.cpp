@@ -28,8 +28,8 @@ bool renderable(ReadContext& ctx, const tinygltf::Primitive& prim) {
 }
 
 // Attribute `name` with `comps` components per vertex (0: VEC3 or VEC4), or empty
-std::vector<float> attribute(const ReadContext& ctx, const tinygltf::Primitive& prim, const std::string& name, int comps,
-                             size_t nverts, int* got_comps = nullptr) {
+std::vector<float> attribute(const ReadContext& ctx, const tinygltf::Primitive& prim, const std::string& name,
+                             int comps, size_t nverts, int* got_comps = nullptr) {
   auto it = prim.attributes.find(name);
   if (it == prim.attributes.end()) return {};
   std::vector<float> v = read_accessor(ctx.model, it->second, comps);
@@ -48,8 +48,7 @@ void read_colors(const ReadContext& ctx, const tinygltf::Primitive& prim, size_t
   for (float c : col)
     if (!(c >= 0.0f && c <= 1.0f))
       throw Error("glTF COLOR_0 values must lie in [0, 1] (integer colors must be normalized)");
-  for (size_t v = 0; v < n; ++v)
-    m->colors.push_back(glm::vec3(col[comps * v], col[comps * v + 1], col[comps * v + 2]));
+  for (size_t v = 0; v < n; ++v) m->colors.push_back(glm::vec3(col[comps * v], col[comps * v + 1], col[comps * v + 2]));
 }
 
 void read_attributes(const ReadContext& ctx, const tinygltf::Primitive& prim, const glm::mat4& world, MeshDesc* m) {
@@ -112,9 +111,8 @@ void add_corner_tangents(const MeshDesc& m, const std::vector<glm::vec2>& uv, si
     float la = glm::length(a), lb = glm::length(b);
     if (!(la > 0.0f && lb > 0.0f)) continue;
     float angle = std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0f, 1.0f));
-    glm::vec3 nv = m.normals.empty() || glm::dot(m.normals[idx[k]], m.normals[idx[k]]) == 0.0f
-                       ? glm::normalize(face)
-                       : m.normals[idx[k]];
+    glm::vec3 nv = m.normals.empty() || glm::dot(m.normals[idx[k]], m.normals[idx[k]]) == 0.0f ? glm::normalize(face)
+                                                                                               : m.normals[idx[k]];
     (*sum)[idx[k]] += angle * dpdu;
     (*handed)[idx[k]] += angle * (glm::dot(glm::cross(nv, dpdu), -dpdv) < 0.0f ? -1.0f : 1.0f);
   }

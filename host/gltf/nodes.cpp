@@ -21,12 +21,10 @@ glm::mat4 local_transform(const tinygltf::Node& node) {
   if (node.translation.size() == 3)
     m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
   if (node.rotation.size() == 4) {
-    glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
-                float(node.rotation[2]));
+    glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]), float(node.rotation[2]));
     m *= glm::mat4_cast(glm::normalize(q));
   }
-  if (node.scale.size() == 3)
-    m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+  if (node.scale.size() == 3) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
   return m;
 }
 
@@ -44,7 +42,9 @@ void read_camera_extras(const tinygltf::Value& extras, CameraDesc* cam) {
   if (auto r = number("aperture_radius")) {
     if (*r < 0.0) throw Error("camera extras candela.aperture_radius must not be negative");
     if (*r > 0.0 && cam->projection == Projection::Orthographic)
-      throw Error("camera extras candela.aperture_radius: an orthographic camera has no lens (depth of field needs a perspective camera)");
+      throw Error(
+          "camera extras candela.aperture_radius: an orthographic camera has no lens (depth of field needs a "
+          "perspective camera)");
     cam->aperture_radius = float(*r);
   }
   if (auto d = number("focus_distance")) {

@@ -33,11 +33,11 @@ struct ReadContext {
   const tinygltf::Model& model;
   Scene& scene;
   Warnings& warn;
-  const std::string& base_dir;  // where files the scene names are found; empty: nowhere
-  const std::map<int, std::string>& image_errors;  // why load_checked_image left each image empty
+  const std::string& base_dir;                        // where files the scene names are found; empty: nowhere
+  const std::map<int, std::string>& image_errors;     // why load_checked_image left each image empty
   std::map<std::pair<int, bool>, int> textures = {};  // (glTF texture, sRGB) -> Scene::textures or NO_TEXTURE
-  size_t degenerate = 0;  // zero-area triangles skipped
-  std::vector<bool> visited = {};  // nodes reached so far
+  size_t degenerate = 0;                              // zero-area triangles skipped
+  std::vector<bool> visited = {};                     // nodes reached so far
 };
 
 // obj[key] (index < 0) or obj[key][index] when it is a number, else `fallback`

@@ -17,8 +17,8 @@ void read_texture_transform(const tinygltf::Value& ext, TextureSlot* ref) {
   float sx = float(number_or(ext, "scale", 0, 1.0)), sy = float(number_or(ext, "scale", 1, 1.0));
   float c = std::cos(r), s = std::sin(r);
   // Column-major: columns are the images of (1,0,0), (0,1,0), (0,0,1)
-  ref->transform = glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f),
-                             glm::vec3(ox, oy, 1.0f));
+  ref->transform =
+      glm::mat3(glm::vec3(c * sx, -s * sx, 0.0f), glm::vec3(s * sy, c * sy, 0.0f), glm::vec3(ox, oy, 1.0f));
   if (ext.Has("texCoord")) ref->texcoord = int(number_or(ext, "texCoord", -1, ref->texcoord));
 }
 
@@ -26,9 +26,9 @@ void read_sampler(const tinygltf::Model& model, int sampler_index, TextureDesc* 
   if (sampler_index < 0 || sampler_index >= (int)model.samplers.size()) return;
   const tinygltf::Sampler& sampler = model.samplers[size_t(sampler_index)];
   auto mode = [](int w) {
-    return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE      ? WRAP_CLAMP
+    return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? WRAP_CLAMP
            : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
-                                                         : WRAP_REPEAT;
+                                                        : WRAP_REPEAT;
   };
   t->wrap_s = mode(sampler.wrapS);
   t->wrap_t = mode(sampler.wrapT);
@@ -50,8 +50,7 @@ std::string decode_image(const ReadContext& ctx, int source, bool srgb, TextureD
   t.width = img.width;
   t.height = img.height;
   size_t n = t.texels();
-  if (img.component != 4 || (img.bits != 8 && img.bits != 16) ||
-      img.image.size() < n * 4 * size_t(img.bits / 8))
+  if (img.component != 4 || (img.bits != 8 && img.bits != 16) || img.image.size() < n * 4 * size_t(img.bits / 8))
     return "has an unexpected pixel layout";
   if (img.bits == 8) {
     t.srgb = srgb;
@@ -115,7 +114,8 @@ TextureSlot texture_ref(ReadContext& ctx, int gltf_texture, int texcoord, const 
   ref.texcoord = texcoord;
   if (transform) read_texture_transform(*transform, &ref);
   if (ref.texcoord < 0 || ref.texcoord > 1) {
-    ctx.warn.add("textures on TEXCOORD_" + std::to_string(ref.texcoord) + " are not supported (only TEXCOORD_0 and TEXCOORD_1): the texture is ignored");
+    ctx.warn.add("textures on TEXCOORD_" + std::to_string(ref.texcoord) +
+                 " are not supported (only TEXCOORD_0 and TEXCOORD_1): the texture is ignored");
     ref.index = NO_TEXTURE;
   }
   return ref;

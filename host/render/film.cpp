@@ -67,8 +67,8 @@ void check_output_path(const std::string& path) {
     throw Error("output must end in .exr, .png or .jpg: " + path);
 }
 
-void write_image(const std::string& path, const Film& film,
-                 const std::map<std::string, std::string>& metadata, const DisplayTransform& display) {
+void write_image(const std::string& path, const Film& film, const std::map<std::string, std::string>& metadata,
+                 const DisplayTransform& display) {
   check_output_path(path);
   bool exr = lower_extension(path) == ".exr";
 

@@ -14,7 +14,7 @@ namespace candela {
 struct Film {
   int width = 0, height = 0;
   std::vector<float> mean;  // 4 per pixel: rgb mean, w = samples kept
-  std::vector<float> m2;  // 4 per pixel: rgb sum of squared deviations, w = samples dropped
+  std::vector<float> m2;    // 4 per pixel: rgb sum of squared deviations, w = samples dropped
 
   Film() = default;
   Film(int w, int h) : width(w), height(h), mean(size_t(w) * h * 4, 0.0f), m2(size_t(w) * h * 4, 0.0f) {}
@@ -49,7 +49,7 @@ struct DisplayTransform {
 
 // Writes OUT.exr (linear float RGB + metadata, no display transform) or OUT.png / OUT.jpg
 // (8-bit sRGB through `display`). Other extensions throw Error.
-void write_image(const std::string& path, const Film& film,
-                 const std::map<std::string, std::string>& metadata, const DisplayTransform& display = {});
+void write_image(const std::string& path, const Film& film, const std::map<std::string, std::string>& metadata,
+                 const DisplayTransform& display = {});
 
 }  // namespace candela

@@ -36,7 +36,8 @@ RgbImage read_rgb_image(const std::string& path, const std::string& what) {
   img.width = spec.width;
   img.height = spec.height;
   int channels = spec.nchannels;
-  if (channels < 1 || img.width <= 0 || img.height <= 0) throw Error("cannot read " + what + " " + path + ": no pixels");
+  if (channels < 1 || img.width <= 0 || img.height <= 0)
+    throw Error("cannot read " + what + " " + path + ": no pixels");
   std::vector<float> all(img.pixels() * size_t(channels));
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
     throw Error("cannot read " + what + " " + path + ": " + in->geterror());

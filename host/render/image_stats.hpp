@@ -24,7 +24,7 @@ void write_variance_image(const std::string& path, const Film& film,
 // beyond the first three are ignored, a grey image is repeated into R, G and B)
 struct RgbImage {
   int width = 0, height = 0;
-  std::vector<float> rgb;  // 3 per pixel, row-major from the top
+  std::vector<float> rgb;                       // 3 per pixel, row-major from the top
   std::map<std::string, std::string> metadata;  // candela:KEY attributes, without "candela:"
   size_t pixels() const { return size_t(width) * height; }
 };
@@ -39,18 +39,17 @@ struct ErrorMetrics {
   size_t values = 0;  // pixel-channels compared
 };
 constexpr double kRelMseEpsilon = 0.01;
-ErrorMetrics image_error(const RgbImage& image, const RgbImage& reference,
-                         double epsilon = kRelMseEpsilon);
+ErrorMetrics image_error(const RgbImage& image, const RgbImage& reference, double epsilon = kRelMseEpsilon);
 
 // Per-pixel z-test between two independent renders a and b of the same scene, each with
 // its variance image: z = (a - b) / sqrt(var_a + var_b) per pixel-channel.
 struct ZTest {
-  size_t values = 0;  // pixel-channels with var_a + var_b > 0 (and finite)
-  size_t zero_variance = 0;  // pixel-channels with no variance on either side
-  size_t zero_variance_mismatch = 0;  // of those, how many differ beyond float rounding
-  size_t undefined = 0;  // pixel-channels with an infinite variance (fewer than 2 samples)
-  double mean_z = 0.0;  // a bias of one image against the other shows as a mean away from 0
-  double mean_z2 = 0.0;  // chi^2 / values; about 1 when consistent
+  size_t values = 0;                            // pixel-channels with var_a + var_b > 0 (and finite)
+  size_t zero_variance = 0;                     // pixel-channels with no variance on either side
+  size_t zero_variance_mismatch = 0;            // of those, how many differ beyond float rounding
+  size_t undefined = 0;                         // pixel-channels with an infinite variance (fewer than 2 samples)
+  double mean_z = 0.0;                          // a bias of one image against the other shows as a mean away from 0
+  double mean_z2 = 0.0;                         // chi^2 / values; about 1 when consistent
   double frac_over_3 = 0.0, frac_over_4 = 0.0;  // fraction of |z| > 3 and > 4
   size_t count_over_4 = 0;
   double max_abs_z = 0.0;

@@ -8,8 +8,8 @@
 #include <mutex>
 #include <thread>
 
-#include "device/energy.hpp"
 #include "base/error.hpp"
+#include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
 
@@ -18,9 +18,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::string format_mib(uint64_t bytes) {
   char buf[32];
@@ -30,15 +28,13 @@ std::string format_mib(uint64_t bytes) {
 
 // A read-only buffer holding `data`, or one dummy element when it is empty
 template <typename T>
-cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data,
-                  const char* what) {
+cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data, const char* what) {
   std::vector<T> one(1);
   const std::vector<T>& src = data.empty() ? one : data;
   size_t bytes = src.size() * sizeof(T);
   if (bytes > device.max_alloc)
-    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) +
-                " in one buffer, more than " + device.description() + " allows (" +
-                format_mib(device.max_alloc) + ")");
+    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +
+                device.description() + " allows (" + format_mib(device.max_alloc) + ")");
   try {
     return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(src.data()));
   } catch (const cl::Error& e) {
@@ -47,13 +43,11 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
 }
 
 void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
-  if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 ||
-      settings.height > 65536 || uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
+  if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 || settings.height > 65536 ||
+      uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
     throw Error("image size must be between 1x1 and 65536x65536 with at most 2^28 pixels");
-  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 ||
-      device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
-    throw Error(device.description() + " supports only " + device.opencl_c_version +
-                "; candela needs OpenCL C 1.2");
+  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 || device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
+    throw Error(device.description() + " supports only " + device.opencl_c_version + "; candela needs OpenCL C 1.2");
 }
 
 }  // namespace
@@ -81,7 +75,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
                 " (CD_SCENE_BUFFERS out of step with the kernel)");
   local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
 
-#define CD_UPLOAD(type, name)                                                  \
+#define CD_UPLOAD(type, name)                                                     \
   scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name)); \
   if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);
   CD_SCENE_BUFFERS(CD_UPLOAD)
@@ -184,8 +178,11 @@ namespace {
 class SampleScheduler {
  public:
   SampleScheduler(uint32_t spp, double time_limit, size_t workers)
-      : limit_(spp > 0 ? spp : kMaxSamplesPerPixel), time_limit_(spp > 0 ? 0.0 : time_limit),
-        partial_(workers, 0.0), done_by_(workers, 0), start_(Clock::now()) {}
+      : limit_(spp > 0 ? spp : kMaxSamplesPerPixel),
+        time_limit_(spp > 0 ? 0.0 : time_limit),
+        partial_(workers, 0.0),
+        done_by_(workers, 0),
+        start_(Clock::now()) {}
 
   // The next range (offsets from the render's first sample) for a worker that wants
   // `want` samples per pixel; false when the render is over

@@ -33,13 +33,11 @@ inline constexpr EnumName<Strategy> kStrategyNames[] = {
     {Strategy::Nee, "nee", "next-event estimation"},
     {Strategy::Bsdf, "bsdf", "BSDF sampling only"},
     {Strategy::Auto, "auto", "per vertex: bsdf at near-specular surfaces, nee elsewhere"}};
-inline constexpr EnumName<PixelFilter> kPixelFilterNames[] = {
-    {PixelFilter::Box, "box", "default"},
-    {PixelFilter::Tent, "tent", "radius 1 pixel"},
-    {PixelFilter::Gaussian, "gaussian", "sigma 0.5 pixel"}};
+inline constexpr EnumName<PixelFilter> kPixelFilterNames[] = {{PixelFilter::Box, "box", "default"},
+                                                              {PixelFilter::Tent, "tent", "radius 1 pixel"},
+                                                              {PixelFilter::Gaussian, "gaussian", "sigma 0.5 pixel"}};
 inline constexpr EnumName<Sampler> kSamplerNames[] = {
-    {Sampler::Sobol, "sobol", "Owen-scrambled Sobol, stratified; default"},
-    {Sampler::Independent, "independent", ""}};
+    {Sampler::Sobol, "sobol", "Owen-scrambled Sobol, stratified; default"}, {Sampler::Independent, "independent", ""}};
 
 // The film's per-pixel sample count is a float: exact up to 2^24
 constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
@@ -48,7 +46,7 @@ struct RenderSettings {
   int width = 512, height = 512;
   uint32_t seed = 0;
   uint32_t max_depth = 16;  // scattering events
-  uint32_t rr_depth = 3;  // Russian roulette after this many bounces
+  uint32_t rr_depth = 3;    // Russian roulette after this many bounces
   Strategy strategy = Strategy::Nee;
   bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/bsdf/energy.cl)
   PixelFilter filter = PixelFilter::Box;
@@ -59,7 +57,7 @@ struct RenderSettings {
 struct RenderProgress {
   uint32_t spp_done = 0;
   double spp_partial = 0.0;  // samples per pixel of the ranges under way
-  uint32_t spp_target = 0;  // 0 when rendering for a time budget
+  uint32_t spp_target = 0;   // 0 when rendering for a time budget
   double seconds = 0.0;
   double time_limit = 0.0;
   std::vector<double> worker_spp;  // per worker: samples per pixel done and under way
@@ -69,8 +67,8 @@ struct RenderResult {
   Film film;
   uint32_t spp = 0;  // samples every pixel received
   double seconds = 0.0;
-  bool interrupted = false;  // stopped by the caller
-  bool partial_pass = false;  // stopped inside a range: some pixels hold more samples
+  bool interrupted = false;              // stopped by the caller
+  bool partial_pass = false;             // stopped inside a range: some pixels hold more samples
   std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
 };
 
@@ -113,8 +111,8 @@ class DeviceRenderer {
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
-  size_t chunk_ = 1;  // pixels per launch
-  uint32_t batch_ = 1;  // samples per pixel for the next range
+  size_t chunk_ = 1;           // pixels per launch
+  uint32_t batch_ = 1;         // samples per pixel for the next range
   double pass_seconds_ = 0.0;  // one sample of every pixel, measured; 0 = not yet
   double kernel_build_seconds_ = 0.0;
   bool kernel_from_cache_ = false;
@@ -126,9 +124,8 @@ class DeviceRenderer {
 // `stop` is polled between launches; a stopped render keeps the samples already done.
 // After a result with partial_pass, some pixels already hold sample indices from
 // sample_begin + result.spp on: do not resume that film from there.
-RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin,
-                            uint32_t spp, double time_limit = 0.0,
-                            const std::function<void(const RenderProgress&)>& progress = {},
+RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_t sample_begin, uint32_t spp,
+                            double time_limit = 0.0, const std::function<void(const RenderProgress&)>& progress = {},
                             const std::function<bool()>& stop = {});
 
 // A scene compiled once and rendered through one camera on one device, or on several
@@ -143,8 +140,8 @@ class Renderer {
            const dev::Camera& camera, const RenderSettings& settings);
   // The same, and then the scene's host arrays are freed as the last device uploads them
   // (CompiledScene::release_host_arrays): for a caller that needs them no more (the CLI)
-  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene,
-           const dev::Camera& camera, const RenderSettings& settings, bool release_host_arrays);
+  Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<CompiledScene> scene, const dev::Camera& camera,
+           const RenderSettings& settings, bool release_host_arrays);
 
   RenderResult render(uint32_t sample_begin, uint32_t spp, double time_limit = 0.0,
                       const std::function<void(const RenderProgress&)>& progress = {},

@@ -45,9 +45,8 @@ glm::vec3 mul(const float m[3][3], glm::vec3 v) {
 }
 
 // Linear sRGB <-> linear Rec. 2020 (ITU-R BT.2087)
-constexpr float kSrgbToRec2020[3][3] = {{0.6274040f, 0.3292820f, 0.0433136f},
-                                        {0.0690970f, 0.9195400f, 0.0113612f},
-                                        {0.0163916f, 0.0880132f, 0.8955950f}};
+constexpr float kSrgbToRec2020[3][3] = {
+    {0.6274040f, 0.3292820f, 0.0433136f}, {0.0690970f, 0.9195400f, 0.0113612f}, {0.0163916f, 0.0880132f, 0.8955950f}};
 constexpr float kRec2020ToSrgb[3][3] = {{1.6604903f, -0.5876391f, -0.0728516f},
                                         {-0.1245500f, 1.1328999f, -0.0083480f},
                                         {-0.0181511f, -0.1005787f, 1.1187299f}};
@@ -63,8 +62,7 @@ constexpr float kAgxMinEv = -12.47393f, kAgxMaxEv = 4.026069f;
 // Polynomial fit of AgX's default contrast sigmoid on the log-encoded value in [0, 1]
 float agx_contrast(float x) {
   float x2 = x * x, x4 = x2 * x2;
-  return 15.5f * x4 * x2 - 40.14f * x4 * x + 31.96f * x4 - 6.868f * x2 * x + 0.4298f * x2 + 0.1191f * x -
-         0.00232f;
+  return 15.5f * x4 * x2 - 40.14f * x4 * x + 31.96f * x4 - 6.868f * x2 * x + 0.4298f * x2 + 0.1191f * x - 0.00232f;
 }
 
 }  // namespace

@@ -82,8 +82,7 @@ SceneFeatures Scene::features() const {
   for (const auto& m : media) f.nanovdb |= f.media && m.is_nanovdb();
   // The lights compile_lights makes: emitting punctual lights; the map, else a background
   f.punctual = punctual_light_count() > 0;
-  f.environment = environment.has_value() ||
-                  dev::luminance_rgb(background.x, background.y, background.z) > 0.0f;
+  f.environment = environment.has_value() || dev::luminance_rgb(background.x, background.y, background.z) > 0.0f;
   return f;
 }
 
@@ -110,8 +109,7 @@ bool Scene::has_light() const {
   return false;
 }
 
-glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
-                               double* area) {
+glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, double* area) {
   glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
   double len = glm::length(n);
   *area = 0.5 * len;

@@ -14,8 +14,8 @@ namespace candela {
 
 // One texture slot of a material: texture, TEXCOORD_n, KHR_texture_transform
 struct TextureSlot {
-  int index = NO_TEXTURE;  // into Scene::textures
-  int texcoord = 0;  // 0 or 1
+  int index = NO_TEXTURE;     // into Scene::textures
+  int texcoord = 0;           // 0 or 1
   glm::mat3 transform{1.0f};  // uv' = transform * (u, v, 1)
   bool operator==(const TextureSlot& o) const {
     return index == o.index && texcoord == o.texcoord && transform == o.transform;
@@ -30,10 +30,10 @@ enum class AlphaMode { Opaque, Mask, Blend };
 // space, or between the voxels of a NanoVDB grid (host/vdb_grid.hpp).
 struct MediumDesc {
   glm::vec3 sigma_a{0.0f}, sigma_s{0.0f};
-  glm::vec3 emission{0.0f};  // radiance emitted per unit length (the lecture's L_e(z))
-  float g = 0.0f;  // Henyey-Greenstein asymmetry, in (-1, 1)
-  glm::ivec3 grid_size{0};  // nodes along x, y, z (each >= 2) when there is a grid
-  std::vector<float> density;  // grid values, x fastest, then y, then z; empty: homogeneous
+  glm::vec3 emission{0.0f};                  // radiance emitted per unit length (the lecture's L_e(z))
+  float g = 0.0f;                            // Henyey-Greenstein asymmetry, in (-1, 1)
+  glm::ivec3 grid_size{0};                   // nodes along x, y, z (each >= 2) when there is a grid
+  std::vector<float> density;                // grid values, x fastest, then y, then z; empty: homogeneous
   glm::vec3 grid_min{0.0f}, grid_max{0.0f};  // a NanoVDB grid: its box in index space
   float density_scale = 1.0f;
   // A NanoVDB float grid (MEDIUM_NANOVDB) instead of `density`: its buffer as 32-bit words,
@@ -63,11 +63,11 @@ struct MaterialDesc {
   glm::vec4 base_color{1.0f};  // linear rgba
   float metallic = 1.0f, roughness = 1.0f;
   glm::vec3 emission{0.0f};  // radiance: emissiveFactor x emissive strength
-  float ior = 1.5f;  // KHR_materials_ior
-  float specular = 1.0f;  // KHR_materials_specular
+  float ior = 1.5f;          // KHR_materials_ior
+  float specular = 1.0f;     // KHR_materials_specular
   glm::vec3 specular_color{1.0f};
-  float transmission = 0.0f;  // KHR_materials_transmission
-  bool thin_walled = true;  // no KHR_materials_volume (or thickness 0): a sheet, not a solid
+  float transmission = 0.0f;                           // KHR_materials_transmission
+  bool thin_walled = true;                             // no KHR_materials_volume (or thickness 0): a sheet, not a solid
   float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
   float anisotropy_strength = 0.0f, anisotropy_rotation = 0.0f;  // KHR_materials_anisotropy
   float normal_scale = 1.0f;
@@ -75,10 +75,10 @@ struct MaterialDesc {
   bool double_sided = false;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
-  int medium = -1;  // into Scene::media: what fills the closed surface (KHR_materials_volume
-                    // attenuation, extras.candela.medium); -1: vacuum
-  bool null_boundary = false;  // extras.candela.medium without transmission: the surface is
-                               // invisible and only bounds its medium
+  int medium = -1;                  // into Scene::media: what fills the closed surface (KHR_materials_volume
+                                    // attenuation, extras.candela.medium); -1: vacuum
+  bool null_boundary = false;       // extras.candela.medium without transmission: the surface is
+                                    // invisible and only bounds its medium
   TextureSlot textures[TEX_SLOTS];  // TEX_* slots
   const TextureSlot& texture(int slot) const { return textures[slot]; }
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
@@ -92,10 +92,10 @@ struct MaterialDesc {
 struct TextureDesc {
   int width = 0, height = 0;
   uint32_t wrap_s = WRAP_REPEAT, wrap_t = WRAP_REPEAT;
-  bool srgb = false;  // rgba8 holds sRGB-encoded colour (alpha linear)
-  bool nearest = false;  // nearest-texel lookup (sampler magFilter NEAREST), else bilinear
+  bool srgb = false;           // rgba8 holds sRGB-encoded colour (alpha linear)
+  bool nearest = false;        // nearest-texel lookup (sampler magFilter NEAREST), else bilinear
   std::vector<uint8_t> rgba8;  // 4 per texel, or
-  std::vector<float> rgbaf;  // 4 per texel (float images)
+  std::vector<float> rgbaf;    // 4 per texel (float images)
   size_t texels() const { return size_t(width) * height; }
   // Mean luminance of the decoded texels
   double mean_luminance() const;
@@ -104,20 +104,20 @@ struct TextureDesc {
 // An equirectangular environment map (cl/lights/environment.cl documents the mapping): a
 // LIGHT_ENVIRONMENT with a texture, replacing the constant background
 struct EnvironmentDesc {
-  TextureDesc image;  // float RGBA texels (alpha 1), linear, row 0 looks up (+Y)
+  TextureDesc image;      // float RGBA texels (alpha 1), linear, row 0 looks up (+Y)
   float strength = 1.0f;  // radiance = strength x texel
   float rotation = 0.0f;  // degrees about +Y, counter-clockwise seen from above
-  std::string source;  // the file it came from, or "built-in sky"
+  std::string source;     // the file it came from, or "built-in sky"
 };
 
 // One glTF primitive placed in the world: vertex arrays (world space) and triangles
 struct MeshDesc {
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;  // per vertex, unit or zero (flat); empty: all flat
+  std::vector<glm::vec3> normals;   // per vertex, unit or zero (flat); empty: all flat
   std::vector<glm::vec2> uv0, uv1;  // TEXCOORD_0/1 as stored; empty when absent
   std::vector<glm::vec4> tangents;  // xyz world-space tangent, w handedness; empty when absent
-  std::vector<glm::vec3> colors;  // COLOR_0 rgb, linear; empty when absent
-  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise = front
+  std::vector<glm::vec3> colors;    // COLOR_0 rgb, linear; empty when absent
+  std::vector<uint32_t> indices;    // three per triangle, counter-clockwise = front
   uint32_t material = 0;
   size_t triangles() const { return indices.size() / 3; }
 };
@@ -128,11 +128,11 @@ struct MeshDesc {
 enum class PunctualType { Point, Spot, Directional };
 struct PunctualLightDesc {
   PunctualType type = PunctualType::Point;
-  glm::vec3 position{0.0f};  // point, spot: the node's world origin
+  glm::vec3 position{0.0f};                // point, spot: the node's world origin
   glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot, directional: the node's world -Z, unit
   glm::vec3 color{1.0f};
-  float intensity = 1.0f;  // point, spot: candela (W/sr); directional: lux (W/m^2)
-  float range = 0.0f;  // point, spot: 0 = infinite
+  float intensity = 1.0f;                            // point, spot: candela (W/sr); directional: lux (W/m^2)
+  float range = 0.0f;                                // point, spot: 0 = infinite
   float inner_cone = 0.0f, outer_cone = 0.7853982f;  // spot, radians
 };
 
@@ -144,8 +144,8 @@ struct CameraDesc {
   glm::vec3 forward{0.0f, 0.0f, -1.0f};
   glm::vec3 up{0.0f, 1.0f, 0.0f};
   float yfov = 0.7853982f;  // perspective: vertical field of view, radians
-  float ymag = 1.0f;  // orthographic: half-height of the view in scene units
-  float aspect = 0.0f;  // width / height (glTF aspectRatio, or xmag / ymag); 0 = not given
+  float ymag = 1.0f;        // orthographic: half-height of the view in scene units
+  float aspect = 0.0f;      // width / height (glTF aspectRatio, or xmag / ymag); 0 = not given
   // Thin lens (perspective only), in scene units: aperture radius (0 = pinhole) and the
   // distance of the sharp plane along the view axis; unset = resolve_camera's default
   float aperture_radius = 0.0f;
@@ -172,25 +172,24 @@ struct Scene {
   std::vector<MaterialDesc> materials;
   std::vector<TextureDesc> textures;
   std::optional<CameraDesc> camera;
-  std::string strategy;  // scene extras candela.strategy (nee, bsdf, auto); empty: not given
-  glm::vec3 background{0.0f};  // constant environment radiance
+  std::string strategy;                            // scene extras candela.strategy (nee, bsdf, auto); empty: not given
+  glm::vec3 background{0.0f};                      // constant environment radiance
   std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
-  std::optional<EnvironmentDesc> environment;  // a map; when present, background is not used
-  std::vector<MediumDesc> media;  // the global medium and the materials' interiors
-  int global_medium = -1;  // into media: what fills the scene (scene extras); -1: vacuum
-  std::vector<std::string> warnings;  // each unsupported feature named once
+  std::optional<EnvironmentDesc> environment;      // a map; when present, background is not used
+  std::vector<MediumDesc> media;                   // the global medium and the materials' interiors
+  int global_medium = -1;                          // into media: what fills the scene (scene extras); -1: vacuum
+  std::vector<std::string> warnings;               // each unsupported feature named once
 
   size_t triangles() const;
   Bounds bounds() const;
   SceneFeatures features() const;
-  bool has_light() const;  // some triangle, the background or map, or a punctual light emits
+  bool has_light() const;               // some triangle, the background or map, or a punctual light emits
   size_t punctual_light_count() const;  // punctual lights that emit (colour x intensity > 0)
 };
 
 // Unit normal of triangle (a, b, c) by its counter-clockwise winding; *area gets its area
 // (the host twin of triangle_normal_area in cl/core/geometry.cl)
-glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
-                               double* area);
+glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, double* area);
 
 // A perspective camera looking at the scene's bounds from +z, far enough to see them all
 CameraDesc framing_camera(const Scene& scene);

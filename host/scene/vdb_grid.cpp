@@ -12,8 +12,8 @@
 #include <nanovdb/util/IO.h>
 #endif
 #ifdef CANDELA_HAVE_OPENVDB
-#include <openvdb/openvdb.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
+#include <openvdb/openvdb.h>
 #endif
 
 namespace candela {
@@ -169,7 +169,8 @@ void load_openvdb_density(const std::string& path, const std::string& grid_name,
     throw Error("cannot read OpenVDB file " + path + ": " + e.what());
   }
   if (!grid->transform().isLinear())
-    throw Error("OpenVDB grid " + name + " of " + path + " has a frustum (non-linear) transform; candela reads affine ones");
+    throw Error("OpenVDB grid " + name + " of " + path +
+                " has a frustum (non-linear) transform; candela reads affine ones");
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   try {
     handle = nanovdb::openToNanoVDB(*grid);

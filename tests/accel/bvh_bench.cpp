@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "compile/bvh_builder.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "compile/scene_compiler.hpp"
+#include "gltf/gltf_loader.hpp"
 
 using namespace candela;
 
@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
   std::vector<int> counts;
   if (argc > 3) {
     std::stringstream ss(argv[3]);
-    for (std::string t; std::getline(ss, t, ',');) counts.push_back(t == "all" ? bvh_build_threads() : std::atoi(t.c_str()));
+    for (std::string t; std::getline(ss, t, ',');)
+      counts.push_back(t == "all" ? bvh_build_threads() : std::atoi(t.c_str()));
   } else {
     counts = {1, bvh_build_threads()};
   }
@@ -63,11 +64,13 @@ int main(int argc, char** argv) {
                  std::memcmp(bvh.nodes.data(), first.nodes.data(), bvh.nodes.size() * sizeof(bvh.nodes[0])) == 0 &&
                  std::memcmp(bvh.tris.data(), first.tris.data(), bvh.tris.size() * sizeof(bvh.tris[0])) == 0;
         }
-        std::printf("{\"scene\": \"%s\", \"triangles\": %zu, \"threads\": %d, \"round\": %d, \"seconds\": %.4f, \"cpu_seconds\": %.4f, "
-                    "\"triangles_per_second\": %.0f, \"sah_cost\": %.4f, \"depth\": %d, \"nodes\": %zu, "
-                    "\"same_tree\": %s}\n",
-                    argv[1], prims.size(), threads, round, s, cpu, double(prims.size()) / s, sah_cost(bvh), bvh.depth,
-                    bvh.nodes.size(), same ? "true" : "false");
+        std::printf(
+            "{\"scene\": \"%s\", \"triangles\": %zu, \"threads\": %d, \"round\": %d, \"seconds\": %.4f, "
+            "\"cpu_seconds\": %.4f, "
+            "\"triangles_per_second\": %.0f, \"sah_cost\": %.4f, \"depth\": %d, \"nodes\": %zu, "
+            "\"same_tree\": %s}\n",
+            argv[1], prims.size(), threads, round, s, cpu, double(prims.size()) / s, sah_cost(bvh), bvh.depth,
+            bvh.nodes.size(), same ? "true" : "false");
         std::fflush(stdout);
       }
   } catch (const std::exception& e) {

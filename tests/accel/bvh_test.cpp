@@ -2,9 +2,9 @@
 // reference in double precision, on random rays and on rays through edges and vertices.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <algorithm>
 #include <random>
 
 #include "compile/bvh_builder.hpp"
@@ -197,7 +197,8 @@ TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
   std::vector<Tri> tris;
   for (int i = 0; i < 5000; ++i) {
     glm::vec3 c(u(rng), u(rng), u(rng));
-    tris.push_back(make_tri(c, c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.05f * glm::vec3(u(rng), u(rng), u(rng))));
+    tris.push_back(
+        make_tri(c, c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.05f * glm::vec3(u(rng), u(rng), u(rng))));
   }
   // Many copies of one triangle: no spatial split exists
   for (int i = 0; i < 100; ++i) tris.push_back(tris[0]);
@@ -222,14 +223,15 @@ TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
 // the rest as jobs on a pool, joined in a fixed order. 150k triangles are enough for
 // both (parallel binning from 32768 refs, jobs of at most max(4096, refs / 128)).
 TEST(BvhBuilder, SameTreeOnAnyThreadCount) {
-  std::vector<Tri> tris = icosphere(6, glm::vec3(0.0f), 1.0f);  // 81920 triangles
+  std::vector<Tri> tris = icosphere(6, glm::vec3(0.0f), 1.0f);              // 81920 triangles
   std::vector<Tri> more = icosphere(5, glm::vec3(3.0f, 0.5f, 0.0f), 0.5f);  // 20480, apart
   tris.insert(tris.end(), more.begin(), more.end());
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-4.0f, 4.0f);
   for (int i = 0; i < 50000; ++i) {  // and a cloud of small triangles
     glm::vec3 c(u(rng), u(rng), u(rng));
-    tris.push_back(make_tri(c, c + 0.02f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.02f * glm::vec3(u(rng), u(rng), u(rng))));
+    tris.push_back(
+        make_tri(c, c + 0.02f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.02f * glm::vec3(u(rng), u(rng), u(rng))));
   }
   Soup soup(tris);  // default thread count
   check_bvh(soup.bvh, tris);
@@ -306,7 +308,8 @@ TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
   std::vector<Tri> sphere = icosphere(3, center, 2.0f);
   Bvh bvh = Soup(sphere).bvh;
   // From points inside, aim exactly at every vertex and every edge midpoint
-  std::vector<glm::vec3> origins = {center, center + glm::vec3(0.3f, -0.5f, 0.2f), center + glm::vec3(-1.1f, 0.4f, 0.6f)};
+  std::vector<glm::vec3> origins = {center, center + glm::vec3(0.3f, -0.5f, 0.2f),
+                                    center + glm::vec3(-1.1f, 0.4f, 0.6f)};
   std::vector<cl_float4> rays;
   for (const auto& o : origins)
     for (const auto& t : sphere)

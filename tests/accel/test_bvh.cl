@@ -3,8 +3,7 @@
 
 // rays: (org, tmax) then (dir, 0); out: (t, b1, b2, tri) closest hit, occluded flag
 __kernel void test_trace_bvh(__global const BvhNode* nodes, __global const BvhTriangle* tris,
-                             __global const float4* rays, __global float4* out,
-                             __global int* occluded) {
+                             __global const float4* rays, __global float4* out, __global int* occluded) {
   uint i = get_global_id(0);
   Ray r;
   r.org = rays[2 * i].xyz;
@@ -17,8 +16,8 @@ __kernel void test_trace_bvh(__global const BvhNode* nodes, __global const BvhTr
 }
 
 // The same rays against every triangle, without the BVH
-__kernel void test_trace_brute(__global const BvhTriangle* tris, uint num_tris,
-                               __global const float4* rays, __global float4* out) {
+__kernel void test_trace_brute(__global const BvhTriangle* tris, uint num_tris, __global const float4* rays,
+                               __global float4* out) {
   uint i = get_global_id(0);
   Ray r;
   r.org = rays[2 * i].xyz;

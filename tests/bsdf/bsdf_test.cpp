@@ -63,7 +63,8 @@ double fresnel_dielectric(double cos_i, double eta) {
 // Conductor of complex index eta + i k: complex Snell's law, then r_s and r_p
 double fresnel_conductor(double cos_i, double eta, double k) {
   std::complex<double> n(eta, k), cos_t = std::sqrt(1.0 - (1.0 - cos_i * cos_i) / (n * n));
-  return 0.5 * (std::norm((cos_i - n * cos_t) / (cos_i + n * cos_t)) + std::norm((n * cos_i - cos_t) / (n * cos_i + cos_t)));
+  return 0.5 *
+         (std::norm((cos_i - n * cos_t) / (cos_i + n * cos_t)) + std::norm((n * cos_i - cos_t) / (n * cos_i + cos_t)));
 }
 
 // Refraction of w (on n's side) through relative index eta; nullopt on total internal reflection
@@ -166,8 +167,12 @@ struct GltfReference {
 
   explicit GltfReference(const dev::Material& m)
       : base(m.base_color[0], m.base_color[1], m.base_color[2]),
-        metallic(m.params.gltf.metallic), transmission(m.params.gltf.transmission), ior(m.params.gltf.ior),
-        f90(m.params.gltf.specular_color[3]), coat(m.params.gltf.clearcoat), thin((m.flags & MATERIAL_THIN_WALLED) != 0u),
+        metallic(m.params.gltf.metallic),
+        transmission(m.params.gltf.transmission),
+        ior(m.params.gltf.ior),
+        f90(m.params.gltf.specular_color[3]),
+        coat(m.params.gltf.clearcoat),
+        thin((m.flags & MATERIAL_THIN_WALLED) != 0u),
         ggx(HostGgx::from(m.params.gltf.roughness, m.params.gltf.anisotropy_strength)),
         coat_ggx(HostGgx::from(m.params.gltf.clearcoat_roughness, 0.0)) {
     double r = (ior - 1.0) / (ior + 1.0);
@@ -183,7 +188,8 @@ struct GltfReference {
 
   // Component probabilities: coat, metal, specular, diffuse, glass
   std::array<double, 5> lobes(double cos_o) const {
-    double m = metallic, t = transmission, fc = coat_fresnel(cos_o), fs = luminance(schlick(f0, glm::dvec3(f90), cos_o));
+    double m = metallic, t = transmission, fc = coat_fresnel(cos_o),
+           fs = luminance(schlick(f0, glm::dvec3(f90), cos_o));
     std::array<double, 5> w = {fc, (1 - fc) * m, (1 - fc) * (1 - m) * (1 - t) * fs,
                                (1 - fc) * (1 - m) * (1 - t) * (1 - spec_albedo(cos_o)) * luminance(base),
                                (1 - fc) * (1 - m) * t};
@@ -309,8 +315,13 @@ dev::Material gold(double roughness, double anisotropy = 0.0) {
 float ior(const dev::Material& m) { return m.type == MATERIAL_GLTF ? m.params.gltf.ior : 1.5f; }
 
 MaterialCase diffuse(glm::dvec3 albedo) {
-  return {"diffuse", make_material(MATERIAL_DIFFUSE, albedo), true, [albedo](double) { return albedo; },
-          lambert_reference(albedo), {}, {}};
+  return {"diffuse",
+          make_material(MATERIAL_DIFFUSE, albedo),
+          true,
+          [albedo](double) { return albedo; },
+          lambert_reference(albedo),
+          {},
+          {}};
 }
 
 // Microfacet lobes lose the samples reflected below the horizon: their pdf integrates to less than 1
@@ -324,10 +335,10 @@ MaterialCase gltf_case(std::string name, dev::Material m, CellSpec cells) {
 }
 
 // Delta lobes: eval and pdf are 0 everywhere; `albedo` where it is known
-MaterialCase delta_case(std::string name, dev::Material m, std::function<std::optional<glm::dvec3>(double)> albedo = {}) {
+MaterialCase delta_case(std::string name, dev::Material m,
+                        std::function<std::optional<glm::dvec3>(double)> albedo = {}) {
   return {name, m, false, albedo, {}, {}, {}};
 }
-
 
 std::vector<MaterialCase> make_materials() {
   const glm::dvec3 orange(0.8, 0.5, 0.2), brass(0.95, 0.64, 0.54), white(1.0);
@@ -404,7 +415,8 @@ Frame frame_around(glm::dvec3 n) {
 // Unit direction at polar angle theta from n, azimuth phi (degrees) in frame_around(n)
 glm::dvec3 around(glm::dvec3 n, double theta_deg, double phi_deg) {
   double th = theta_deg * kPi / 180.0, ph = phi_deg * kPi / 180.0;
-  return frame_around(glm::normalize(n)).world({std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)});
+  return frame_around(glm::normalize(n))
+      .world({std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)});
 }
 
 const glm::dvec3 kTilted = glm::normalize(glm::dvec3(1.0, 2.0, 3.0));
@@ -660,7 +672,8 @@ struct SphereCells {
           }
           for (const auto& c : corners) on_side = on_side || side(c) == k;
           if (!on_side && !crossed) continue;
-          add(k * per_side() + size_t(a / sub_t) * spec.sectors + b / sub_phi, t0, t1, phi0, phi1, crossed ? kRefine : 1);
+          add(k * per_side() + size_t(a / sub_t) * spec.sectors + b / sub_phi, t0, t1, phi0, phi1,
+              crossed ? kRefine : 1);
         }
       }
     }
@@ -758,7 +771,8 @@ bool near_rel(double a, double b, double rel) { return std::fabs(a - b) <= rel *
 
 // Colours equal channel by channel, relative to their largest channel
 bool near_vec(glm::dvec3 a, glm::dvec3 b, double rel) {
-  double scale = std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y), std::fabs(b.z)});
+  double scale =
+      std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y), std::fabs(b.z)});
   return glm::all(glm::lessThanEqual(glm::abs(a - b), glm::dvec3(rel * scale)));
 }
 
@@ -1001,7 +1015,8 @@ TEST_P(BsdfTest, Sampling) {
   BSDF_SKIP_KNOWN_BUGS(bugs);
 }
 
-INSTANTIATE_TEST_SUITE_P(Lobes, BsdfTest, ::testing::Combine(::testing::Values("pocl", "rusticl"), ::testing::ValuesIn(kMaterials)),
+INSTANTIATE_TEST_SUITE_P(Lobes, BsdfTest,
+                         ::testing::Combine(::testing::Values("pocl", "rusticl"), ::testing::ValuesIn(kMaterials)),
                          [](const ::testing::TestParamInfo<Param>& info) {
                            return std::get<0>(info.param) + "_" + std::get<1>(info.param).name;
                          });
@@ -1215,8 +1230,8 @@ TEST_P(BsdfDelta, SmoothConductor) {
 TEST_P(BsdfDelta, SmoothGlass) {
   DELTA_RIG_OR_SKIP(r);
   dev::Material glass = gltf(glm::dvec3(1.0), 0.0, 0.0, 1.0);
-  for (auto [theta, back] : std::vector<std::pair<double, bool>>{{0, false}, {45, false}, {80, false}, {20, true},
-                                                                 {40, true}, {60, true}, {80, true}}) {
+  for (auto [theta, back] : std::vector<std::pair<double, bool>>{
+           {0, false}, {45, false}, {80, false}, {20, true}, {40, true}, {60, true}, {80, true}}) {
     SCOPED_TRACE("theta " + std::to_string(theta) + (back ? " inside" : " outside"));
     Geometry g = flat(theta, back);
     check_delta(sample(*r, glass, g), glass_lobes(g, 1.5, false, glm::dvec3(1.0)), true);
@@ -1379,12 +1394,14 @@ std::vector<EnergyLobe> energy_lobes() {
       {"glass_inside", [=](double r) { return gltf(white, 0.0, r, 1.0); }, true, ""},
       {"thin_glass", [=](double r) { return gltf(white, 0.0, r, 1.0, true); }, false, ""},
       {"coat_plastic_white", coat, false, ""},
-      {"smooth_coat_metal_white", [=](double r) {
+      {"smooth_coat_metal_white",
+       [=](double r) {
          dev::Material m = coat(r);
          m.params.gltf.metallic = 1.0f;
          m.params.gltf.clearcoat_roughness = 0.0f;
          return m;
-       }, false, ""},
+       },
+       false, ""},
       {"mixture_white", [=](double r) { return gltf(white, 0.5, r, 0.5); }, false, ""},
   };
 }
@@ -1435,7 +1452,8 @@ TEST_P(BsdfEnergy, AlbedoAtMostOne) {
       double r = kEnergyRoughness[c / wos.size()], t = kEnergyTheta[c % wos.size()];
       std::string where = "roughness " + std::to_string(r) + " theta " + std::to_string(t);
       if (lobe.name == "metal_white" && t == 0.0)
-        RecordProperty("albedo_metal_white_r" + std::to_string(r), std::to_string(e.mean.x) + " SE " + std::to_string(e.se.x));
+        RecordProperty("albedo_metal_white_r" + std::to_string(r),
+                       std::to_string(e.mean.x) + " SE " + std::to_string(e.se.x));
       for (int ch = 0; ch < 3; ++ch)
         if (e.mean[ch] > 1.0 + 4.0 * e.se[ch] + 1e-5) {
           created += " " + where + ": " + std::to_string(e.mean[ch]) + " (SE " + std::to_string(e.se[ch]) + ");";

@@ -105,7 +105,8 @@ struct EnergyRig {
   }
   template <typename T>
   cl::Buffer input(const std::vector<T>& v) {
-    return cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T), const_cast<T*>(v.data()));
+    return cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
+                      const_cast<T*>(v.data()));
   }
 
   // (E(mu), E_avg, E5(mu), E5_avg) as the lobes look them up, for (mu, roughness) queries
@@ -232,8 +233,8 @@ TEST(Energy, TableMatchesIndependentMonteCarlo) {
     // E5 has nodes uniform in mu: its interpolation error is larger for smooth lobes
     EXPECT_NEAR(looked[k].s[2], mc5.mean, 4.0 * mc5.se + kTable5Tolerance)
         << "E5: mu " << q[k].s[0] << " roughness " << q[k].s[1] << " SE " << mc5.se;
-    std::printf("  mu %.2f roughness %.2f: table E %.5f, Monte Carlo %.5f +- %.5f; E5 %.5f, %.5f +- %.5f\n",
-                q[k].s[0], q[k].s[1], looked[k].s[0], mc.mean, mc.se, looked[k].s[2], mc5.mean, mc5.se);
+    std::printf("  mu %.2f roughness %.2f: table E %.5f, Monte Carlo %.5f +- %.5f; E5 %.5f, %.5f +- %.5f\n", q[k].s[0],
+                q[k].s[1], looked[k].s[0], mc.mean, mc.se, looked[k].s[2], mc5.mean, mc5.se);
   }
   // Alpha = 1 at normal incidence has a closed form: D = 1 / pi, E = 1 - ln 2
   EXPECT_NEAR(r.lookup({{{1.0f, 1.0f}}})[0].s[0], 1.0 - std::log(2.0), 2e-4);
@@ -262,8 +263,8 @@ TEST(Energy, TableQuadratureAndInterpolationAreAccurate) {
     worst_quadrature = std::max(worst_quadrature, std::fabs(double(table_quadrature[k]) - converged[k]));
     worst_lookup = std::max(worst_lookup, std::fabs(double(looked[k].s[0]) - converged[k]));
   }
-  std::printf("quadrature error %.2e, lookup error %.2e (max over %zu cell centres)\n", worst_quadrature,
-              worst_lookup, centres.size());
+  std::printf("quadrature error %.2e, lookup error %.2e (max over %zu cell centres)\n", worst_quadrature, worst_lookup,
+              centres.size());
   EXPECT_LT(worst_quadrature, 3e-4);
   EXPECT_LT(worst_lookup, kTableTolerance);
 }
@@ -297,8 +298,13 @@ TEST(Energy, CompensatedAlbedoIsOneForWhiteAndAtMostOneForAll) {
   };
   const Case cases[] = {
       {"white metal", [](double a) { return metal(glm::dvec3(1.0), a); }, true, kTableTolerance},
-      {"white conductor", [](double a) { return conductor(glm::dvec3(0.0), glm::dvec3(0.0), a); }, true, kTableTolerance},
-      {"gold metal", [](double a) { return metal({1.0, 0.78, 0.34}, a); }, false, 0.0},
+      {"white conductor", [](double a) { return conductor(glm::dvec3(0.0), glm::dvec3(0.0), a); }, true,
+       kTableTolerance},
+      {"gold metal",
+       [](double a) {
+         return metal({1.0, 0.78, 0.34}, a);
+       },
+       false, 0.0},
       {"gold conductor", [](double a) { return conductor(kGoldEta, kGoldK, a); }, false, 0.0},
       {"anisotropic metal", [](double a) { return metal(glm::dvec3(1.0), a, 0.7); }, false, 0.03},
   };
@@ -310,7 +316,8 @@ TEST(Energy, CompensatedAlbedoIsOneForWhiteAndAtMostOneForAll) {
         std::printf("  %-17s roughness %.1f theta %2.0f: albedo %.5f %.5f %.5f (SE %.5f)\n", c.name.c_str(), roughness,
                     theta, a[0].mean, a[1].mean, a[2].mean, a[1].se);
         for (int k = 0; k < 3; ++k) {
-          EXPECT_LE(a[k].mean, 1.0 + 4.0 * a[k].se + c.tolerance) << c.name << " roughness " << roughness << " theta " << theta;
+          EXPECT_LE(a[k].mean, 1.0 + 4.0 * a[k].se + c.tolerance)
+              << c.name << " roughness " << roughness << " theta " << theta;
           if (c.white) {
             EXPECT_NEAR(a[k].mean, 1.0, 4.0 * a[k].se + c.tolerance)
                 << c.name << " roughness " << roughness << " theta " << theta;
@@ -335,9 +342,10 @@ TEST(Energy, WhitePlasticReflectsOneAtEveryAngle) {
       auto with = r.albedo(white, true, at_angle(theta), seed++, kSamples / 2);
       auto without = r.albedo(white, false, at_angle(theta), seed++, kSamples / 2);
       auto tint = r.albedo(tinted, true, at_angle(theta), seed++, kSamples / 2);
-      std::printf("  white plastic roughness %.1f theta %2.0f: albedo %.5f +- %.5f compensated, %.5f not; "
-                  "tinted %.4f %.4f %.4f\n", roughness, theta, with[1].mean, with[1].se, without[1].mean,
-                  tint[0].mean, tint[1].mean, tint[2].mean);
+      std::printf(
+          "  white plastic roughness %.1f theta %2.0f: albedo %.5f +- %.5f compensated, %.5f not; "
+          "tinted %.4f %.4f %.4f\n",
+          roughness, theta, with[1].mean, with[1].se, without[1].mean, tint[0].mean, tint[1].mean, tint[2].mean);
       for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(with[c].mean, 1.0, 4.0 * with[c].se + 2.0 * kTable5Tolerance)
             << "roughness " << roughness << " theta " << theta;
@@ -383,7 +391,8 @@ TEST(Energy, CompensatedLobesSampleTheirPdfAndAreReciprocal) {
       bool ok = wi.z > 0.0 && std::fabs(pdf - pdf_e) <= tol * pdf && s[3 * i + 1].s[3] == 1.0f;
       for (int c = 0; c < 3; ++c) ok = ok && std::fabs(f[c] - fe[c]) <= tol * std::max(f[c], fe[c]);
       if (!ok && ++bad <= 3)
-        ADD_FAILURE() << name << " sample " << i << ": f " << f.y << " vs " << fe.y << ", pdf " << pdf << " vs " << pdf_e;
+        ADD_FAILURE() << name << " sample " << i << ": f " << f.y << " vs " << fe.y << ", pdf " << pdf << " vs "
+                      << pdf_e;
       if (wi.z > 0.0) observed[cell(wi)] += 1.0;
     }
     EXPECT_EQ(bad, 0u) << name;
@@ -426,7 +435,8 @@ TEST(Energy, CompensatedLobesSampleTheirPdfAndAreReciprocal) {
     size_t unequal = 0;
     for (size_t k = 0; k < pairs.size(); ++k)
       for (int c = 0; c < 3; ++c)
-        if (std::fabs(f1[k].s[c] - f2[k].s[c]) > 1e-5 * std::max(std::fabs(f1[k].s[c]), std::fabs(f2[k].s[c]))) ++unequal;
+        if (std::fabs(f1[k].s[c] - f2[k].s[c]) > 1e-5 * std::max(std::fabs(f1[k].s[c]), std::fabs(f2[k].s[c])))
+          ++unequal;
     EXPECT_EQ(unequal, 0u) << name << ": f(wo, wi) != f(wi, wo)";
   }
 }
@@ -439,8 +449,9 @@ TEST_P(EnergyFurnaceTest, WhiteRoughMetalSphereVanishes) {
   DeviceEntry device;
   CANDELA_DEVICE_OR_SKIP(GetParam(), device);
   GltfBuilder g;
-  int mat = g.add("materials", {{"pbrMetallicRoughness",
-                                 {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 1.0}, {"roughnessFactor", 1.0}}}});
+  int mat =
+      g.add("materials", {{"pbrMetallicRoughness",
+                           {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 1.0}, {"roughnessFactor", 1.0}}}});
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 1.0f, 3, mat)})}});
   g.add_camera({0, 0, 3.2f}, {0, 0, 0}, 0.75f);  // the sphere spans 0.84 of the image height
   g.set_background({1, 1, 1});

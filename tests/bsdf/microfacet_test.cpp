@@ -104,7 +104,8 @@ std::map<std::string, std::unique_ptr<KernelRig>>& rigs() {
 template <typename Out, typename In>
 std::vector<Out> run_map(KernelRig& rig, cl::Kernel& k, cl_uint in_arg, const std::vector<In>& in, size_t n,
                          size_t out_per_item) {
-  cl::Buffer ib(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(In), const_cast<In*>(in.data()));
+  cl::Buffer ib(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(In),
+                const_cast<In*>(in.data()));
   cl::Buffer ob(rig.context, CL_MEM_WRITE_ONLY, n * out_per_item * sizeof(Out));
   k.setArg(in_arg, ib);
   k.setArg(in_arg + 1, ob);
@@ -178,7 +179,7 @@ class MicrofacetTest : public ::testing::TestWithParam<std::string> {
   }
 };
 
-#define RIG_OR_SKIP(r)   \
+#define RIG_OR_SKIP(r)  \
   KernelRig* r = rig(); \
   if (!r) GTEST_SKIP() << GetParam() << " OpenCL device is not available"
 
@@ -224,7 +225,8 @@ struct StretchedCells {
   }
   // Integral over each cell of D_w(m) dw_m = D_w(m(n)) |dw_m / dw_n| dw_n, where for
   // m = M n / |M n|, M = diag(ax, ay, 1): dw_m / dw_n = det M / |M n|^3
-  std::vector<double> integrals(const std::function<std::vector<double>(const std::vector<glm::dvec3>&)>& visible_d) const {
+  std::vector<double> integrals(
+      const std::function<std::vector<double>(const std::vector<glm::dvec3>&)>& visible_d) const {
     int nc = n_cos * sub, np = n_phi * sub;
     double dz = 1.0 / nc, dphi = 2.0 * kPi / np;
     std::vector<glm::dvec3> ms;
@@ -279,7 +281,7 @@ TEST_P(MicrofacetTest, FresnelDielectricAtNormalIncidence) {
   std::vector<float> f = dielectric(*r, {{{1.0f, 1.5f}}, {{1.0f, 1.0f / 1.5f}}, {{1.0f, 1.0f}}});
   EXPECT_NEAR(f[0], 0.04, 1e-6);
   EXPECT_NEAR(f[1], 0.04, 1e-6);  // the same from the dense side
-  EXPECT_NEAR(f[2], 0.0, 1e-7);  // index-matched
+  EXPECT_NEAR(f[2], 0.0, 1e-7);   // index-matched
 }
 
 // Beyond the critical angle asin(1 / 1.5) exactly 1; just inside it below 1
@@ -446,9 +448,9 @@ TEST_P(MicrofacetTest, GgxMatchesLectureFormulas) {
                 std::fabs(v[i].g1_w - g1) <= 1e-5 * g1 && std::fabs(v[i].g - g) <= 1e-5 * g &&
                 std::fabs(v[i].lambda_m - lm) <= 2e-5 * lm + 1e-6;
       if (!ok && ++bad <= 5)
-        ADD_FAILURE() << "alpha " << a.x << " " << a.y << " w " << w.x << " " << w.y << " " << w.z << " m " << m.x << " "
-                      << m.y << " " << m.z << ": D " << v[i].d << " vs " << d << ", Lambda " << v[i].lambda_w << " vs "
-                      << lw << ", G1 " << v[i].g1_w << " vs " << g1 << ", G " << v[i].g << " vs " << g;
+        ADD_FAILURE() << "alpha " << a.x << " " << a.y << " w " << w.x << " " << w.y << " " << w.z << " m " << m.x
+                      << " " << m.y << " " << m.z << ": D " << v[i].d << " vs " << d << ", Lambda " << v[i].lambda_w
+                      << " vs " << lw << ", G1 " << v[i].g1_w << " vs " << g1 << ", G " << v[i].g << " vs " << g;
     }
     EXPECT_EQ(bad, 0u) << "alpha " << a.x << " " << a.y;
   }
@@ -495,7 +497,8 @@ TEST_P(MicrofacetTest, GgxVisibleSamplesFollowVisibleD) {
       glm::dvec3 w = spherical(deg(theta), deg(30.0));
       double cell_sum = 0.0;
       ChiSquare chi2 = visible_chi_square(*r, a, a, w, &cell_sum);
-      std::string where = "alpha " + std::to_string(a.x) + " " + std::to_string(a.y) + " theta_w " + std::to_string(theta);
+      std::string where =
+          "alpha " + std::to_string(a.x) + " " + std::to_string(a.y) + " theta_w " + std::to_string(theta);
       EXPECT_NEAR(cell_sum, 1.0, 1e-4) << where;
       EXPECT_GT(chi2.p_value, kAlpha) << where << ": chi2 " << chi2.statistic << " dof " << chi2.dof;
     }

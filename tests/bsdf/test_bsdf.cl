@@ -44,9 +44,8 @@ bool test_bsdf_sample_i(const Bsdf* b, float3 wo, uint i, uint seed, BsdfSample*
 // out[3i..3i+2]: (wi, pdf), (f, eta), (bsdf_eval, bsdf_pdf) at the sampled wi, all zero
 // when sampling fails; info[i]: (returned, BSDF_DELTA set, BSDF_REFLECTION set, flags valid:
 // within bsdf_flags and exactly one of reflection and transmission), 0 where not returned
-__kernel void test_bsdf_sample(__global const Material* materials, float4 ng, float4 ns,
-                               float4 tangent, float4 wo, uint seed, __global float4* out,
-                               __global uint4* info) {
+__kernel void test_bsdf_sample(__global const Material* materials, float4 ng, float4 ns, float4 tangent, float4 wo,
+                               uint seed, __global float4* out, __global uint4* info) {
   uint i = get_global_id(0);
   SceneData sc = test_bsdf_scene(materials);
   SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz, 0u);
@@ -63,15 +62,13 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
   out[3 * i + 2] = (float4)(bsdf_eval(&b, wo.xyz, bs.wi), bsdf_pdf(&b, wo.xyz, bs.wi));
   uint side = bs.flags & (BSDF_REFLECTION | BSDF_TRANSMISSION);
   bool valid = (bs.flags & ~bsdf_flags(&b)) == 0u && (side == BSDF_REFLECTION || side == BSDF_TRANSMISSION);
-  info[i] = (uint4)(1u, (bs.flags & BSDF_DELTA) != 0u ? 1u : 0u, side == BSDF_REFLECTION ? 1u : 0u,
-                    valid ? 1u : 0u);
+  info[i] = (uint4)(1u, (bs.flags & BSDF_DELTA) != 0u ? 1u : 0u, side == BSDF_REFLECTION ? 1u : 0u, valid ? 1u : 0u);
 }
 
 // f and pdf for the pair (wo, wi) = (pairs[2i], pairs[2i+1]) at a hit oriented by that wo;
 // out[i] = (f, pdf), from one bsdf_eval_pdf (test_bsdf_sample covers bsdf_eval and bsdf_pdf)
-__kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns,
-                             float4 tangent, __global const float4* pairs,
-                             __global float4* out) {
+__kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns, float4 tangent,
+                             __global const float4* pairs, __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = test_bsdf_scene(materials);
   float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
@@ -84,9 +81,9 @@ __kernel void test_bsdf_eval(__global const Material* materials, float4 ng, floa
 // Albedo samples: work-item i estimates configuration c = i / per_config, material
 // c / n_wo seen from wos[c % n_wo]. out[i] = (f |cos| / pdf * eta^2, returned), where
 // eta = bs.eta (eta_wi / eta_wo) undoes the 1 / eta^2 radiance scaling of refraction
-__kernel void test_bsdf_albedo(__global const Material* materials, float4 ng, float4 ns,
-                               float4 tangent, __global const float4* wos, uint n_wo,
-                               uint per_config, uint seed, __global float4* out) {
+__kernel void test_bsdf_albedo(__global const Material* materials, float4 ng, float4 ns, float4 tangent,
+                               __global const float4* wos, uint n_wo, uint per_config, uint seed,
+                               __global float4* out) {
   uint i = get_global_id(0), c = i / per_config;
   SceneData sc = test_bsdf_scene(materials);
   float3 wo = wos[c % n_wo].xyz;

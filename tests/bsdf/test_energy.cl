@@ -3,8 +3,7 @@
 // bsdf_sample / bsdf_eval of material 0 with or without the table.
 
 // (E(mu), E_avg, E5(mu), E5_avg) for queries (mu, glTF roughness) of an isotropic lobe
-__kernel void test_energy_lookup(__global const float* table, __global const float2* queries,
-                                 __global float4* out) {
+__kernel void test_energy_lookup(__global const float* table, __global const float2* queries, __global float4* out) {
   uint i = get_global_id(0);
   GgxEnergy e = energy_ggx(table, ggx_from_roughness(queries[i].y, 0.0f), queries[i].x);
   out[i] = (float4)(e.e_o, e.e_avg, e.e5_o, e.e5_avg);
@@ -20,8 +19,7 @@ __kernel void test_energy_quadrature(__global const float2* queries, uint n, __g
 // F = (1 - wo.h)^5 (fresnel5 = 1) from half vectors distributed as D(h) cos theta_h (Walter
 // et al. 2007), not the visible normals the table integrates over: work-item i draws n of
 // them and writes their sum and sum of squares
-__kernel void test_energy_albedo_mc(float mu, float roughness, uint fresnel5, uint seed, uint n,
-                                    __global float2* out) {
+__kernel void test_energy_albedo_mc(float mu, float roughness, uint fresnel5, uint seed, uint n, __global float2* out) {
   uint i = get_global_id(0);
   Rng rng = rng_init(i, 0u, seed);
   Ggx g = ggx_from_roughness(roughness, 0.0f);
@@ -48,8 +46,7 @@ __kernel void test_energy_albedo_mc(float mu, float roughness, uint fresnel5, ui
 
 // Material 0 at a point of normal +z and tangent +x seen from wo (above), with the table
 // if asked: a scene of the material table alone
-Bsdf test_energy_bsdf(__global const Material* materials, __global const float* table, uint with_table,
-                      float3 wo) {
+Bsdf test_energy_bsdf(__global const Material* materials, __global const float* table, uint with_table, float3 wo) {
   SceneData sc = {CD_SCENE_BUFFERS(TEST_ENERGY_NO_BUFFER) 0};
   sc.materials = materials;
   if (with_table) sc.ggx_albedo = table;
@@ -68,8 +65,8 @@ Bsdf test_energy_bsdf(__global const Material* materials, __global const float* 
 // Sample i of bsdf_sample from wo, (uc, u.x, u.y) from rng_init(i, 0, seed): out[3i..3i+2] =
 // (wi, pdf), (f, 1 for a non-delta reflection within bsdf_flags, else 0), (bsdf_eval,
 // bsdf_pdf) at wi; all zero where sampling fails
-__kernel void test_energy_sample(__global const Material* materials, __global const float* table,
-                                 uint with_table, float4 wo, uint seed, __global float4* out) {
+__kernel void test_energy_sample(__global const Material* materials, __global const float* table, uint with_table,
+                                 float4 wo, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo.xyz);
   BsdfSample bs;
@@ -86,8 +83,8 @@ __kernel void test_energy_sample(__global const Material* materials, __global co
 }
 
 // The weight f |cos| / pdf of sample i of bsdf_sample from wo (0 where sampling fails)
-__kernel void test_energy_albedo(__global const Material* materials, __global const float* table,
-                                 uint with_table, float4 wo, uint seed, __global float4* out) {
+__kernel void test_energy_albedo(__global const Material* materials, __global const float* table, uint with_table,
+                                 float4 wo, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo.xyz);
   BsdfSample bs;
@@ -96,8 +93,8 @@ __kernel void test_energy_albedo(__global const Material* materials, __global co
 }
 
 // (bsdf_eval, bsdf_pdf) for the pairs (wo, wi) = (pairs[2i], pairs[2i + 1])
-__kernel void test_energy_eval(__global const Material* materials, __global const float* table,
-                               uint with_table, __global const float4* pairs, __global float4* out) {
+__kernel void test_energy_eval(__global const Material* materials, __global const float* table, uint with_table,
+                               __global const float4* pairs, __global float4* out) {
   uint i = get_global_id(0);
   float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo);

@@ -16,8 +16,7 @@ __kernel void test_fresnel_refract(__global const float4* in, __global float4* o
 }
 
 // cos_i[i] -> fresnel_conductor(cos_i, eta, k) per channel
-__kernel void test_fresnel_conductor(float4 eta, float4 k, __global const float* cos_i,
-                                     __global float4* out) {
+__kernel void test_fresnel_conductor(float4 eta, float4 k, __global const float* cos_i, __global float4* out) {
   uint i = get_global_id(0);
   out[i] = (float4)(fresnel_conductor(cos_i[i], eta.xyz, k.xyz), 0.0f);
 }

@@ -50,21 +50,19 @@ double gaussian_cdf(double x) { return 0.5 * std::erfc(-x / (0.5 * std::sqrt(2.0
 
 // Pearson's test of 2D offsets on a grid of `bins` x `bins` cells over [-extent, extent]^2
 // plus open cells beyond it, against the product of the marginal CDFs (a separable density)
-ChiSquare offsets_chi_square(const std::vector<cl_float2>& xy, const std::function<double(double)>& cdf,
-                             double extent, int bins) {
+ChiSquare offsets_chi_square(const std::vector<cl_float2>& xy, const std::function<double(double)>& cdf, double extent,
+                             int bins) {
   std::vector<double> edges = {-INFINITY};
   for (int i = 0; i <= bins; ++i) edges.push_back(-extent + 2.0 * extent * i / bins);
   edges.push_back(INFINITY);
   const int cells = int(edges.size()) - 1;
-  auto cell = [&](double v) {
-    return int(std::upper_bound(edges.begin(), edges.end(), v) - edges.begin()) - 1;
-  };
+  auto cell = [&](double v) { return int(std::upper_bound(edges.begin(), edges.end(), v) - edges.begin()) - 1; };
   std::vector<double> observed(size_t(cells * cells), 0.0), expected(observed.size());
   for (const cl_float2& p : xy) observed[size_t(cell(p.s[1]) * cells + cell(p.s[0]))] += 1.0;
   for (int j = 0; j < cells; ++j)
     for (int i = 0; i < cells; ++i)
-      expected[size_t(j * cells + i)] = double(xy.size()) * (cdf(edges[i + 1]) - cdf(edges[i])) *
-                                        (cdf(edges[j + 1]) - cdf(edges[j]));
+      expected[size_t(j * cells + i)] =
+          double(xy.size()) * (cdf(edges[i + 1]) - cdf(edges[i])) * (cdf(edges[j + 1]) - cdf(edges[j]));
   return chi_square_test(observed, expected);
 }
 
@@ -97,9 +95,7 @@ TEST(PixelFilter, SampledOffsetsFollowTheFilterDensity) {
   }
 }
 
-TEST(PixelFilter, BoxIsTheDefault) {
-  EXPECT_EQ(RenderSettings().filter, PixelFilter::Box);
-}
+TEST(PixelFilter, BoxIsTheDefault) { EXPECT_EQ(RenderSettings().filter, PixelFilter::Box); }
 
 // Uniform on the unit disk: r^2 and the angle are independent and uniform
 TEST(ThinLens, ConcentricDiskIsUniform) {
@@ -350,7 +346,8 @@ std::string write_camera_scene(const std::string& name, const nlohmann::json& ca
 
 TEST(GltfCamera, OrthographicCameraIsRead) {
   Scene s = load_gltf(write_camera_scene(
-      "ortho.gltf", {{"type", "orthographic"}, {"orthographic", {{"xmag", 3.0}, {"ymag", 1.5}, {"znear", 0.1}, {"zfar", 10.0}}}}));
+      "ortho.gltf",
+      {{"type", "orthographic"}, {"orthographic", {{"xmag", 3.0}, {"ymag", 1.5}, {"znear", 0.1}, {"zfar", 10.0}}}}));
   ASSERT_TRUE(s.camera.has_value());
   EXPECT_EQ(s.camera->projection, Projection::Orthographic);
   EXPECT_FLOAT_EQ(s.camera->ymag, 1.5f);

@@ -45,8 +45,8 @@ std::string net_failure(const cl_uint* x, const cl_uint* y, size_t stride, size_
       uint64_t cx = k == 0 ? 0 : x[i * stride] >> (32 - k);
       uint64_t cy = k == m ? 0 : y[i * stride] >> (32 - (m - k));
       if (++count[(cx << (m - k)) | cy] > 1)
-        return "m " + std::to_string(m) + ", intervals 2^-" + std::to_string(k) + " x 2^-" +
-               std::to_string(m - k) + ": two points in one";
+        return "m " + std::to_string(m) + ", intervals 2^-" + std::to_string(k) + " x 2^-" + std::to_string(m - k) +
+               ": two points in one";
     }
   }
   return "";
@@ -149,8 +149,8 @@ TEST_P(SamplerTest, PointsAreJitteredWithinTheirStrata) {
       sum_var += (s2 - s1 * s1 / samples) / (samples - 1);
     }
     double mean_var = sum_var / pixels;
-    EXPECT_NEAR(mean_var, 1.0 / 12.0, 0.006) << "dimension " << d << " (coordinate " << d % 2 << " of pair "
-                                             << d / 2 << ")";
+    EXPECT_NEAR(mean_var, 1.0 / 12.0, 0.006)
+        << "dimension " << d << " (coordinate " << d % 2 << " of pair " << d / 2 << ")";
   }
 }
 
@@ -190,8 +190,8 @@ TEST_P(SamplerTest, InterfaceLaysDimensionsOutInPairs) {
   enum Op : cl_uint { kFloat = 0, kUint = 1, kPoint = 2 };
   // pixel position, then twice: light selection, light point, BSDF component and
   // direction, roulette
-  const std::vector<cl_uint> ops = {kFloat, kFloat, kUint, kPoint, kFloat, kPoint, kFloat,
-                                    kUint, kPoint, kFloat, kPoint, kFloat};
+  const std::vector<cl_uint> ops = {kFloat, kFloat, kUint,  kPoint, kFloat, kPoint,
+                                    kFloat, kUint,  kPoint, kFloat, kPoint, kFloat};
   // 1D draws 0, 1, 2, ... are dimensions 0, 1, 4, 5, 8, 9, ...; 2D draws are (2, 3), (6, 7), ...
   const std::vector<cl_uint> dim_of = {0, 1, 4, 2, 3, 5, 6, 7, 8, 9, 10, 11, 12, 14, 15, 13};
   const std::vector<size_t> points = {3, 6, 10, 13};  // outputs where a 2D point starts
@@ -243,10 +243,10 @@ TEST(SamplerConvergence, SobolBeatsIndependentOnAnAreaLitFloor) {
   std::string path = ::testing::TempDir() + "sampler-floor.gltf";
   const float h = 0.6f, s = 0.2f, o = 0.08f, oh = 0.3f;
   std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),        // floor, facing +y
-      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1),        // light, facing -y
+      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),       // floor, facing +y
+      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1),       // light, facing -y
       quad_primitive({{-o, oh, o}, {o, oh, o}, {o, oh, -o}, {-o, oh, -o}}, 0)};  // occluder
-  GltfBuilder g;  // black background
+  GltfBuilder g;                                                                 // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([
     {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},

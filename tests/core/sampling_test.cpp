@@ -31,8 +31,8 @@ std::vector<cl_float4> run_direction_kernel(KernelRig& rig, cl_uint which, cl_ui
 }
 
 // Histogram over (cos theta, phi) cells against the pdf integrated over each cell
-ChiSquare direction_chi_square(const std::vector<cl_float4>& dirs, double cos_lo, int n_cos,
-                               int n_phi, double (*cell_prob)(double, double, double)) {
+ChiSquare direction_chi_square(const std::vector<cl_float4>& dirs, double cos_lo, int n_cos, int n_phi,
+                               double (*cell_prob)(double, double, double)) {
   std::vector<double> observed(n_cos * n_phi, 0.0), expected(n_cos * n_phi, 0.0);
   double dphi = 2.0 * kPi / n_phi, dcos = (1.0 - cos_lo) / n_cos;
   for (const auto& d : dirs) {

@@ -3,8 +3,8 @@
 // Work-item i draws `dims` dimensions (32-bit fractions) of sample sample_begin + i % samples
 // of pixel pixel_begin + i / samples into out[i * dims + d]; which: 0 the Sobol sampler
 // (dimension d is coordinate d % 2 of pair d / 2), 1 the independent one
-__kernel void test_sampler_draw(uint which, uint pixel_begin, uint sample_begin, uint samples, uint seed,
-                                uint dims, __global uint* out) {
+__kernel void test_sampler_draw(uint which, uint pixel_begin, uint sample_begin, uint samples, uint seed, uint dims,
+                                __global uint* out) {
   uint i = get_global_id(0);
   uint pixel = pixel_begin + i / samples, sample = sample_begin + i % samples;
   if (which == 0u) {

@@ -18,8 +18,7 @@ __kernel void test_sample_direction(uint which, uint seed, __global float4* out)
 }
 
 // Uniform point on triangle v0 v1 v2, written as a 3D point
-__kernel void test_sample_triangle(uint seed, float4 v1, float4 v2, float4 v3,
-                                   __global float4* out) {
+__kernel void test_sample_triangle(uint seed, float4 v1, float4 v2, float4 v3, __global float4* out) {
   uint i = get_global_id(0);
   Rng rng = rng_init(i, 0u, seed);
   float u = rng_next(&rng), v = rng_next(&rng);

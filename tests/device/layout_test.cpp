@@ -16,10 +16,10 @@ TEST_P(LayoutTest, DeviceStructLayoutMatchesHost) {
   using namespace dev;
   std::vector<cl_uint> want;
   std::vector<std::string> names;
-#define WANT_SIZE(type, bytes)   \
+#define WANT_SIZE(type, bytes)  \
   want.push_back(sizeof(type)); \
   names.push_back("sizeof(" #type ")");
-#define WANT_FIELD(type, field, offset)     \
+#define WANT_FIELD(type, field, offset)  \
   want.push_back(offsetof(type, field)); \
   names.push_back("offsetof(" #type ", " #field ")");
   CD_LAYOUT(WANT_SIZE, WANT_FIELD)

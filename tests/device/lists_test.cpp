@@ -65,8 +65,8 @@ TEST(Lists, NameTablesFollowTheLists) {
   }
   EXPECT_EQ(dev::light_type_name(dev::kLightTypeCount), nullptr);
   ASSERT_EQ(std::size(dev::kSceneFeatureNames), kFeatures.size());
-  EXPECT_EQ(SceneFeatures::all().names(), std::vector<std::string>(std::begin(dev::kSceneFeatureNames),
-                                                                    std::end(dev::kSceneFeatureNames)));
+  EXPECT_EQ(SceneFeatures::all().names(),
+            std::vector<std::string>(std::begin(dev::kSceneFeatureNames), std::end(dev::kSceneFeatureNames)));
   EXPECT_TRUE(SceneFeatures().names().empty());
 }
 

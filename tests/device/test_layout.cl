@@ -3,9 +3,9 @@
 // Sizes and offsets of the shared structs as the device compiler lays them out, in the
 // order of CD_LAYOUT (device_types.h), the list the host's static_asserts come from
 #define TEST_LAYOUT_SIZE(type, bytes) out[n++] = (uint)sizeof(type);
-#define TEST_LAYOUT_FIELD(type, field, offset) \
-  {                                            \
-    type object;                               \
+#define TEST_LAYOUT_FIELD(type, field, offset)                \
+  {                                                           \
+    type object;                                              \
     out[n++] = (uint)((char*)&object.field - (char*)&object); \
   }
 __kernel void test_struct_layout(__global uint* out) {

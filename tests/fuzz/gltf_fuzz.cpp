@@ -10,11 +10,11 @@
 #include <cstdlib>
 #include <string>
 
+#include "base/error.hpp"
 #include "compile/bvh_builder.hpp"
 #include "compile/camera.hpp"
-#include "base/error.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "compile/scene_compiler.hpp"
+#include "gltf/gltf_loader.hpp"
 
 namespace {
 
@@ -65,15 +65,15 @@ void check_compiled(const candela::CompiledScene& c, const candela::CameraDesc& 
     pmf += l.pmf;
   }
   require(b.lights.empty() || std::fabs(pmf - 1.0) < 1e-4, "light pmfs sum to 1");
-  require(c.environment_light == NO_LIGHT ||
-              (c.environment_light >= 0 && size_t(c.environment_light) < b.lights.size()),
-          "environment light index");
+  require(
+      c.environment_light == NO_LIGHT || (c.environment_light >= 0 && size_t(c.environment_light) < b.lights.size()),
+      "environment light index");
   for (const auto& t : b.bvh_tris) require(t.prim < b.prims.size(), "BVH triangle prim");
   require(!b.bvh_nodes.empty(), "BVH root");
   for (const auto& n : b.bvh_nodes)
     for (int i = 0; i < 4; ++i) {
       if (n.lo_x[i] > n.hi_x[i]) continue;  // unused slot
-      if (n.child[i] < 0) {  // leaf run: ends at a BVH_TRI_LAST triangle inside the array
+      if (n.child[i] < 0) {                 // leaf run: ends at a BVH_TRI_LAST triangle inside the array
         size_t t = size_t(~n.child[i]);
         while (t < b.bvh_tris.size() && !(b.bvh_tris[t].flags & BVH_TRI_LAST)) ++t;
         require(t < b.bvh_tris.size(), "BVH leaf range");

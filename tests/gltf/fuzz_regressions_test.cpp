@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "base/error.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "compile/scene_compiler.hpp"
+#include "gltf/gltf_loader.hpp"
 
 namespace fs = std::filesystem;
 

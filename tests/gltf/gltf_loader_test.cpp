@@ -35,7 +35,8 @@ GltfBuilder quad_gltf(const GltfBuilder::Primitive& prim = quad()) {
 class TempDir {
  public:
   TempDir() {
-    path = fs::temp_directory_path() / ("candela-gltf-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
+    path = fs::temp_directory_path() /
+           ("candela-gltf-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
     fs::create_directories(path);
   }
   ~TempDir() { fs::remove_all(path); }
@@ -139,7 +140,11 @@ TEST(GltfLoader, GeneratesTangentsForNormalMapsWithoutTangent) {
     p.normals.assign(4, glm::vec3(0, 0, 1));
     if (mirrored) p.uvs = {{1, 1}, {0, 1}, {0, 0}, {1, 0}};
     json j = quad_gltf(p).document();
-    j["images"] = {{{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="}}};
+    j["images"] = {
+        {{"uri",
+          "data:image/"
+          "png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg="
+          "="}}};
     j["textures"] = {{{"source", 0}}};
     j["materials"][0]["normalTexture"] = {{"index", 0}};
     Scene s = load_gltf(dir.write(mirrored ? "m.gltf" : "n.gltf", j.dump()));
@@ -192,7 +197,8 @@ TEST(GltfLoader, TextureTransformAppliesToUvs) {
   json j = g.document();
   j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {
       {"index", 0},
-      {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}, {"scale", {2, 2}}, {"rotation", 1.5707963267948966}}}}}};
+      {"extensions",
+       {{"KHR_texture_transform", {{"offset", {0.5, 0}}, {"scale", {2, 2}}, {"rotation", 1.5707963267948966}}}}}};
   // The image cannot be read: the loader says so and drops the texture, not the scene
   Scene missing = load_gltf(dir.write("tt.gltf", j.dump()));
   EXPECT_EQ(missing.materials[0].texture(TEX_BASE_COLOR).index, NO_TEXTURE);
@@ -258,7 +264,11 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   j["materials"][0]["occlusionTexture"] = {{"index", 0}};
   j["materials"][1]["occlusionTexture"] = {{"index", 0}};
   j["textures"] = {{{"source", 0}}};
-  j["images"] = {{{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="}}};
+  j["images"] = {
+      {{"uri",
+        "data:image/"
+        "png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg="
+        "="}}};
   Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
   int sheen = 0, occlusion = 0;
   for (const auto& w : s.warnings) {
@@ -320,7 +330,10 @@ TEST(GltfLoader, BaseColorTextureIsSrgbDecodedAndRendered) {
   j["materials"][0]["doubleSided"] = true;
   Scene s = load_gltf(dir.write("textured.gltf", j.dump()));
   ASSERT_EQ(s.textures.size(), 1u);
-  auto srgb = [](double c) { c /= 255.0; return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+  auto srgb = [](double c) {
+    c /= 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  };
   const TextureDesc& tex = s.textures[0];
   ASSERT_EQ(tex.rgba8.size(), 8u);  // RGBA8, decoded from sRGB in the kernel
   EXPECT_TRUE(tex.srgb);
@@ -379,9 +392,8 @@ TEST(GltfLoader, AccessorWithoutBufferViewReadsAsZeros) {
   j["accessors"][1].erase("bufferView");
   json& pos = j["accessors"][0];
   pos.erase("bufferView");
-  pos["sparse"] = {{"count", 3},
-                   {"indices", {{"bufferView", 2}, {"componentType", 5123}}},
-                   {"values", {{"bufferView", 0}}}};
+  pos["sparse"] = {
+      {"count", 3}, {"indices", {{"bufferView", 2}, {"componentType", 5123}}}, {"values", {{"bufferView", 0}}}};
   Scene s = load_gltf(dir.write("zeros.gltf", j.dump()));
   ASSERT_EQ(s.meshes.size(), 1u);
   const MeshDesc& m = s.meshes[0];
@@ -403,7 +415,7 @@ TEST(GltfLoader, UndecodableImagesFallBackToTheCoreSourceOrAreDropped) {
   ASSERT_FALSE(write_png(dir, "white.png", 1, 1, 3, white).empty());
   dir.write("fake.webp", std::string("RIFF\x24\0\0\0WEBPVP8 \x18\0\0\0", 20) + std::string(24, '\0'));
   const unsigned char png_header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
-  std::string ihdr_small = std::string("\0\0\0\4\0\0\0\4\x08\x06\0\0\0", 13);  // 4 x 4, RGBA8
+  std::string ihdr_small = std::string("\0\0\0\4\0\0\0\4\x08\x06\0\0\0", 13);         // 4 x 4, RGBA8
   std::string ihdr_huge = std::string("\0\0\x9c\x40\0\0\x9c\x40\x08\x06\0\0\0", 13);  // 40000 x 40000
   std::string header(reinterpret_cast<const char*>(png_header), sizeof png_header);
   dir.write("corrupt.png", header + ihdr_small + "not a zlib stream at all");

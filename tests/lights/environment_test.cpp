@@ -17,12 +17,12 @@
 #include <map>
 #include <memory>
 
-#include "scene/environment.hpp"
 #include "base/error.hpp"
-#include "support/gltf_builder.hpp"
+#include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
-#include "compile/scene_compiler.hpp"
+#include "scene/environment.hpp"
+#include "support/gltf_builder.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
@@ -277,15 +277,15 @@ TEST_P(EnvironmentKernels, MappingAndRotation) {
     glm::dvec3 dir;
     int x, y;
   } cases[] = {
-      {0.0f, {std::sin(a), std::sin(a), -1.0}, 8, 3},  // just right of -Z, just above the horizon
+      {0.0f, {std::sin(a), std::sin(a), -1.0}, 8, 3},    // just right of -Z, just above the horizon
       {0.0f, {-std::sin(a), -std::sin(a), -1.0}, 7, 4},  // just left of -Z, just below
-      {0.0f, {1.0, 0.3, std::sin(a)}, 12, 3},  // +X (u = 3/4), a little toward +Z (u = 1)
-      {0.0f, {-1.0, 0.3, std::sin(a)}, 3, 3},  // -X (u = 1/4), a little toward +Z (u = 0)
-      {0.0f, {0.0, 1.0, 0.1}, 0, 0},  // near the zenith: the top row
-      {0.0f, {0.0, -1.0, 0.1}, 0, 7},  // near the nadir: the bottom row (phi = 0 at +Z)
+      {0.0f, {1.0, 0.3, std::sin(a)}, 12, 3},            // +X (u = 3/4), a little toward +Z (u = 1)
+      {0.0f, {-1.0, 0.3, std::sin(a)}, 3, 3},            // -X (u = 1/4), a little toward +Z (u = 0)
+      {0.0f, {0.0, 1.0, 0.1}, 0, 0},                     // near the zenith: the top row
+      {0.0f, {0.0, -1.0, 0.1}, 0, 7},                    // near the nadir: the bottom row (phi = 0 at +Z)
       {90.0f, {-1.0, std::sin(a), -std::sin(a)}, 8, 3},  // rotated: -Z's view is now at -X
       {90.0f, {std::sin(a), std::sin(a), -1.0}, 12, 3},  // and +X's at -Z
-      {-90.0f, {1.0, std::sin(a), std::sin(a)}, 8, 3},  // the other way round: at +X
+      {-90.0f, {1.0, std::sin(a), std::sin(a)}, 8, 3},   // the other way round: at +X
   };
   for (float rotation : {0.0f, 90.0f, -90.0f}) {
     use(env_of(map, 2.0f, rotation));
@@ -363,7 +363,7 @@ TEST(EnvironmentRender, TinySunNeeAgreesWithBsdfAndHasLowerVariance) {
   double per_sample_nee = a.standard_error * std::sqrt(double(nee_spp));
   double per_sample_bsdf = b.standard_error * std::sqrt(double(bsdf_spp));
   RecordProperty("means", "nee " + std::to_string(a.mean) + " +- " + std::to_string(a.standard_error) + ", bsdf " +
-                             std::to_string(b.mean) + " +- " + std::to_string(b.standard_error));
+                              std::to_string(b.mean) + " +- " + std::to_string(b.standard_error));
   RecordProperty("se_ratio", std::to_string(per_sample_bsdf / per_sample_nee));
   EXPECT_GT(per_sample_bsdf, 5.0 * per_sample_nee) << "nee " << per_sample_nee << " bsdf " << per_sample_bsdf;
   EXPECT_EQ(nee.dropped_samples(), 0u);
@@ -443,8 +443,12 @@ TEST(EnvironmentLoader, SceneExtras) {
 TEST(EnvironmentLoader, BuiltinSky) {
   EnvironmentDesc sky = builtin_sky();
   const TextureDesc& t = sky.image;
-  auto texel = [&](int y) { return glm::vec3(t.rgbaf[4 * size_t(y) * t.width], t.rgbaf[4 * size_t(y) * t.width + 1], t.rgbaf[4 * size_t(y) * t.width + 2]); };
-  glm::vec3 zenith = texel(0), above = texel(t.height / 2 - 1), below = texel(t.height / 2), nadir = texel(t.height - 1);
+  auto texel = [&](int y) {
+    return glm::vec3(t.rgbaf[4 * size_t(y) * t.width], t.rgbaf[4 * size_t(y) * t.width + 1],
+                     t.rgbaf[4 * size_t(y) * t.width + 2]);
+  };
+  glm::vec3 zenith = texel(0), above = texel(t.height / 2 - 1), below = texel(t.height / 2),
+            nadir = texel(t.height - 1);
   EXPECT_NEAR(above.x, 1.0f, 0.02f);
   EXPECT_GT(zenith.z, zenith.x);
   EXPECT_GT(zenith.z, above.z);

@@ -62,8 +62,7 @@ std::vector<glm::vec3> quad_light() {
 Scene quad_scene() {
   Scene s = with_materials(glm::vec3(2.0f));
   add_polygon(&s, quad_light(), 1);
-  add_polygon(&s, parallelogram({0.1f, 0.05f, 0.6f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.15f, 0.15f),
-              0);
+  add_polygon(&s, parallelogram({0.1f, 0.05f, 0.6f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.15f, 0.15f), 0);
   return s;
 }
 const Context kQuadContext{{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, false};
@@ -81,8 +80,7 @@ const Context kEnvTransmits{{0.0, 0.0, 0.0}, kTilted, true};
 const Context kEnvMedium{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, false};
 
 // (c) A small triangle light and the environment, above a floor
-const std::vector<glm::vec3> kSmallTriangle = {
-    {0.6f, 0.3f, 1.8f}, {0.75f, 0.65f, 1.9f}, {1.05f, 0.35f, 1.7f}};
+const std::vector<glm::vec3> kSmallTriangle = {{0.6f, 0.3f, 1.8f}, {0.75f, 0.65f, 1.9f}, {1.05f, 0.35f, 1.7f}};
 Scene mixture_scene() {
   Scene s = with_materials(glm::vec3(800.0f));
   s.background = glm::vec3(1.0f);
@@ -164,8 +162,7 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
         for (int i = 0; i < g.n_cos; ++i)
           for (int j = 0; j < g.n_phi; ++j) {
             double dc = (g.c_hi - g.c_lo) / g.n_cos, dp = 2.0 * kPi / g.n_phi;
-            v.push_back(
-                {{float(g.c_lo + i * dc), float(g.c_lo + (i + 1) * dc), float(j * dp), float((j + 1) * dp)}});
+            v.push_back({{float(g.c_lo + i * dc), float(g.c_lo + (i + 1) * dc), float(j * dp), float((j + 1) * dp)}});
           }
       return v;
     }
@@ -188,8 +185,7 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
   };
 
   // Probability of each cell under the summed lights_pdf (mode 1: the wrong pdf)
-  std::vector<double> cell_probabilities(const Context& c, const Histogram& h, cl_uint mode = 0,
-                                         cl_uint sub = 32) {
+  std::vector<double> cell_probabilities(const Context& c, const Histogram& h, cl_uint mode = 0, cl_uint sub = 32) {
     std::vector<cl_float4> cells = h.cells();
     cl::Buffer cb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, cells.size() * sizeof(cl_float4),
                   cells.data());
@@ -211,8 +207,7 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
 
   // Chi-square of the sampled directions against cell probabilities (renormalized when
   // `normalize`); samples that lights_sample rejected are left out (measure zero)
-  static ChiSquare chi_square(const Samples& s, const Histogram& h, std::vector<double> prob,
-                              bool normalize = false) {
+  static ChiSquare chi_square(const Samples& s, const Histogram& h, std::vector<double> prob, bool normalize = false) {
     std::vector<double> observed(prob.size(), 0.0);
     double kept = 0.0;
     for (size_t i = 0; i < s.size(); ++i) {
@@ -394,8 +389,8 @@ TEST_P(LightsTest, SamplePdfMatchesLightsPdf) {
       if (!(f & kCompared)) continue;
       ++compared;
       if (!(std::fabs(s.pdf_eval(i) - s.pdf(i)) <= 1e-3 * s.pdf(i)) && mismatched++ < 5)
-        ADD_FAILURE() << "sample " << i << " light " << s.light(i) << ": ls.pdf " << s.pdf(i)
-                      << " lights_pdf " << s.pdf_eval(i);
+        ADD_FAILURE() << "sample " << i << " light " << s.light(i) << ": ls.pdf " << s.pdf(i) << " lights_pdf "
+                      << s.pdf_eval(i);
       // Seen from the front: the material's emission; the environment: its radiance
       double want = l.type == LIGHT_ENVIRONMENT ? l.radiance[0] : cs.scene.materials[1].emission.x;
       ASSERT_FLOAT_EQ(s.radiance(i), want) << "sample " << i;
@@ -422,8 +417,7 @@ TEST_P(LightsTest, EnvironmentIrradianceEstimate) {
   for (const auto& cs : cases) {
     Samples s = sample(cs.c, seed++);
     auto [mean, se] = irradiance_estimate(s, cs.c.n);
-    EXPECT_NEAR(mean, cs.want, 4.0 * se + 1e-5 * cs.want)
-        << "transmits " << cs.c.transmits << " n " << cs.c.n.z;
+    EXPECT_NEAR(mean, cs.want, 4.0 * se + 1e-5 * cs.want) << "transmits " << cs.c.transmits << " n " << cs.c.n.z;
   }
 }
 

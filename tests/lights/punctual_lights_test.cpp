@@ -17,9 +17,9 @@
 #include <memory>
 
 #include "base/error.hpp"
+#include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
-#include "compile/scene_compiler.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -151,7 +151,8 @@ class PunctualRender : public ::testing::TestWithParam<std::string> {
       double m = f.pixel(i)[c], se_measured = std::sqrt(double(f.variance_of_mean(i)[c]));
       double se = std::max(se_measured, std::sqrt(var[c] / spp));
       EXPECT_NEAR(m, e[c], 5.0 * se + 2e-4 * e[c] + 1e-7)
-          << "pixel " << x << "," << y << " channel " << c << " se " << se_measured << " (model " << std::sqrt(var[c] / spp) << ")";
+          << "pixel " << x << "," << y << " channel " << c << " se " << se_measured << " (model "
+          << std::sqrt(var[c] / spp) << ")";
       if (se > 0.0) max_z_ = std::max(max_z_, std::fabs(m - e[c]) / se);
     }
   }
@@ -291,8 +292,11 @@ TEST_P(PunctualRender, DirectionalLightGivesECosineAndHardShadows) {
   Scene s = plane_scene(l);
   // A 0.6 x 0.6 blocker at height 1 over x = 1: its shadow is offset by -tan(theta)
   const double bx = 1.0, half = 0.3, bz = 1.0;
-  add_quad(&s, {{float(bx - half), -float(half), float(bz)}, {float(bx + half), -float(half), float(bz)},
-                {float(bx + half), float(half), float(bz)}, {float(bx - half), float(half), float(bz)}},
+  add_quad(&s,
+           {{float(bx - half), -float(half), float(bz)},
+            {float(bx + half), -float(half), float(bz)},
+            {float(bx + half), float(half), float(bz)},
+            {float(bx - half), float(half), float(bz)}},
            0);
   CameraDesc cam = camera({0.0f, -3.0f, 2.5f}, {0.3f, 0.0f, 0.0f}, 0.6f);
   View view(cam, 20);
@@ -565,10 +569,10 @@ TEST(PunctualLoader, MalformedLightsAreClearErrors) {
   auto one = [](const char* text) { return json::parse(text); };
   EXPECT_NE(error_of(one(R"([{"type": "point", "intensity": -1}])"), light_node(0)).find("intensity"),
             std::string::npos);
-  EXPECT_NE(error_of(one(R"([{"type": "spot", "spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.4}}])"),
-                     light_node(0))
-                .find("cone"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(one(R"([{"type": "spot", "spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.4}}])"), light_node(0))
+          .find("cone"),
+      std::string::npos);
   EXPECT_NE(error_of(one(R"([{"type": "spot", "spot": {"outerConeAngle": 2.0}}])"), light_node(0)).find("cone"),
             std::string::npos);
   EXPECT_NE(error_of(one(R"([{"type": "spot", "spot": {"innerConeAngle": -0.1}}])"), light_node(0)).find("cone"),

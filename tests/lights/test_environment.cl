@@ -11,8 +11,8 @@ float3 test_environment_direction(float theta, float phi) {
 
 // One sample per work-item: out[2i] = (dir, pdf), out[2i+1] = (environment_pdf(dir),
 // radiance rgb); the light is the scene's environment light
-__kernel void test_environment_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                      uint seed, __global float4* out) {
+__kernel void test_environment_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, uint seed,
+                                      __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   __global const Light* env = &sc.lights[params->environment_light];
@@ -31,9 +31,8 @@ __kernel void test_environment_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global 
 // about +Y: midpoint rule on sub x sub points uniform in (theta, phi), where
 // dw = sin(theta) dtheta dphi. mode 1: a deliberately wrong pdf without the 1 / sin(theta)
 // of the (u, v) -> direction Jacobian.
-__kernel void test_environment_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                         uint sub, uint mode, __global const float4* cells,
-                                         __global float* out) {
+__kernel void test_environment_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, uint sub,
+                                         uint mode, __global const float4* cells, __global float* out) {
   uint c = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   __global const Light* env = &sc.lights[params->environment_light];

@@ -2,8 +2,8 @@
 // context on a compiled scene, bound as render_paths binds it.
 
 // Flags of test_lights_sample
-#define TL_OK 1u  // lights_sample returned true
-#define TL_COMPARED 2u  // the ray along wi first meets the chosen light (escapes: environment)
+#define TL_OK 1u            // lights_sample returned true
+#define TL_COMPARED 2u      // the ray along wi first meets the chosen light (escapes: environment)
 #define TL_SHADOW_CLEAR 4u  // the integrator's shadow ray toward ls.target is unoccluded
 #define TL_AT_INFINITY 8u
 #define TL_DELTA 16u
@@ -20,9 +20,8 @@ LightSampleContext test_lights_context(float4 p, float4 n, uint transmits) {
 // One light sample per work-item. out[2i] = (wi, pdf); out[2i+1] = (radiance.x,
 // lights_pdf(chosen light, wi), chosen light, flags); `check` = 0 skips lights_pdf and
 // the traced rays (pdf_eval 0, no TL_COMPARED / TL_SHADOW_CLEAR)
-__kernel void test_lights_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                 float4 p, float4 n, uint transmits, uint seed, uint check,
-                                 __global float4* out) {
+__kernel void test_lights_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 p,
+                                 float4 n, uint transmits, uint seed, uint check, __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   LightSampleContext ctx = test_lights_context(p, n, transmits);
@@ -64,9 +63,8 @@ __kernel void test_lights_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const
 // (ft, fb, fa) of the sum over lights of lights_pdf: midpoint rule on sub x sub points
 // uniform in (cos theta, phi), where dw = dcos dphi.
 // mode 1: a deliberately wrong pdf, triangle lights without the cosine of dw/dA.
-__kernel void test_lights_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                    float4 p, float4 n, uint transmits, float4 ft, float4 fb,
-                                    float4 fa, uint sub, uint mode,
+__kernel void test_lights_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 p,
+                                    float4 n, uint transmits, float4 ft, float4 fb, float4 fa, uint sub, uint mode,
                                     __global const float4* cells, __global float* out) {
   uint c = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};

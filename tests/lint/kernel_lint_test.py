@@ -112,6 +112,8 @@ def list_entries(body):
 def defines_above(text, name):
     """(macro, value) of the run of `#define MACRO <n>u` lines right above `#define name(X)`."""
     lines = text[:text.find('#define ' + name + '(')].rstrip('\n').split('\n')
+    while lines and lines[-1].lstrip().startswith('//'):  # comments between (clang-format off)
+        lines.pop()
     run = []
     while lines and re.match(r'#define \w+ \d+u\b', lines[-1]):
         m = re.match(r'#define (\w+) (\d+)u\b', lines.pop())

@@ -20,8 +20,8 @@ __kernel void test_phase_eval(float g, float4 wo, __global const float4* dirs, _
 
 // media_shadow_transmittance from org along dir up to tmax (through null boundaries),
 // starting in the media org lies in (media_at_origin), one estimate per work-item
-__kernel void test_media_transmittance(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                       float4 org, float4 dir, float tmax, uint seed, __global float4* out) {
+__kernel void test_media_transmittance(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 org,
+                                       float4 dir, float tmax, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   Rng rng = rng_init(i, 0u, seed);
@@ -36,8 +36,8 @@ __kernel void test_media_transmittance(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global
 // whichever is nearer, media_sample_segment samples where the path scatters next.
 // out[i] = (beta, event): event MEDIUM_PASSED (0) means the flight reached the end, and
 // beta is the weight it carries there (1 for grey media).
-__kernel void test_media_free_flight(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                                     float4 org, float4 dir, float tmax, uint seed, __global float4* out) {
+__kernel void test_media_free_flight(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 org,
+                                     float4 dir, float tmax, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   Rng rng = rng_init(i, 0u, seed);

@@ -18,11 +18,11 @@
 #include <random>
 
 #include "base/error.hpp"
-#include "support/gltf_builder.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
-#include "support/test_support.hpp"
 #include "scene/vdb_grid.hpp"
+#include "support/gltf_builder.hpp"
+#include "support/test_support.hpp"
 
 #ifdef CANDELA_HAVE_OPENVDB
 #include <nanovdb/util/IO.h>
@@ -37,9 +37,9 @@ namespace {
 
 using nlohmann::json;
 
-
 json medium_with_grid(glm::vec3 sigma_a, glm::vec3 sigma_s, const json& grid) {
-  return {{"sigma_a", {sigma_a.x, sigma_a.y, sigma_a.z}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"grid", grid}};
+  return {
+      {"sigma_a", {sigma_a.x, sigma_a.y, sigma_a.z}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"grid", grid}};
 }
 
 // A null boundary (a box of the medium) around [-3, 3]^3, which holds every grid here
@@ -239,7 +239,8 @@ TEST_P(VolumeVdbRamp, RatioTrackingMatchesTheDensityIntegral) {
     glm::dvec3 org, dir;
   };
   glm::dvec3 through = glm::normalize(inside(104, 4, 4) - inside(-3, 12, 12));
-  for (const Ray& r : {Ray{inside(-3, 12, 12), through}, Ray{inside(30, 30, -4), glm::normalize(inside(32, -2, 25) - inside(30, 30, -4))}}) {
+  for (const Ray& r : {Ray{inside(-3, 12, 12), through},
+                       Ray{inside(30, 30, -4), glm::normalize(inside(32, -2, 25) - inside(30, 30, -4))}}) {
     ASSERT_LT(glm::length(r.org), 2.9) << "starts inside the null boundary";
     double t_exit = INFINITY;
     for (int a = 0; a < 3; ++a)
@@ -287,7 +288,8 @@ TEST(VolumeVdbMajorants, CellsBoundTheTrilinearDensity) {
         double peak = 0.0;
         for (int s = 0; s < 64; ++s) {
           glm::dvec3 q = glm::dvec3(m.grid_min) + (glm::dvec3(x, y, z) + glm::dvec3(u(rng), u(rng), u(rng))) * width;
-          if (s < 8) q = glm::dvec3(m.grid_min) + (glm::dvec3(x, y, z) + glm::dvec3(s & 1, (s >> 1) & 1, s >> 2)) * width;
+          if (s < 8)
+            q = glm::dvec3(m.grid_min) + (glm::dvec3(x, y, z) + glm::dvec3(s & 1, (s >> 1) & 1, s >> 2)) * width;
           peak = std::max(peak, reference_density(*grid, index_to_world(*grid, q)));
         }
         ASSERT_LE(peak, double(bound) * (1.0 + 1e-6)) << "cell " << x << "," << y << "," << z;
@@ -332,7 +334,8 @@ TEST(VolumeVdbFurnace, RotatedFogSphereIsInvisible) {
   GltfBuilder g2;
   g2.add_camera(glm::vec3(0.0f, 0.3f, 2.5f), glm::vec3(0.0f), 0.6f);
   g2.set_background(glm::vec3(1.0f));
-  Film dark = scene_renderer(*device_by_name("pocl"), grid_scene(medium, "fog-absorbing", &g2), settings).render(0, 16).film;
+  Film dark =
+      scene_renderer(*device_by_name("pocl"), grid_scene(medium, "fog-absorbing", &g2), settings).render(0, 16).film;
   Estimate mid = region_mean(dark, 0, 5, 11, 5, 11);
   EXPECT_LT(mid.mean + 10.0 * mid.standard_error, 1.0);
 }
@@ -355,7 +358,8 @@ TEST(VolumeVdbLoader, ErrorsAndGridMemory) {
   openvdb::io::File(::testing::TempDir() + "empty.vdb").write({empty});
   EXPECT_THROW(load_openvdb_density(::testing::TempDir() + "empty.vdb", "", &m), Error);
 
-  Scene scene = grid_scene(medium_with_grid(glm::vec3(1.0f), glm::vec3(0.0f), {{"vdb", "two.vdb"}, {"name", "density"}}), "memory");
+  Scene scene = grid_scene(
+      medium_with_grid(glm::vec3(1.0f), glm::vec3(0.0f), {{"vdb", "two.vdb"}, {"name", "density"}}), "memory");
   CompiledScene c = compile_scene(scene);
   ASSERT_EQ(c.grids.size(), 1u);
   const MediumDesc& md = scene.media[0];

@@ -22,13 +22,13 @@
 #include <map>
 #include <memory>
 
-#include "support/gltf_builder.hpp"
 #include "base/error.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "scene/vdb_grid.hpp"
+#include "support/gltf_builder.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
-#include "scene/vdb_grid.hpp"
 
 #ifdef CANDELA_HAVE_NANOVDB
 #include <nanovdb/util/IO.h>
@@ -223,13 +223,13 @@ TEST_P(PhaseTest, PdfIntegratesToOne) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, PhaseTest,
-                         ::testing::Combine(::testing::Values("pocl", "rusticl"), ::testing::Range(0, int(kPhaseG.size()))),
+                         ::testing::Combine(::testing::Values("pocl", "rusticl"),
+                                            ::testing::Range(0, int(kPhaseG.size()))),
                          [](const auto& info) {
                            return std::get<0>(info.param) + "_g" + std::to_string(std::get<1>(info.param));
                          });
 
 // --- Scenes ---
-
 
 json medium_json(glm::vec3 sigma_a, glm::vec3 sigma_s, double g = 0.0, glm::vec3 emission = glm::vec3(0.0f)) {
   return {{"sigma_a", {sigma_a.x, sigma_a.y, sigma_a.z}},
@@ -244,8 +244,9 @@ json null_material(const json& medium) { return {{"extras", {{"candela", {{"medi
 json emitter_material() {
   return {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0.0}}},
           {"emissiveFactor", {1, 1, 1}},
-          {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 1.0}}},
-                          {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
+          {"extensions",
+           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 1.0}}},
+            {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
 }
 
 // An emitter's emissiveFactor holds at most 1: radiance = factor x strength
@@ -362,7 +363,10 @@ TEST_P(VolumeRender, EmissiveSlab) {
 // down -z from z = 3: L = integral over s in [0, d] of exp(-sigma_a density s) E(d - s) ds.
 json emission_slab(float d, glm::vec3 e, float density, float scale, float c0, float c1) {
   json medium = medium_json(kSigmaA, glm::vec3(0.0f), 0.0, e);
-  medium["grid"] = {{"size", {2, 2, 9}}, {"min", {-1, -1, 0}}, {"max", {1, 1, d}}, {"density", std::vector<float>(2 * 2 * 9, density)}};
+  medium["grid"] = {{"size", {2, 2, 9}},
+                    {"min", {-1, -1, 0}},
+                    {"max", {1, 1, d}},
+                    {"density", std::vector<float>(2 * 2 * 9, density)}};
   std::vector<float> ramp;
   const int nz = 5;
   for (int z = 0; z < nz; ++z)
@@ -401,11 +405,14 @@ TEST_P(VolumeRender, AbsorbingGlassSlab) {
   const glm::vec3 color(0.9f, 0.6f, 0.3f);
   GltfBuilder g;
   add_emitter(g, kLight);
-  json glass = {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
-                {"extensions",
-                 {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
-                  {"KHR_materials_volume",
-                   {{"thicknessFactor", d}, {"attenuationDistance", distance}, {"attenuationColor", {color.x, color.y, color.z}}}}}}};
+  json glass = {
+      {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+      {"extensions",
+       {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+        {"KHR_materials_volume",
+         {{"thicknessFactor", d},
+          {"attenuationDistance", distance},
+          {"attenuationColor", {color.x, color.y, color.z}}}}}}};
   int slab = g.add("materials", glass);
   g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
   Film f = render_view(g, "glass", 512);
@@ -460,9 +467,12 @@ class GlassFurnace : public ::testing::TestWithParam<Strategy> {};
 
 TEST_P(GlassFurnace, ScatteringGlassIsInvisible) {
   GltfBuilder g;
-  json glass = {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
-                {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}, {"KHR_materials_volume", {{"thicknessFactor", 1.0}}}}},
-                {"extras", {{"candela", {{"medium", medium_json(glm::vec3(0.0f), glm::vec3(2.0f, 1.0f, 0.5f), 0.5)}}}}}};
+  json glass = {
+      {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+      {"extensions",
+       {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+        {"KHR_materials_volume", {{"thicknessFactor", 1.0}}}}},
+      {"extras", {{"candela", {{"medium", medium_json(glm::vec3(0.0f), glm::vec3(2.0f, 1.0f, 0.5f), 0.5)}}}}}};
   int m = g.add("materials", glass);
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
   g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
@@ -669,7 +679,8 @@ TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
   json glass = {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
                 {"extensions",
                  {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
-                  {"KHR_materials_volume", {{"thicknessFactor", 1.0}, {"attenuationDistance", 2.0}, {"attenuationColor", {0.5, 0.25, 1.0}}}}}},
+                  {"KHR_materials_volume",
+                   {{"thicknessFactor", 1.0}, {"attenuationDistance", 2.0}, {"attenuationColor", {0.5, 0.25, 1.0}}}}}},
                 {"extras", {{"candela", {{"medium", {{"sigma_s", {0.1, 0.2, 0.3}}, {"g", 0.5}}}}}}}};
   json clear = glass;
   clear["extensions"]["KHR_materials_volume"] = {{"thicknessFactor", 1.0}};
@@ -717,7 +728,8 @@ TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
 
   // Without media the kernel has no media code and the buffers stay empty
   GltfBuilder plain;
-  plain.add_node({{"mesh", plain.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), plain.add("materials", clear)))}});
+  plain.add_node(
+      {{"mesh", plain.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), plain.add("materials", clear)))}});
   Scene none = load(plain, "no-media");
   EXPECT_FALSE(none.features().media);
   EXPECT_TRUE(compile_scene(none).buffers.media.empty());
@@ -729,10 +741,14 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
       {{"sigma_s", {1, -1, 0}}},
       {{"g", 1.0}},
       {{"density_scale", -1}},
-      {{"grid", {{"size", {2, 2, 1}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(4, 1.0f)}}}},
-      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 0, 1}}, {"density", std::vector<float>(8, 1.0f)}}}},
-      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(7, 1.0f)}}}},
-      {{"grid", {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(8, -1.0f)}}}},
+      {{"grid",
+        {{"size", {2, 2, 1}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(4, 1.0f)}}}},
+      {{"grid",
+        {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 0, 1}}, {"density", std::vector<float>(8, 1.0f)}}}},
+      {{"grid",
+        {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(7, 1.0f)}}}},
+      {{"grid",
+        {{"size", {2, 2, 2}}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"density", std::vector<float>(8, -1.0f)}}}},
   };
   // Emission grids: without a dense density grid, the wrong number of values, a negative
   // value, a box outside the density grid's, a bad scale, a scale without a grid
@@ -745,8 +761,10 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   const std::vector<std::pair<json, std::string>> bad_emission = {
       {{{"emission_grid", eg}}, "needs an inline dense grid"},
       {{{"grid", {{"vdb", "smoke.vdb"}}}, {"emission_grid", eg}}, "needs an inline dense grid"},
-      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(7, 1.0f))}}, "emission_grid.values must be an array"},
-      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(8, -1.0f))}}, "emission_grid.values must hold finite non-negative"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(7, 1.0f))}},
+       "emission_grid.values must be an array"},
+      {{{"grid", dense}, {"emission_grid", with(eg, "values", std::vector<float>(8, -1.0f))}},
+       "emission_grid.values must hold finite non-negative"},
       {{{"grid", dense}, {"emission_grid", with(eg, "max", {1, 1.5, 1})}}, "inside the density grid's box"},
       {{{"grid", dense}, {"emission_grid", with(eg, "size", {2, 1, 2})}}, "emission_grid.size must hold"},
       {{{"grid", dense}, {"emission_grid", eg}, {"emission_scale", -1}}, "emission_scale must be finite"},
@@ -755,7 +773,8 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   int k = 0;
   for (const auto& [medium, message] : bad_emission) {
     GltfBuilder g;
-    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", null_material(medium))))}});
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f),
+                                                   g.add("materials", null_material(medium))))}});
     try {
       load(g, "bad-emission-" + std::to_string(k++));
       ADD_FAILURE() << "no error for " << medium.dump();
@@ -766,13 +785,16 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   int i = 0;
   for (const json& medium : bad) {
     GltfBuilder g;
-    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", null_material(medium))))}});
+    g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f),
+                                                   g.add("materials", null_material(medium))))}});
     EXPECT_THROW(load(g, "bad-" + std::to_string(i++)), Error) << medium.dump();
   }
   // A global medium that emits where nothing attenuates would give infinite radiance
   GltfBuilder g;
-  g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", diffuse(0.5f))))}});
-  g.doc["scenes"][0]["extras"]["candela"]["medium"] = medium_json(glm::vec3(0.0f, 1.0f, 1.0f), glm::vec3(0.0f), 0.0, glm::vec3(1.0f));
+  g.add_node(
+      {{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", diffuse(0.5f))))}});
+  g.doc["scenes"][0]["extras"]["candela"]["medium"] =
+      medium_json(glm::vec3(0.0f, 1.0f, 1.0f), glm::vec3(0.0f), 0.0, glm::vec3(1.0f));
   EXPECT_THROW(load(g, "bad-emitting-fog"), Error);
 }
 

@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "support/gltf_builder.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/gltf_builder.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -36,7 +36,6 @@ KernelRig& pocl_rig() {
   static KernelRig rig(pocl_device());
   return rig;
 }
-
 
 json scattering_medium(glm::vec3 sigma_s, double g) {
   return {{"sigma_a", {0, 0, 0}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"g", g}};
@@ -74,9 +73,7 @@ struct HostGrid {
           v.push_back(float(std::max(0.0, s)));
         }
   }
-  glm::dvec3 node(int i, int j, int k) const {
-    return lo + glm::dvec3(i, j, k) / glm::dvec3(n - 1) * (hi - lo);
-  }
+  glm::dvec3 node(int i, int j, int k) const { return lo + glm::dvec3(i, j, k) / glm::dvec3(n - 1) * (hi - lo); }
   double value(int i, int j, int k) const { return v[size_t((k * n.y + j) * n.x + i)]; }
   double at(glm::dvec3 p) const {
     glm::dvec3 u = (p - lo) / (hi - lo);
@@ -143,7 +140,8 @@ struct HostGrid {
       for (int i = 0; i <= cells[a]; ++i) cuts.push_back((lo[a] + (hi[a] - lo[a]) * i / cells[a] - o[a]) / d[a]);
     }
     std::sort(cuts.begin(), cuts.end());
-    const double a1 = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2)), a2 = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
+    const double a1 = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2)),
+                 a2 = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
     const double w1 = (18.0 + std::sqrt(30.0)) / 36.0, w2 = (18.0 - std::sqrt(30.0)) / 36.0;
     const double x[4] = {-a2, -a1, a1, a2}, w[4] = {w2, w1, w1, w2};
     double sum = 0.0;
@@ -285,20 +283,22 @@ TEST(VolumeTracking, HostQuadratureIsConsistent) {
   for (int k = 0; k < cells.z; ++k)
     for (int j = 0; j < cells.y; ++j)
       for (int i = 0; i < cells.x; ++i)
-        empty_cells += grid.majorant_at(grid.lo + (glm::dvec3(i, j, k) + 0.5) / glm::dvec3(cells) * (grid.hi - grid.lo)) == 0.0;
+        empty_cells +=
+            grid.majorant_at(grid.lo + (glm::dvec3(i, j, k) + 0.5) / glm::dvec3(cells) * (grid.hi - grid.lo)) == 0.0;
   EXPECT_GT(empty_cells, 0);
   int rays_through_empty = 0;  // the walk skips an empty cell on some of the test rays
   for (const TrackRay& r : tracking_rays()) {
     double t0, t1;
     if (!grid.span(r.org, r.dir, r.tmax, &t0, &t1)) continue;
     bool crosses = false;
-    for (int s = 0; s <= 2000; ++s) crosses = crosses || grid.majorant_at(r.org + (t0 + (t1 - t0) * s / 2000.0) * r.dir) == 0.0;
+    for (int s = 0; s <= 2000; ++s)
+      crosses = crosses || grid.majorant_at(r.org + (t0 + (t1 - t0) * s / 2000.0) * r.dir) == 0.0;
     rays_through_empty += crosses;
   }
   EXPECT_GT(rays_through_empty, 0);
-  std::printf("  %d of %zu nodes empty, largest %.3f; %d of %d majorant cells empty, crossed by %d of the rays\n", zeros,
-              grid.v.size(), double(*std::max_element(grid.v.begin(), grid.v.end())), empty_cells,
-              cells.x * cells.y * cells.z, rays_through_empty);
+  std::printf("  %d of %zu nodes empty, largest %.3f; %d of %d majorant cells empty, crossed by %d of the rays\n",
+              zeros, grid.v.size(), double(*std::max_element(grid.v.begin(), grid.v.end())), empty_cells,
+              cells.x* cells.y* cells.z, rays_through_empty);
   // Trilinear interpolation reproduces the nodes
   EXPECT_DOUBLE_EQ(grid.at(grid.node(3, 5, 7)), grid.value(3, 5, 7));
   EXPECT_DOUBLE_EQ(grid.at(grid.node(16, 12, 10)), grid.value(16, 12, 10));
@@ -333,8 +333,8 @@ TEST_P(VolumeTrackingDepth, RatioAndDeltaTrackingMatchQuadrature) {
     double se = std::sqrt(std::max(0.0, second - want * want) / double(kTrackingSamples));
     EXPECT_TRUE(m.finite);
     EXPECT_TRUE(m.non_negative);
-    EXPECT_NEAR(m.mean, want, 5.0 * se + 1e-6 * want)
-        << "ratio tracking, SE " << se << " (sample's " << m.se << "), relative variance " << second / (want * want) - 1.0;
+    EXPECT_NEAR(m.mean, want, 5.0 * se + 1e-6 * want) << "ratio tracking, SE " << se << " (sample's " << m.se
+                                                      << "), relative variance " << second / (want * want) - 1.0;
     if (second < 20.0 * want * want) {  // light tails: the sample's variance estimates the exact one
       EXPECT_NEAR(m.se / se, 1.0, 0.15) << "ratio tracking's variance: the majorant cells differ from the README's";
     }
@@ -363,7 +363,8 @@ TEST_P(VolumeTrackingDepth, RatioAndDeltaTrackingMatchQuadrature) {
     }
     double n = double(dt.size()), mean = double(passed) / n;
     double se_binary = std::sqrt(want * (1.0 - want) / n);
-    EXPECT_NEAR(mean, want, 5.0 * se_binary) << "delta tracking: " << passed << " of " << dt.size() << " passed, SE " << se_binary;
+    EXPECT_NEAR(mean, want, 5.0 * se_binary)
+        << "delta tracking: " << passed << " of " << dt.size() << " passed, SE " << se_binary;
     EXPECT_EQ(passed + scattered, dt.size());
     std::printf("  %-26s tau %7.3f  T %.4g  ratio %.4g (z %+.2f, rel. var. %.3g)  delta %.4g (z %+.2f)\n", r.what, tau,
                 want, m.mean, (m.mean - want) / se, second / (want * want) - 1.0, mean,
@@ -445,7 +446,8 @@ TEST(VolumePhaseNearOne, DeflectionAnglesFollowTheCdf) {
     // P(mu) = (1 - g^2) / (2 g) [(1 + g^2 - 2 g mu)^(-1/2) - 1 / (1 + g)], written in terms of
     // x = 1 - mu: 1 + g^2 - 2 g mu = (1 - g)^2 + 2 g x
     auto cdf_x = [&](double x) {  // P(1 - mu <= x) = 1 - P(mu < 1 - x)
-      double p_mu = (1.0 - gd * gd) / (2.0 * gd) * (1.0 / std::sqrt((1.0 - gd) * (1.0 - gd) + 2.0 * gd * x) - 1.0 / (1.0 + gd));
+      double p_mu =
+          (1.0 - gd * gd) / (2.0 * gd) * (1.0 / std::sqrt((1.0 - gd) * (1.0 - gd) + 2.0 * gd * x) - 1.0 / (1.0 + gd));
       return 1.0 - p_mu;
     };
     auto hg_x = [&](double x) {  // the phase function at deflection 1 - mu = x
@@ -473,8 +475,8 @@ TEST(VolumePhaseNearOne, DeflectionAnglesFollowTheCdf) {
     double critical = 1.63 / std::sqrt(double(n));
     EXPECT_LT(d, critical) << "KS distance of the deflection angles";
     EXPECT_EQ(pdf_off, 0u) << "samples whose pdf is off the formula by more than 1 % (worst " << worst_pdf << ")";
-    std::printf("  g %+.3f: KS D %.2e (critical %.2e), median deflection %.3g rad, worst pdf error %.2g\n", gd, d, critical,
-                2.0 * std::asin(std::sqrt(0.5 * xs[n / 2])), worst_pdf);
+    std::printf("  g %+.3f: KS D %.2e (critical %.2e), median deflection %.3g rad, worst pdf error %.2g\n", gd, d,
+                critical, 2.0 * std::asin(std::sqrt(0.5 * xs[n / 2])), worst_pdf);
   }
 }
 
@@ -495,7 +497,9 @@ Film render_furnace(const FurnaceCase& c, uint32_t seed) {
   GltfBuilder g;
   json medium = scattering_medium(c.sigma_s, c.g);
   if (c.grid) {  // a constant grid of density 0.25 x 4: the same medium through delta tracking
-    medium["grid"] = {{"size", {2, 2, 2}}, {"min", {-0.6, -0.6, -0.6}}, {"max", {0.6, 0.6, 0.6}},
+    medium["grid"] = {{"size", {2, 2, 2}},
+                      {"min", {-0.6, -0.6, -0.6}},
+                      {"max", {0.6, 0.6, 0.6}},
                       {"density", std::vector<float>(8, 0.25f)}};
     medium["density_scale"] = 4.0;
   }
@@ -543,7 +547,8 @@ TEST_P(VolumeStability, FurnaceStaysOne) {
     Estimate e = region_mean(f, ch, 0, 16, 0, 16);
     EXPECT_TRUE(std::isfinite(e.mean) && std::isfinite(e.standard_error));
     EXPECT_LE(e.standard_error, c.max_se) << "too noisy to test anything";
-    EXPECT_NEAR(e.mean, 1.0, 4.5 * e.standard_error + 1e-4) << c.name << " channel " << ch << " SE " << e.standard_error;
+    EXPECT_NEAR(e.mean, 1.0, 4.5 * e.standard_error + 1e-4)
+        << c.name << " channel " << ch << " SE " << e.standard_error;
     Estimate mid = region_mean(f, ch, 4, 12, 4, 12);  // inside the sphere's outline
     EXPECT_NEAR(mid.mean, 1.0, 4.5 * mid.standard_error + 1e-4) << c.name << " middle, channel " << ch;
     std::printf("  %s channel %d: %.5f +- %.5f (middle %.5f +- %.5f)\n", c.name, ch, e.mean, e.standard_error, mid.mean,

@@ -5,16 +5,15 @@
 
 #include <cmath>
 
-#include "support/gltf_builder.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/gltf_builder.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
 using nlohmann::json;
-
 
 // A sphere of `material` filling most of the view under a uniform background of 1
 Scene furnace_scene(const json& material, const std::string& file) {
@@ -31,14 +30,15 @@ Scene furnace_scene(const json& material, const std::string& file) {
 json glass(double roughness, bool volume) {
   json ext = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}};
   if (volume) ext["KHR_materials_volume"] = {{"thicknessFactor", 1.0}};
-  return {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", roughness}}},
+  return {{"pbrMetallicRoughness",
+           {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", roughness}}},
           {"extensions", ext}};
 }
 
 struct FurnaceCase {
   const char* label;
   json material;
-  double tolerance;  // allowed deficit beyond 4 standard errors
+  double tolerance;        // allowed deficit beyond 4 standard errors
   bool bsdf_only = false;  // nee is heavy-tailed here (light sampling of a near-delta lobe)
 };
 
@@ -46,7 +46,10 @@ class MaterialFurnace : public ::testing::TestWithParam<std::tuple<int, Strategy
 
 const std::vector<FurnaceCase>& furnace_cases() {
   static const std::vector<FurnaceCase> cases = {
-      {"white_lambert", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}}, 1e-6},
+      {"white_lambert",
+       {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+        {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}},
+       1e-6},
       {"smooth_glass", glass(0.0, true), 1e-5},
       // glTF plastic (ior 1.5): the diffuse base gets exactly what the specular layer does not
       // reflect (cl/bsdf/bsdf_gltf.cl's layering), within the albedo table's accuracy
@@ -74,7 +77,8 @@ TEST_P(MaterialFurnace, InvisibleUnderUniformBackground) {
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   EXPECT_LE(e.mean, 1.0 + 4.0 * e.standard_error + 1e-5) << c.label << " " << strategy_name(s) << " creates energy";
-  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + c.tolerance) << c.label << " " << strategy_name(s) << " SE " << e.standard_error;
+  EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + c.tolerance)
+      << c.label << " " << strategy_name(s) << " SE " << e.standard_error;
   for (int by = 0; by < 16; by += 4)
     for (int bx = 0; bx < 16; bx += 4) {
       Estimate b = region_mean(f, 1, bx, bx + 4, by, by + 4);
@@ -103,12 +107,15 @@ TEST_P(SpecularShowsLight, NeeSeesTheLightAndStrategiesAgree) {
                            {"extras", {{"candela", {{"conductor", "silver"}}}}}}
                     : glass(0.0, true);
   int obj = g.add("materials", object);
-  int floor = g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0.0}}},
-                                  {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
-  int light = g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0.0}}},
-                                  {"emissiveFactor", {1, 1, 1}},
-                                  {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 20.0}}},
-                                                  {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
+  int floor =
+      g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0.0}}},
+                          {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
+  int light =
+      g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0.0}}},
+                          {"emissiveFactor", {1, 1, 1}},
+                          {"extensions",
+                           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 20.0}}},
+                            {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
   const float l = 0.3f, h = 1.5f;
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f, 0.5f, 0.0f), 0.5f, 3, obj),
                                    quad_primitive({{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}}, floor),
@@ -137,7 +144,8 @@ TEST_P(SpecularShowsLight, NeeSeesTheLightAndStrategiesAgree) {
       double z = (a.mean - b.mean) / se;
       chi2 += z * z;
       ++blocks;
-      EXPECT_LT(std::fabs(z), 4.5) << GetParam() << " block " << bx << "," << by << ": nee " << a.mean << " bsdf " << b.mean;
+      EXPECT_LT(std::fabs(z), 4.5) << GetParam() << " block " << bx << "," << by << ": nee " << a.mean << " bsdf "
+                                   << b.mean;
     }
   EXPECT_LT(chi2, blocks + 5.0 * std::sqrt(2.0 * blocks));
 }
@@ -158,7 +166,8 @@ class ShadingNormals : public ::testing::TestWithParam<int> {};
 
 TEST_P(ShadingNormals, NoBlackFringesAtSilhouettesOfSmoothedCoarseMeshes) {
   const json materials[] = {
-      {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}},
+      {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+       {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}},
       {{"pbrMetallicRoughness", {{"metallicFactor", 1.0}, {"roughnessFactor", 0.3}}}},
       {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.3}}}},
   };
@@ -180,8 +189,8 @@ TEST_P(ShadingNormals, NoBlackFringesAtSilhouettesOfSmoothedCoarseMeshes) {
     for (size_t i = 0; i < f.pixels() && s == Strategy::Bsdf; ++i)
       if (f.pixel(i).x < 0.6f) ++dark;
     Estimate e = image_mean(f);
-    std::printf("material %d %s: %zu of %zu pixels below 0.6, image mean %.4f +- %.4f\n", GetParam(), strategy_name(s), dark,
-                f.pixels(), e.mean, e.standard_error);
+    std::printf("material %d %s: %zu of %zu pixels below 0.6, image mean %.4f +- %.4f\n", GetParam(), strategy_name(s),
+                dark, f.pixels(), e.mean, e.standard_error);
     EXPECT_EQ(dark, 0u) << strategy_name(s);
     EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01) << strategy_name(s);
   }

@@ -14,8 +14,8 @@
 namespace candela::test {
 namespace {
 
-RenderResult render_scene(const DeviceEntry& device, const std::string& scene_file, Strategy s,
-                          int size, uint32_t spp, uint32_t max_depth = 1000, uint32_t seed = 1) {
+RenderResult render_scene(const DeviceEntry& device, const std::string& scene_file, Strategy s, int size, uint32_t spp,
+                          uint32_t max_depth = 1000, uint32_t seed = 1) {
   Scene scene = load_gltf(scene_path(scene_file));
   RenderSettings settings;
   settings.width = settings.height = size;
@@ -92,8 +92,8 @@ TEST_P(CornellTest, StrategiesAgreeWithinStandardError) {
         max_z = std::max(max_z, std::fabs(z));
         chi2 += z * z;
         ++blocks;
-        EXPECT_LT(std::fabs(z), 4.5) << "block " << bx << "," << by << " channel " << c << ": nee "
-                                    << a.mean << " bsdf " << b.mean << " se " << se;
+        EXPECT_LT(std::fabs(z), 4.5) << "block " << bx << "," << by << " channel " << c << ": nee " << a.mean
+                                     << " bsdf " << b.mean << " se " << se;
       }
   // The sum of squared z-scores is chi-square with `blocks` dof: mean 48, sd ~10
   EXPECT_LT(chi2, blocks + 5.0 * std::sqrt(2.0 * blocks)) << "max |z| " << max_z;
@@ -114,7 +114,7 @@ TEST(Render, StrategiesAgreeForALightCloseToASurface) {
   std::vector<GltfBuilder::Primitive> quads = {
       quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),   // floor, facing +y
       quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};  // light, facing -y
-  GltfBuilder g;  // black background
+  GltfBuilder g;                                                             // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([
     {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
@@ -149,9 +149,8 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
   out->close();
   const float s = 0.25f, h = 0.3f;
-  std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),
-      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};
+  std::vector<GltfBuilder::Primitive> quads = {quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),
+                                               quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};
   GltfBuilder g;  // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([

@@ -77,12 +77,14 @@ TEST(Strategies, SmallLightFavoursLightSampling) {
   EXPECT_LT(3.0 * e.nee, e.bsdf);
   // Every vertex is diffuse: auto takes the same light samples as nee, number for number
   Scene scene = load_gltf(scene_path("lights/small-light.gltf"));
-  Film a = render_film(scene, Strategy::Auto, kWidth, kHeight, 4, 4, 7), n = render_film(scene, Strategy::Nee, kWidth, kHeight, 4, 4, 7);
+  Film a = render_film(scene, Strategy::Auto, kWidth, kHeight, 4, 4, 7),
+       n = render_film(scene, Strategy::Nee, kWidth, kHeight, 4, 4, 7);
   EXPECT_EQ(a.mean, n.mean);
 }
 
 TEST(Strategies, LargeLightOnGlossyMetalFavoursBsdfSampling) {
-  Errors e = compare("lights/large-light-glossy.gltf", 4, 16, 2, Strategy::Bsdf, 1024, {Strategy::Bsdf, Strategy::Auto});
+  Errors e =
+      compare("lights/large-light-glossy.gltf", 4, 16, 2, Strategy::Bsdf, 1024, {Strategy::Bsdf, Strategy::Auto});
   EXPECT_LT(2.0 * e.bsdf, e.nee);
   EXPECT_LT(e.automatic, 1.3 * e.bsdf);
 }

@@ -3,9 +3,9 @@
 // renders across seeds; the z-test of `candela compare` on renders with known answers.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
-#include <unistd.h>
 
 #include "base/error.hpp"
 
@@ -151,8 +151,8 @@ TEST(VarianceImage, AgreesWithTheSpreadAcrossSeeds) {
   for (double d : diff) var_diff += (d - mean_diff) * (d - mean_diff) / (pixels - 1);
   double se = std::sqrt(var_diff / pixels);
   EXPECT_GT(predicted_sum, 0.0);
-  EXPECT_NEAR(mean_diff, 0.0, 4.0 * se) << "SE " << se << ", empirical " << empirical_sum / (3 * pixels) << " predicted "
-                                        << predicted_sum / (3 * pixels);
+  EXPECT_NEAR(mean_diff, 0.0, 4.0 * se) << "SE " << se << ", empirical " << empirical_sum / (3 * pixels)
+                                        << " predicted " << predicted_sum / (3 * pixels);
   // And the ratio is near one (the test above has power: the SE is a fraction of the mean)
   EXPECT_LT(4.0 * se, 0.25 * predicted_sum / pixels);
 }
@@ -166,14 +166,14 @@ TEST(CompareZTest, SameRenderDifferentSeedsIsConsistent) {
   Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
   RenderResult a = render(device, scene, 24, 32, 1, 8, Sampler::Independent),
                b = render(device, scene, 24, 32, 2, 8, Sampler::Independent);
-  ZTest t = z_test(as_image(a.film, "za"), as_variance(a.film, "za"), as_image(b.film, "zb"),
-                   as_variance(b.film, "zb"));
+  ZTest t =
+      z_test(as_image(a.film, "za"), as_variance(a.film, "za"), as_image(b.film, "zb"), as_variance(b.film, "zb"));
   EXPECT_TRUE(t.consistent) << (t.reasons.empty() ? "" : t.reasons[0]);
   EXPECT_GT(t.values, 24u * 24u);
   EXPECT_NEAR(t.mean_z2, 1.0, 0.3);
   RenderResult c = render(device, scene, 24, 32, 1, 8), d = render(device, scene, 24, 32, 2, 8);
-  ZTest sobol = z_test(as_image(c.film, "zc"), as_variance(c.film, "zc"), as_image(d.film, "zd"),
-                       as_variance(d.film, "zd"));
+  ZTest sobol =
+      z_test(as_image(c.film, "zc"), as_variance(c.film, "zc"), as_image(d.film, "zd"), as_variance(d.film, "zd"));
   EXPECT_TRUE(sobol.consistent) << (sobol.reasons.empty() ? "" : sobol.reasons[0]);
   EXPECT_LT(sobol.mean_z2, 1.3);
 }
@@ -182,8 +182,8 @@ TEST(CompareZTest, DirectLightingOnlyIsNotConsistent) {
   DeviceEntry device = pocl_device();
   Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
   RenderResult a = render(device, scene, 24, 32, 1, 8), b = render(device, scene, 24, 32, 2, 1);
-  ZTest t = z_test(as_image(a.film, "da"), as_variance(a.film, "da"), as_image(b.film, "db"),
-                   as_variance(b.film, "db"));
+  ZTest t =
+      z_test(as_image(a.film, "da"), as_variance(a.film, "da"), as_image(b.film, "db"), as_variance(b.film, "db"));
   EXPECT_FALSE(t.consistent);
   EXPECT_GT(t.mean_z, 0.0);  // the full render is brighter
 }
@@ -233,9 +233,10 @@ TEST(Specialization, GenericAndSpecializedKernelsAgreeOnEveryShippedScene) {
   auto render_with = [&](const Scene& scene, const SceneFeatures& features, uint32_t seed, const std::string& tag) {
     RenderSettings settings = s;
     settings.seed = seed;
-    if (!scene.strategy.empty()) settings.strategy = scene.strategy == "bsdf" ? Strategy::Bsdf
-                                                     : scene.strategy == "auto" ? Strategy::Auto
-                                                                                : Strategy::Nee;
+    if (!scene.strategy.empty())
+      settings.strategy = scene.strategy == "bsdf"   ? Strategy::Bsdf
+                          : scene.strategy == "auto" ? Strategy::Auto
+                                                     : Strategy::Nee;
     Renderer r(device, std::make_shared<const CompiledScene>(compile_scene(scene, features)),
                scene_camera(scene, settings), settings);
     RenderResult res = r.render(0, 32);

@@ -102,7 +102,8 @@ Traced trace(KernelRig& rig, const Scene& scene, const std::vector<glm::vec2>& p
     rays.push_back({{0.0f, 0.0f, -1.0f, 0.0f}});
   }
   size_t n = points.size();
-  cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4), rays.data());
+  cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4),
+                     rays.data());
   cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
   cl::Buffer occ(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_int));
   cl::Kernel k(rig.program, "test_alpha_trace");
@@ -370,10 +371,10 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
   out->close();
   const float l = 0.3f, c = 0.3f;
   std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),  // floor
-      quad_primitive({{-l, 1, -l}, {l, 1, -l}, {l, 1, l}, {-l, 1, l}}, 1),  // light, facing -y
+      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),               // floor
+      quad_primitive({{-l, 1, -l}, {l, 1, -l}, {l, 1, l}, {-l, 1, l}}, 1),               // light, facing -y
       quad_primitive({{-c, 0.5f, c}, {c, 0.5f, c}, {c, 0.5f, -c}, {-c, 0.5f, -c}}, 2)};  // occluder
-  GltfBuilder g;  // black background
+  GltfBuilder g;                                                                         // black background
   g.add_node({{"mesh", g.add_mesh(quads)}});
   g.doc["materials"] = nlohmann::json::parse(R"([
     {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
@@ -433,7 +434,7 @@ TEST(Textures, NearestLookupReturnsExactTexelsWhereBilinearBlends) {
   ASSERT_EQ(compiled.buffers.textures[1].flags & TEXTURE_NEAREST, TEXTURE_NEAREST);
   SceneOnDevice on_device(rig, compiled);
   // Texel centres, points between them, and points beyond [0, 1) that repeat
-  std::vector<cl_float2> uvs = {{{0.25f, 0.5f}}, {{0.75f, 0.5f}}, {{0.4f, 0.3f}}, {{0.6f, 0.9f}},
+  std::vector<cl_float2> uvs = {{{0.25f, 0.5f}}, {{0.75f, 0.5f}}, {{0.4f, 0.3f}},  {{0.6f, 0.9f}},
                                 {{0.05f, 0.1f}}, {{0.95f, 0.5f}}, {{1.3f, -0.2f}}, {{-0.3f, 2.7f}}};
   auto lookup = [&](uint32_t material) {
     cl::Buffer uv_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, uvs.size() * sizeof(cl_float2), uvs.data());

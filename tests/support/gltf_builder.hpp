@@ -15,12 +15,12 @@ class GltfBuilder {
   // One primitive's vertex data; empty attributes (and indices) are left out
   struct Primitive {
     std::vector<glm::vec3> positions;
-    std::vector<glm::vec3> normals;     // NORMAL
-    std::vector<glm::vec2> uvs;         // TEXCOORD_0
-    std::vector<glm::u8vec4> colors;    // COLOR_0, normalized unsigned bytes
+    std::vector<glm::vec3> normals;   // NORMAL
+    std::vector<glm::vec2> uvs;       // TEXCOORD_0
+    std::vector<glm::u8vec4> colors;  // COLOR_0, normalized unsigned bytes
     std::vector<uint16_t> indices;
-    int material = -1;                  // -1: none (the default material)
-    int mode = 4;                       // triangles (5: strip)
+    int material = -1;  // -1: none (the default material)
+    int mode = 4;       // triangles (5: strip)
   };
 
   // The document without its buffer: tests may edit it directly
@@ -54,7 +54,6 @@ GltfBuilder::Primitive quad_primitive(const float (&p)[4][3], int material);
 std::vector<GltfBuilder::Primitive> box_primitives(glm::vec3 lo, glm::vec3 hi, int material);
 
 // A closed icosphere (flat-shaded, shared vertices, outward winding)
-GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions,
-                                        int material);
+GltfBuilder::Primitive sphere_primitive(const glm::vec3& center, float radius, int subdivisions, int material);
 
 }  // namespace candela::test

@@ -6,9 +6,9 @@
 #include <memory>
 
 #include "base/error.hpp"
+#include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
-#include "device/energy.hpp"
 
 namespace candela::test {
 
@@ -99,9 +99,7 @@ Estimate image_mean(const Film& f) {
   return e;
 }
 
-std::string scene_path(const std::string& relative) {
-  return std::string(CANDELA_SOURCE_DIR) + "/scenes/" + relative;
-}
+std::string scene_path(const std::string& relative) { return std::string(CANDELA_SOURCE_DIR) + "/scenes/" + relative; }
 
 }  // namespace candela::test
 
@@ -114,8 +112,8 @@ KernelRig& shared_rig(const std::string& name, const DeviceEntry& device) {
   return *r;
 }
 
-Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
-                 uint32_t seed, const DeviceEntry& device) {
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth, uint32_t seed,
+                 const DeviceEntry& device) {
   RenderSettings settings;
   settings.width = w;
   settings.height = h;
@@ -130,8 +128,7 @@ RenderResult render_result(const Scene& scene, const RenderSettings& settings, u
   return scene_renderer(device, scene, settings).render(0, spp);
 }
 
-Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
-                 uint32_t seed) {
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth, uint32_t seed) {
   return render_film(scene, strategy, w, h, spp, max_depth, seed, pocl_device());
 }
 

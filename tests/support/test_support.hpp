@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "device/device.hpp"
-#include "render/film.hpp"
 #include "base/device_types.hpp"
-#include "support/gltf_builder.hpp"
-#include "render/renderer.hpp"
 #include "compile/camera.hpp"
 #include "compile/scene_compiler.hpp"
+#include "device/device.hpp"
+#include "render/film.hpp"
+#include "render/renderer.hpp"
+#include "support/gltf_builder.hpp"
 
 namespace candela::test {
 
@@ -23,7 +23,7 @@ DeviceEntry pocl_device();
 std::optional<DeviceEntry> rusticl_device();
 
 // Device by test-parameter name: "pocl" or "rusticl"; skips the test when absent
-#define CANDELA_DEVICE_OR_SKIP(name, out)                                          \
+#define CANDELA_DEVICE_OR_SKIP(name, out)                                         \
   do {                                                                            \
     auto candela_dev_ = ::candela::test::device_by_name(name);                    \
     if (!candela_dev_) GTEST_SKIP() << name << " OpenCL device is not available"; \
@@ -62,7 +62,7 @@ struct Estimate {
   double standard_error = 0.0;
 };
 Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1);  // channel c
-Estimate image_mean(const Film& f);  // all pixels, channels averaged
+Estimate image_mean(const Film& f);                                          // all pixels, channels averaged
 // The mean of component c of a kernel's samples, with its standard error
 Estimate sample_mean(const std::vector<cl_float4>& samples, int c);
 
@@ -75,13 +75,12 @@ dev::Camera scene_camera(const Scene& scene, const RenderSettings& settings);
 Renderer scene_renderer(const DeviceEntry& device, const Scene& scene, const RenderSettings& settings);
 
 // A render of `scene` with `settings`, `spp` samples per pixel (sample indices [0, spp))
-RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp,
-                           const DeviceEntry& device);
+RenderResult render_result(const Scene& scene, const RenderSettings& settings, uint32_t spp, const DeviceEntry& device);
 
 // A w x h render of `scene` with `spp` samples per pixel (sample indices [0, spp)) on
 // `device`; every other setting is RenderSettings' default
-Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
-                 uint32_t seed, const DeviceEntry& device);
+Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth, uint32_t seed,
+                 const DeviceEntry& device);
 Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t spp, uint32_t max_depth,
                  uint32_t seed);  // on PoCL
 
