@@ -30,11 +30,14 @@ candela_install_packages() {
   "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# CANDELA_BUILD_TARGETS (e.g. "candela"): build only those targets (scripts/demo: the
+# renderer without the test suite); default everything
 candela_build() {
-  local jobs
+  local jobs targets=()
   jobs=$(nproc 2>/dev/null || echo 2)
+  for t in ${CANDELA_BUILD_TARGETS:-}; do targets+=(--target "$t"); done
   cmake -S "$CANDELA_ROOT" -B "$CANDELA_ROOT/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$CANDELA_ROOT/build" -j "$jobs"
+  cmake --build "$CANDELA_ROOT/build" -j "$jobs" "${targets[@]}"
 }
 
 candela_install_packages
