@@ -188,8 +188,8 @@ class GltfWriter:
 
     def set_background(self, rgb):
         """candela's scene background radiance (scene extras)."""
-        extras = {"candela": {"background": list(rgb)}}
-        self.doc["scenes"][0]["extras"] = extras
+        extras = self.doc["scenes"][0].setdefault("extras", {})
+        extras.setdefault("candela", {})["background"] = list(rgb)
 
     def write(self, path, embed=True):
         """Write the .gltf; embed=False puts the buffer in a .bin beside it."""

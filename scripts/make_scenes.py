@@ -39,6 +39,14 @@ from gltf_writer import (DATA_URI_PREFIX, ELEMENT_ARRAY_BUFFER, FLOAT,
 
 GENERATOR = "candela scripts/make_scenes.py"
 
+# KHR_lights_punctual intensities are photometric (candela, lux); candela reads them by
+# 683 lm/W, so a light meant to give W radiometric units is written as W x 683
+LUMENS_PER_WATT = 683.0
+
+
+def photometric(watts):
+    return watts * LUMENS_PER_WATT
+
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -225,6 +233,7 @@ def make_cornell_box(path):
     cam = g.camera("camera", 2.0 * math.atan(12.5 / 35.0), 1.0)
     g.node("camera", camera=cam, translation=[0.278, 0.273, -0.8],
            rotation=[0.0, 1.0, 0.0, 0.0])
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -584,18 +593,19 @@ def make_punctual(path):
     g.node("cube", mesh=g.mesh("cube", *flat_mesh(cube(0.7)), white),
            translation=[0.9, 0.35, 0.3],
            rotation=[0.0, math.sin(half), 0.0, math.cos(half)])
-    point = g.punctual_light("warm point", "point", (1.0, 0.8, 0.6), 6.0)
+    point = g.punctual_light("warm point", "point", (1.0, 0.8, 0.6), photometric(6.0))
     g.light_node("point", point, translation=[-1.6, 1.6, 1.2])
-    spot = g.punctual_light("blue spot", "spot", (0.5, 0.7, 1.0), 30.0,
+    spot = g.punctual_light("blue spot", "spot", (0.5, 0.7, 1.0), photometric(30.0),
                             light_range=6.0, inner_cone=0.2, outer_cone=0.35)
     spot_at = [1.4, 3.2, 1.2]
     g.light_node("spot", spot, translation=spot_at,
                  rotation=look_at_rotation(tuple(spot_at), (0.9, 0.35, 0.3)))
-    sun = g.punctual_light("sun", "directional", (1.0, 1.0, 0.95), 0.6)
+    sun = g.punctual_light("sun", "directional", (1.0, 1.0, 0.95), photometric(0.6))
     g.light_node("sun", sun, rotation=look_at_rotation((-2.0, 3.0, 1.0), (0.0, 0.0, 0.0)))
     eye = (0.0, 2.2, 4.8)
     g.node("camera", camera=g.camera("camera", 0.7, 1.5), translation=list(eye),
            rotation=look_at_rotation(eye, (0.0, 0.4, 0.0)))
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -789,6 +799,7 @@ def make_veach(path):
         [f32v(p) for p in w], (0.0, 0.0, 1.0)))), wall))
     look_camera(g, eye, (0.0, 0.9, 0.0), 0.55, 1.5)
     g.doc["scenes"][0]["extras"] = {"candela": {"strategy": "auto"}}  # the scene-side default
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -805,6 +816,7 @@ def make_small_light(path):
     g.node("light", mesh=g.mesh("light", *flat_mesh(icosphere(2, radius=0.05)), light),
            translation=[0.0, 0.6, 0.0])
     look_camera(g, (0.0, 2.2, 2.6), (0.0, 0.0, 0.0), 0.8, 1.5)
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -822,6 +834,7 @@ def make_large_light_glossy(path):
     g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
         [f32v(q) for q in p], (0.0, -1.0, 0.0)))), light))
     look_camera(g, (0.0, 1.2, 3.5), (0.0, 0.0, -0.6), 0.7, 1.5)
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -859,6 +872,7 @@ def make_many_lights(path):
         normals = [(0.0, -1.0, 0.0)] * len(positions)
         g.node("emitters%d" % c, mesh=g.mesh("emitters%d" % c, positions, normals, indices, mat))
     look_camera(g, (0.0, 3.0, 7.5), (0.0, 0.6, 0.0), 0.7, 1.5)
+    g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
 
 
@@ -924,7 +938,7 @@ def make_god_rays(path):
     inset = 0.001
     g.node("fog", mesh=g.mesh("fog", *flat_mesh(box_tris(
         add(lo, (inset, inset, inset)), sub(hi, (inset, inset, inset)))), fog))
-    sun = g.punctual_light("sun", "directional", (1.0, 0.9, 0.75), 25.0)
+    sun = g.punctual_light("sun", "directional", (1.0, 0.9, 0.75), photometric(25.0))
     g.light_node("sun", sun, rotation=look_at_rotation((-3.0, 3.2, 0.8), (0.0, 0.0, 0.0)))
     eye = (1.8, 1.5, 1.8)
     g.node("camera", camera=g.camera("camera", 1.1, 1.5), translation=list(eye),
@@ -1054,7 +1068,7 @@ def make_cloud(path):
                        "density": cloud_density(n)}}
     cloud = null_medium_material(g, "cloud", medium)
     g.node("cloud", mesh=g.mesh("cloud", *flat_mesh(box_tris(lo, hi)), cloud))
-    sun = g.punctual_light("sun", "directional", (1.0, 0.95, 0.85), 3.0)
+    sun = g.punctual_light("sun", "directional", (1.0, 0.95, 0.85), photometric(3.0))
     g.light_node("sun", sun, rotation=look_at_rotation((2.0, 3.0, 1.0), (0.0, 0.0, 0.0)))
     eye = (0.0, 1.4, 5.5)
     g.node("camera", camera=g.camera("camera", 0.75, 1.5), translation=list(eye),

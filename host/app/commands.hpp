@@ -22,6 +22,13 @@ struct CompareCommand {
 CLI::App* add_compare_command(CLI::App* app, CompareCommand* c);
 int run_compare_command(CLI::App* cmd, CompareCommand* c);
 
+// `candela info SCENE`: what the scene holds as candela reads it
+struct InfoArgs {
+  std::string scene;
+};
+CLI::App* add_info_command(CLI::App* app, InfoArgs* args);
+int run_info_command(const InfoArgs& args);
+
 // `candela merge` (merge.hpp; run_merge runs it)
 CLI::App* add_merge_command(CLI::App* app, MergeArgs* m);
 

@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
   CLI::App* compare_cmd = add_compare_command(&app, &compare);
   MergeArgs merge_args;
   CLI::App* merge_cmd = add_merge_command(&app, &merge_args);
+  InfoArgs info_args;
+  CLI::App* info_cmd = add_info_command(&app, &info_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -70,6 +72,7 @@ int main(int argc, char** argv) {
     if (*devices_cmd) return run_devices_command();
     if (*compare_cmd) return run_compare_command(compare_cmd, &compare);
     if (*merge_cmd) return run_merge(merge_args);
+    if (*info_cmd) return run_info_command(info_args);
     return run_render_command(render_args);
   });
 }

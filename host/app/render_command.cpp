@@ -18,6 +18,7 @@
 #include "compile/scene_compiler.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
+#include "scene/default_light.hpp"
 
 namespace candela {
 namespace {
@@ -60,12 +61,20 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option(
       "--env-rotation", a.env_rotation,
       "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)");
-  render->add_flag("--no-default-light", a.no_default_light,
-                   "Keep a scene without any light black instead of lighting it with the built-in sky");
+  render->add_option("--default-light", a.default_light,
+                     "The built-in studio environment: " + enum_names(kDefaultLightNames, true));
+  render->add_flag_callback(
+      "--no-default-light", [&a] { a.default_light = "off"; }, "Same as --default-light off");
+  render->add_option("--light-units", a.light_units,
+                     "KHR_lights_punctual intensities: " + enum_names(kLightUnitNames, true) +
+                         "; default: the scene's extras candela.light_units, else photometric");
 }
 
 // The camera, replacing or changing the scene's
 void add_camera_render_options(CLI::App* render, RenderArgs& a) {
+  render->add_option("--camera", a.camera,
+                     "The scene's camera to render through, by index (candela info lists them; "
+                     "default 0, the first)");
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
@@ -121,6 +130,8 @@ RenderSettings check_render_args(const RenderArgs& a) {
   settings.filter = parse_enum(kPixelFilterNames, "--filter", a.filter);
   settings.sampler = parse_enum(kSamplerNames, "--sampler", a.sampler);
   parse_tonemap(a.tonemap);  // a bad name fails before loading
+  parse_enum(kDefaultLightNames, "--default-light", a.default_light);
+  if (!a.light_units.empty()) parse_enum(kLightUnitNames, "--light-units", a.light_units);
   if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number of stops");
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
@@ -199,9 +210,8 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   add_lighting_render_options(render, a);
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
   render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear");
-  render->add_option(
-      "--tonemap", a.tonemap,
-      "Display transform of PNG/JPEG outputs: neutral (Khronos PBR Neutral, default), agx (as Blender 4) or clamp");
+  render->add_option("--tonemap", a.tonemap,
+                     "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true));
   add_camera_render_options(render, a);
   render->add_option("--filter", a.filter, "Pixel filter: " + enum_names(kPixelFilterNames, true));
   render->add_option("--sampler", a.sampler, "Random numbers: " + enum_names(kSamplerNames, true));

@@ -23,10 +23,12 @@ struct RenderArgs {
   std::string background;
   std::string env;
   std::optional<float> env_strength, env_rotation;
-  bool no_default_light = false;
+  std::string default_light = "auto";  // --default-light auto|on|off (--no-default-light: off)
+  std::string light_units;             // --light-units photometric|radiometric; empty: the scene's
   std::string stats;
   float exposure = 0.0f;
   std::string tonemap = "neutral";
+  std::optional<int> camera;  // --camera N: the scene's camera N (default its first)
   std::string look_from, look_at, up;
   std::optional<float> fov;  // degrees
   std::optional<float> aperture, focus_distance;

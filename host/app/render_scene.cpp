@@ -9,6 +9,7 @@
 #include "app/options.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "scene/default_light.hpp"
 #include "scene/environment.hpp"
 
 namespace candela {
@@ -57,6 +58,15 @@ void set_lens(const RenderArgs& a, std::optional<float> look_at_distance, Camera
 
 void apply_camera_options(const RenderArgs& a, Scene* scene) {
   check_camera_options(a);
+  if (a.camera) {
+    int n = int(scene->cameras.size());
+    if (*a.camera < 0 || *a.camera >= n)
+      throw Error("--camera " + std::to_string(*a.camera) + ": the scene has " +
+                  (n == 0   ? "no camera"
+                   : n == 1 ? "one camera (0)"
+                            : std::to_string(n) + " cameras (0 to " + std::to_string(n - 1) + ")"));
+    scene->camera = scene->cameras[size_t(*a.camera)];
+  }
   bool any = !a.look_from.empty() || !a.look_at.empty() || !a.up.empty() || a.fov || a.aperture || a.focus_distance;
   if (!any) return;
   CameraDesc cam = scene->camera ? *scene->camera : framing_camera(*scene);
@@ -72,20 +82,30 @@ void apply_background_options(const RenderArgs& a, Scene* scene) {
     if (scene->background.x < 0 || scene->background.y < 0 || scene->background.z < 0)
       throw Error("--background must not be negative");
     scene->environment.reset();  // the constant replaces the scene's map too
+    scene->lighting_given = true;
   }
-  if (!a.env.empty()) scene->environment = load_environment(a.env, 1.0f, 0.0f);
+  if (!a.env.empty()) {
+    scene->environment = load_environment(a.env, 1.0f, 0.0f);
+    scene->lighting_given = true;
+  }
 }
 
-// A scene without any light (and without a map) gets the built-in sky
+// The built-in studio, by --default-light's rule (scene/default_light.hpp), said in one line
 void add_default_light(const RenderArgs& a, Scene* scene) {
-  if (scene->has_light() || scene->environment) return;
-  if (a.no_default_light) {
-    std::fprintf(
-        stderr,
-        "warning: the scene has no light: no emissive material and a black background; the image will be black\n");
-  } else {
-    std::fprintf(stderr, "%s\n", kBuiltinSkyNote);
-    scene->environment = builtin_sky();
+  DefaultLight mode = parse_enum(kDefaultLightNames, "--default-light", a.default_light);
+  bool given = scene->lighting_given || scene->environment.has_value();
+  EnvironmentDesc studio = builtin_environment();
+  DefaultLightChoice c = choose_default_light(*scene, mode, given, environment_mean_luminance(studio.image));
+  if (c.use_environment) {
+    bool own_light = scene->has_light();
+    scene->environment = std::move(studio);
+    std::fprintf(stderr, "note: lighting the scene with the built-in studio environment: %s (--default-light off %s)\n",
+                 c.reason.c_str(), own_light ? "leaves it out" : "keeps the scene black");
+  } else if (!given && !scene->has_light()) {
+    std::fprintf(stderr, "warning: the scene has no light and --default-light is off: the image will be black\n");
+  } else if (mode == DefaultLight::Auto && !given) {
+    std::fprintf(stderr, "note: the scene's own lights light it: %s (--default-light on adds the built-in studio)\n",
+                 c.reason.c_str());
   }
 }
 
@@ -121,7 +141,9 @@ void warn_unreachable_lights(const RenderArgs& a, const Scene& scene) {
 
 Scene load_render_scene(RenderArgs* args) {
   RenderArgs& a = *args;
-  Scene scene = load_gltf(a.scene);
+  LoadOptions options;
+  if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
+  Scene scene = load_gltf(a.scene, options);
   if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "nee" : scene.strategy;
   apply_background_options(a, &scene);
   apply_camera_options(a, &scene);
@@ -129,7 +151,10 @@ Scene load_render_scene(RenderArgs* args) {
   add_default_light(a, &scene);
   apply_environment_options(a, &scene);
   warn_unreachable_lights(a, scene);
-  if (!scene.camera) std::fprintf(stderr, "note: the scene has no camera; framing the whole scene from +z\n");
+  if (!scene.camera)
+    std::fprintf(stderr,
+                 "note: the scene has no camera; framing its bounds from an elevated three-quarter view "
+                 "(--look-from and --look-at choose another)\n");
   return scene;
 }
 

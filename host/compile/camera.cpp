@@ -36,7 +36,7 @@ dev::Camera make_device_camera(const CameraDesc& cam, int width, int height) {
 }
 
 dev::Camera compile_camera(const Scene& scene, int width, int height) {
-  return make_device_camera(resolve_camera(scene), width, height);
+  return make_device_camera(resolve_camera(scene, float(width) / float(height)), width, height);
 }
 
 }  // namespace candela

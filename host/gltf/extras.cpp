@@ -1,5 +1,5 @@
 // candela's scene extras (scenes[i].extras.candela): environment map, strategy, global
-// medium and constant background; and the environment map file, read once the document is.
+// medium, constant background and the punctual lights' units; and the environment map file, read once the document is.
 #include <cmath>
 #include <filesystem>
 
@@ -31,6 +31,7 @@ void read_environment(ReadContext& ctx, const tinygltf::Value& env) {
   e.rotation = number("rotation", 0.0f);
   if (e.strength < 0.0f) throw Error(std::string(what) + ".strength must not be negative");
   ctx.scene.environment = e;
+  ctx.scene.lighting_given = true;
 }
 
 void read_strategy(ReadContext& ctx, const tinygltf::Value& st) {
@@ -59,6 +60,16 @@ void read_background(ReadContext& ctx, const tinygltf::Value& bg) {
     if (!(ctx.scene.background[i] >= 0.0f) || !std::isfinite(ctx.scene.background[i]))
       throw Error("scene extras candela.background must be finite and non-negative");
   }
+  ctx.scene.lighting_given = true;
+}
+
+// How the punctual lights' intensities read; the command line's choice wins
+void read_light_units(ReadContext& ctx, const tinygltf::Value& v) {
+  std::string units = v.IsString() ? v.Get<std::string>() : "";
+  if (units != "photometric" && units != "radiometric")
+    throw Error("scene extras candela.light_units must be \"photometric\" or \"radiometric\"");
+  if (!ctx.options.light_units)
+    ctx.scene.light_units = units == "photometric" ? LightUnits::Photometric : LightUnits::Radiometric;
 }
 
 }  // namespace
@@ -70,6 +81,7 @@ void read_scene_extras(ReadContext& ctx, const tinygltf::Value& extras) {
   if (c.Has("strategy")) read_strategy(ctx, c.Get("strategy"));
   if (c.Has("medium")) read_global_medium(ctx, c.Get("medium"));
   if (c.Has("background")) read_background(ctx, c.Get("background"));
+  if (c.Has("light_units")) read_light_units(ctx, c.Get("light_units"));
 }
 
 // The environment map's file, beside the glTF file; none is read from memory alone

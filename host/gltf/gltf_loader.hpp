@@ -1,20 +1,29 @@
 // glTF 2.0 (.gltf / .glb) scene loading through tinygltf.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "scene/scene.hpp"
 
 namespace candela {
 
+// Choices the user makes about reading a file (the command line's), over the file's own
+struct LoadOptions {
+  std::optional<LightUnits> light_units;  // else the scene extras' candela.light_units, else photometric
+};
+
+// Whether the loader implements glTF extension `name` (others are named in a warning)
+bool supported_gltf_extension(const std::string& name);
+
 // Loads the default scene (or the first) with node transforms applied. Throws Error
 // on a missing or malformed file; unsupported features land in Scene::warnings, and so
 // do images that cannot be decoded (their textures fall back or are dropped).
-Scene load_gltf(const std::string& path);
+Scene load_gltf(const std::string& path, const LoadOptions& options = {});
 
 // The same from the bytes of a .gltf or .glb (told apart by the "glTF" magic). External
 // URIs resolve against `base_dir`; with an empty `base_dir` no file is read (only data:
 // URIs and the GLB's own BIN chunk load), as for untrusted input.
-Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir);
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir, const LoadOptions& options = {});
 
 }  // namespace candela

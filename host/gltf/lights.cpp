@@ -38,14 +38,15 @@ void read_spot_cone(const tinygltf::Light& gl, const std::string& what, Punctual
 
 // A light's own properties, checked against what the extension says they must be (an
 // Error) or should be (a warning); read_node_light places it
-PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, Warnings* warn) {
+PunctualLightDesc read_punctual_light(const tinygltf::Light& gl, size_t index, LightUnits units, Warnings* warn) {
   const std::string what = "KHR_lights_punctual light " + std::to_string(index);
   PunctualLightDesc l;
   l.type = light_type(gl, what);
   read_color(gl, what, warn, &l);
-  l.intensity = float(gl.intensity);
-  if (!(l.intensity >= 0.0f && std::isfinite(l.intensity)))
+  if (!(gl.intensity >= 0.0 && std::isfinite(gl.intensity)))
     throw Error(what + ": intensity must be finite and non-negative");
+  // candela and lux to W/sr and W/m^2 (in double: a file written as radiometric x 683 reads back exactly)
+  l.intensity = float(units == LightUnits::Photometric ? gl.intensity / kLumensPerWatt : gl.intensity);
   // tinygltf reads an absent range as 0: both mean infinite
   l.range = float(gl.range);
   if (!(l.range >= 0.0f && std::isfinite(l.range))) throw Error(what + ": range must be greater than 0");
@@ -67,7 +68,8 @@ void read_node_light(ReadContext& ctx, int node_index, const tinygltf::Value& ex
   double index = ext.Get("light").GetNumberAsDouble();
   if (!(index >= 0.0 && index < double(ctx.model.lights.size()) && index == std::floor(index)))
     throw Error(where + " refers to a missing KHR_lights_punctual light");
-  PunctualLightDesc l = read_punctual_light(ctx.model.lights[size_t(index)], size_t(index), &ctx.warn);
+  PunctualLightDesc l =
+      read_punctual_light(ctx.model.lights[size_t(index)], size_t(index), ctx.scene.light_units, &ctx.warn);
   l.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
   if (!(std::isfinite(l.position.x) && std::isfinite(l.position.y) && std::isfinite(l.position.z)))
     throw Error(where + ": the light's position is not finite");

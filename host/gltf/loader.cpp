@@ -86,7 +86,8 @@ tinygltf::Model parse_model(const std::string& data, const std::string& base_dir
 
 // Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
 // External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
-Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name) {
+Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
+                      const LoadOptions& options) {
   if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
   if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
   std::map<int, std::string> image_errors;  // filled by load_checked_image
@@ -98,8 +99,10 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
     scene.warnings.push_back("glTF loader: " + warn);
   }
   Warnings warnings(&scene.warnings);
+  scene.extensions_used = model.extensionsUsed;
   warn_model_wide(model, &warnings);
-  ReadContext ctx{model, scene, warnings, base_dir, image_errors};
+  ReadContext ctx{model, scene, warnings, base_dir, image_errors, options};
+  if (options.light_units) scene.light_units = *options.light_units;
   read_materials(ctx);
   read_nodes(ctx);
   if (scene.meshes.empty()) throw Error("the scene has no triangles to render");
@@ -110,7 +113,9 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
 }  // namespace
 }  // namespace gltf
 
-Scene load_gltf(const std::string& path) {
+bool supported_gltf_extension(const std::string& name) { return gltf::supported_extension(name); }
+
+Scene load_gltf(const std::string& path, const LoadOptions& options) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
@@ -124,11 +129,11 @@ Scene load_gltf(const std::string& path) {
   }
   if (!in || ec) throw Error("cannot read scene file " + path);
   std::string dir = fs::path(path).parent_path().string();
-  return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path);
+  return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path, options);
 }
 
-Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir) {
-  return gltf::load_gltf_bytes(data, base_dir, "(from memory)");
+Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir, const LoadOptions& options) {
+  return gltf::load_gltf_bytes(data, base_dir, "(from memory)", options);
 }
 
 }  // namespace candela

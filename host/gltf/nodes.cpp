@@ -53,8 +53,8 @@ void read_camera_extras(const tinygltf::Value& extras, CameraDesc* cam) {
   }
 }
 
-// The first camera met, perspective or orthographic; znear and zfar are ignored (rays
-// start at the camera and are never clipped)
+// A camera node, perspective or orthographic, into Scene::cameras (the first met also into
+// Scene::camera); znear and zfar are ignored (rays start at the camera and are never clipped)
 void read_camera(ReadContext& ctx, int index, const glm::mat4& world) {
   if (index >= (int)ctx.model.cameras.size()) throw Error("glTF camera " + std::to_string(index) + " does not exist");
   const tinygltf::Camera& c = ctx.model.cameras[size_t(index)];
@@ -79,7 +79,9 @@ void read_camera(ReadContext& ctx, int index, const glm::mat4& world) {
   cam.forward = glm::normalize(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
   cam.up = glm::normalize(glm::vec3(world * glm::vec4(0, 1, 0, 0)));
   read_camera_extras(c.extras, &cam);
-  ctx.scene.camera = cam;
+  cam.name = c.name.empty() ? "camera " + std::to_string(index) : c.name;
+  ctx.scene.cameras.push_back(cam);
+  if (!ctx.scene.camera) ctx.scene.camera = cam;  // the first is the default (render --camera N picks another)
 }
 
 // Each node once: glTF 3.5.2 makes nodes disjoint strict trees (no node has two parents,
@@ -99,7 +101,7 @@ void visit(ReadContext& ctx, int index, const glm::mat4& parent) {
     if (!node.weights.empty() || !ctx.model.meshes[size_t(node.mesh)].weights.empty())
       ctx.warn.add("morph targets are not supported yet: base geometry is rendered");
   }
-  if (node.camera >= 0 && !ctx.scene.camera) read_camera(ctx, node.camera, world);
+  if (node.camera >= 0) read_camera(ctx, node.camera, world);
   if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
     read_node_light(ctx, index, ext->second, world);
   for (int child : node.children) visit(ctx, child, world);

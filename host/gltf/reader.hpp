@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "gltf/gltf_loader.hpp"
 #include "scene/scene.hpp"
 
 namespace candela::gltf {
@@ -35,6 +36,7 @@ struct ReadContext {
   Warnings& warn;
   const std::string& base_dir;                        // where files the scene names are found; empty: nowhere
   const std::map<int, std::string>& image_errors;     // why load_checked_image left each image empty
+  const LoadOptions& options;                         // the user's choices over the file's
   std::map<std::pair<int, bool>, int> textures = {};  // (glTF texture, sRGB) -> Scene::textures or NO_TEXTURE
   size_t degenerate = 0;                              // zero-area triangles skipped
   std::vector<bool> visited = {};                     // nodes reached so far

@@ -8,15 +8,8 @@
 namespace candela {
 
 Tonemap parse_tonemap(const std::string& name) {
-  for (const auto& t : kTonemapNames)
-    if (name == t.name) return t.value;
-  throw Error("tonemap must be neutral, agx or clamp (got '" + name + "')");
-}
-
-const char* tonemap_name(Tonemap t) {
-  for (const auto& n : kTonemapNames)
-    if (n.value == t) return n.name;
-  return "?";
+  if (auto t = enum_value(kTonemapNames, name)) return *t;
+  throw Error("--tonemap must be " + enum_names(kTonemapNames) + ", not '" + name + "'");
 }
 
 glm::vec3 tonemap_pbr_neutral(glm::vec3 c) {

@@ -5,6 +5,8 @@
 #include <glm/glm.hpp>
 #include <string>
 
+#include "base/enum_names.hpp"
+
 namespace candela {
 
 // neutral: Khronos PBR Neutral (made for glTF's base colours: they come out as authored up
@@ -14,16 +16,13 @@ namespace candela {
 // clamp:   no curve, values above 1 clip
 enum class Tonemap { Neutral, Agx, Clamp };
 
-struct TonemapName {
-  Tonemap value;
-  const char* name;
-};
-inline constexpr TonemapName kTonemapNames[] = {
-    {Tonemap::Neutral, "neutral"}, {Tonemap::Agx, "agx"}, {Tonemap::Clamp, "clamp"}};
+inline constexpr EnumName<Tonemap> kTonemapNames[] = {{Tonemap::Neutral, "neutral", "Khronos PBR Neutral, default"},
+                                                      {Tonemap::Agx, "agx", "as Blender 4"},
+                                                      {Tonemap::Clamp, "clamp", "no curve"}};
 
 // Throws Error naming the choices for an unknown name
 Tonemap parse_tonemap(const std::string& name);
-const char* tonemap_name(Tonemap t);
+inline const char* tonemap_name(Tonemap t) { return enum_name(kTonemapNames, t); }
 
 // Khronos PBR Neutral tone mapper (Khronos 3D Commerce, 2024): linear sRGB in, [0, 1] out
 glm::vec3 tonemap_pbr_neutral(glm::vec3 c);

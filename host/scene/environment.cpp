@@ -1,4 +1,4 @@
-// Environment maps on the host (environment.hpp): loading, the built-in sky, the mean radiance.
+// Environment maps on the host (environment.hpp): loading, the built-in studio, the mean radiance.
 #include "scene/environment.hpp"
 
 #include <OpenImageIO/imageio.h>
@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <glm/glm.hpp>
 
 #include "base/error.hpp"
 
@@ -21,9 +22,6 @@ double texel_luminance(const TextureDesc& map, size_t i) {
 }
 
 }  // namespace
-
-const char* const kBuiltinSkyNote =
-    "note: the scene has no light; lighting it with the built-in sky (--no-default-light keeps it black)";
 
 TextureDesc load_environment_image(const std::string& path) {
   namespace fs = std::filesystem;
@@ -78,23 +76,49 @@ EnvironmentDesc load_environment(const std::string& path, float strength, float 
   return e;
 }
 
-EnvironmentDesc builtin_sky() {
-  const int w = 64, h = 32;
-  const double ground[3] = {0.4, 0.35, 0.3}, zenith_gain[3] = {0.1, 0.25, 0.6};
+namespace {
+
+// A soft lobe around unit direction `axis`: exp((cos - 1) / width), 1 on the axis
+double soft_lobe(const glm::dvec3& d, glm::dvec3 axis, double width) {
+  return std::exp((glm::dot(d, glm::normalize(axis)) - 1.0) / width);
+}
+
+// The studio's radiance toward direction d (neutral grey): a bright ceiling over a darker
+// floor, blended across a soft horizon, with a key softbox in front to the left and above
+// (glTF assets face +Z), a weaker fill to the right and a rim light behind
+double studio_radiance(const glm::dvec3& d) {
+  double sky = 0.55 + 0.30 * std::max(d.y, 0.0), floor = 0.18;
+  double t = std::clamp((d.y + 0.2) / 0.28, 0.0, 1.0);
+  double base = floor + (sky - floor) * t * t * (3.0 - 2.0 * t);
+  double key = 4.0 * soft_lobe(d, {-0.45, 0.75, 0.5}, 0.02);
+  double fill = 1.5 * soft_lobe(d, {0.85, 0.35, 0.4}, 0.04);
+  double rim = 2.5 * soft_lobe(d, {0.2, 0.55, -0.8}, 0.02);
+  return base + key + fill + rim;
+}
+
+}  // namespace
+
+EnvironmentDesc builtin_environment() {
+  const int w = 512, h = 256;
   EnvironmentDesc e;
-  e.source = "built-in sky";
+  e.source = "built-in studio";
   TextureDesc& t = e.image;
   t.width = w;
   t.height = h;
+  t.wrap_s = WRAP_REPEAT;
   t.wrap_t = WRAP_CLAMP;
-  t.nearest = true;
+  t.nearest = false;  // bilinear: no steps between texels; every texel is > 0, so the
+                      // piecewise-constant sampling pdf covers the whole sphere
   t.rgbaf.resize(size_t(w) * h * 4);
   for (int r = 0; r < h; ++r) {
-    double y = std::cos(kPi * (r + 0.5) / h);
+    double theta = kPi * (r + 0.5) / h;
     for (int c = 0; c < w; ++c) {
+      // The direction of the texel centre, as cl/lights/environment.cl maps it (rotation 0)
+      double phi = 2.0 * kPi * (c + 0.5) / w;
+      glm::dvec3 d(-std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi));
+      float v = float(studio_radiance(d));
       float* texel = &t.rgbaf[4 * (size_t(r) * w + c)];
-      for (int k = 0; k < 3; ++k)
-        texel[k] = float(y >= 0.0 ? 1.0 + y * zenith_gain[k] : ground[k] + (1.0 - ground[k]) * std::exp(y / 0.1));
+      texel[0] = texel[1] = texel[2] = v;
       texel[3] = 1.0f;
     }
   }

@@ -1,6 +1,6 @@
 // Environment maps on the host: equirectangular images read through OpenImageIO, the
-// built-in sky that lights scenes without any light, and their mean radiance. The sampling
-// distribution is the compile step's (compile/environment_distribution.hpp).
+// built-in studio that lights scenes without light of their own, and their mean radiance.
+// The sampling distribution is the compile step's (compile/environment_distribution.hpp).
 #pragma once
 
 #include <string>
@@ -20,13 +20,12 @@ TextureDesc load_environment_image(const std::string& path);
 // negative or non-finite strength or rotation
 EnvironmentDesc load_environment(const std::string& path, float strength, float rotation);
 
-// The built-in sky, 64 x 32 texels, each the radiance at its centre's height y = cos(theta):
-//   sky (y >= 0):    (1, 1, 1) + y (0.1, 0.25, 0.6)  (1 at the horizon, bluish-white zenith)
-//   ground (y < 0):  g + (1 - g) exp(y / 0.1), g = (0.4, 0.35, 0.3)  (darker, warm)
-EnvironmentDesc builtin_sky();
-
-// The note printed when a scene without light gets the built-in sky
-extern const char* const kBuiltinSkyNote;
+// The built-in environment that lights scenes without light of their own (the default light,
+// scene/default_light.hpp): a neutral grey studio, 512 x 256 texels looked up bilinearly.
+// Radiance 0.55 at the horizon to 0.85 overhead, a floor of 0.18 below a soft horizon
+// (blended from 12 degrees below to 5 above), and three soft lights: a key (peak 4.6, about 10 degrees wide) in front,
+// left and above, a fill (2, right) and a rim light (3, behind); mean radiance about 0.5.
+EnvironmentDesc builtin_environment();
 
 // Mean luminance of the radiance over the sphere (texels weighted by solid angle)
 double environment_mean_luminance(const TextureDesc& map);

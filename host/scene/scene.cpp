@@ -116,19 +116,33 @@ glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm
   return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
 }
 
-CameraDesc framing_camera(const Scene& scene) {
-  // Look at the bounds from +z, far enough to see the whole bounding sphere
+CameraDesc framing_camera(const Scene& scene, float aspect) {
+  const float kDegree = 3.14159265f / 180.0f, kMargin = 0.95f;
   Bounds b = scene.bounds();
   CameraDesc cam;
-  float r = std::max(b.radius(), 1e-3f);
-  float dist = r / std::sin(0.5f * cam.yfov) * 1.05f;
-  cam.position = b.center() + glm::vec3(0.0f, 0.0f, dist);
-  cam.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+  if (b.empty()) return cam;
+  glm::vec3 extent = b.hi - b.lo, centre = b.center();
+  bool flat = extent.y < 0.15f * std::max(extent.x, extent.z);
+  float azimuth = 30.0f * kDegree, elevation = (flat ? 50.0f : 20.0f) * kDegree;
+  glm::vec3 back(std::sin(azimuth) * std::cos(elevation), std::sin(elevation), std::cos(azimuth) * std::cos(elevation));
+  cam.forward = -back;
+  glm::vec3 right = glm::normalize(glm::cross(cam.forward, cam.up)), up = glm::cross(right, cam.forward);
+  // The distance along `back` at which every corner projects inside the frame
+  float tan_y = std::tan(0.5f * cam.yfov) * kMargin, tan_x = tan_y * (aspect > 0.0f ? aspect : 1.0f);
+  float dist = 0.0f, nearest = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    glm::vec3 q = glm::vec3(i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z) - centre;
+    float along = glm::dot(q, back);
+    dist = std::max({dist, along + std::fabs(glm::dot(q, right)) / tan_x, along + std::fabs(glm::dot(q, up)) / tan_y});
+    nearest = std::max(nearest, along);
+  }
+  dist = std::max({dist, 1.05f * nearest, 1e-3f});
+  cam.position = centre + dist * back;
   return cam;
 }
 
-CameraDesc resolve_camera(const Scene& scene) {
-  CameraDesc cam = scene.camera ? *scene.camera : framing_camera(scene);
+CameraDesc resolve_camera(const Scene& scene, float aspect) {
+  CameraDesc cam = scene.camera ? *scene.camera : framing_camera(scene, aspect);
   if (!(cam.aperture_radius >= 0.0f) || !std::isfinite(cam.aperture_radius))
     throw Error("the camera's aperture radius must be finite and non-negative");
   if (cam.aperture_radius > 0.0f && cam.projection == Projection::Orthographic)

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/device_types.hpp"
+#include "base/enum_names.hpp"
 #include "base/scene_features.hpp"
 
 namespace candela {
@@ -59,6 +60,7 @@ struct MediumDesc {
 // A material as glTF describes it (defaults: the glTF specification's), or a measured
 // conductor; factors multiply the textures of the same name
 struct MaterialDesc {
+  std::string name;  // the glTF material's, if it has one
   uint32_t type = MATERIAL_GLTF;
   glm::vec4 base_color{1.0f};  // linear rgba
   float metallic = 1.0f, roughness = 1.0f;
@@ -122,23 +124,33 @@ struct MeshDesc {
   size_t triangles() const { return indices.size() / 3; }
 };
 
-// A KHR_lights_punctual light placed in the world. Photometric values are taken one to one
-// as radiometric ones (no 683 lm/W): intensity in candela is radiant intensity (W/sr),
-// illuminance in lux is irradiance; colour (linear RGB) multiplies the intensity.
+// How KHR_lights_punctual intensities are read: photometric, the extension's units (candela
+// for point and spot lights, lux for directional ones), turned into radiant intensity (W/sr)
+// and irradiance (W/m^2) by 683 lm/W as Blender's importer does; or radiometric, taken one
+// to one, for files written that way (scene extras candela.light_units, --light-units)
+enum class LightUnits { Photometric, Radiometric };
+inline constexpr EnumName<LightUnits> kLightUnitNames[] = {
+    {LightUnits::Photometric, "photometric", "candela and lux, divided by 683 lm/W"},
+    {LightUnits::Radiometric, "radiometric", "W/sr and W/m^2, one to one"}};
+constexpr double kLumensPerWatt = 683.0;
+
+// A KHR_lights_punctual light placed in the world, in radiometric units; colour (linear
+// RGB) multiplies the intensity.
 enum class PunctualType { Point, Spot, Directional };
 struct PunctualLightDesc {
   PunctualType type = PunctualType::Point;
   glm::vec3 position{0.0f};                // point, spot: the node's world origin
   glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot, directional: the node's world -Z, unit
   glm::vec3 color{1.0f};
-  float intensity = 1.0f;                            // point, spot: candela (W/sr); directional: lux (W/m^2)
-  float range = 0.0f;                                // point, spot: 0 = infinite
+  float intensity = 1.0f;  // point, spot: radiant intensity (W/sr); directional: irradiance (W/m^2)
+  float range = 0.0f;      // point, spot: 0 = infinite
   float inner_cone = 0.0f, outer_cone = 0.7853982f;  // spot, radians
 };
 
 enum class Projection { Perspective, Orthographic };
 
 struct CameraDesc {
+  std::string name;  // the glTF camera's (or "camera N"); empty for cameras made otherwise
   Projection projection = Projection::Perspective;
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, -1.0f};
@@ -171,14 +183,18 @@ struct Scene {
   std::vector<MeshDesc> meshes;
   std::vector<MaterialDesc> materials;
   std::vector<TextureDesc> textures;
-  std::optional<CameraDesc> camera;
+  std::optional<CameraDesc> camera;                // the one to render with: the first of `cameras`, or none
+  std::vector<CameraDesc> cameras;                 // every camera node of the scene, in node order
   std::string strategy;                            // scene extras candela.strategy (nee, bsdf, auto); empty: not given
   glm::vec3 background{0.0f};                      // constant environment radiance
   std::vector<PunctualLightDesc> punctual_lights;  // KHR_lights_punctual
   std::optional<EnvironmentDesc> environment;      // a map; when present, background is not used
   std::vector<MediumDesc> media;                   // the global medium and the materials' interiors
   int global_medium = -1;                          // into media: what fills the scene (scene extras); -1: vacuum
-  std::vector<std::string> warnings;               // each unsupported feature named once
+  LightUnits light_units = LightUnits::Photometric;  // how the file's punctual lights were read
+  bool lighting_given = false;               // the scene (extras) or the command line set the background or environment
+  std::vector<std::string> warnings;         // each unsupported feature named once
+  std::vector<std::string> extensions_used;  // the file's extensionsUsed
 
   size_t triangles() const;
   Bounds bounds() const;
@@ -191,13 +207,18 @@ struct Scene {
 // (the host twin of triangle_normal_area in cl/core/geometry.cl)
 glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, double* area);
 
-// A perspective camera looking at the scene's bounds from +z, far enough to see them all
-CameraDesc framing_camera(const Scene& scene);
+// Without a camera of the scene's: a perspective camera (yfov 45 degrees) looking at the
+// centre of the scene's bounds from an elevated three-quarter view, 30 degrees to the right
+// of +Z (glTF's front) and 20 degrees up, or 50 degrees up for a flat horizontal scene (its
+// height under 15 % of its width), so that no flat asset is seen edge-on and no box
+// face-on; as close as keeps all eight corners of the bounds inside the frame of an image
+// of width / height `aspect`, with 5 % to spare.
+CameraDesc framing_camera(const Scene& scene, float aspect = 1.0f);
 // The camera to render with: the scene's, else framing_camera. An unset focus distance
 // becomes the distance from the camera to the bounds' centre along the view axis (when
 // that centre is not in front of the camera: the bounds' radius). Throws Error for an
 // invalid camera (negative aperture, non-positive focus distance, a lens on an
 // orthographic camera).
-CameraDesc resolve_camera(const Scene& scene);
+CameraDesc resolve_camera(const Scene& scene, float aspect = 1.0f);
 
 }  // namespace candela

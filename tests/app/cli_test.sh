@@ -53,6 +53,19 @@ expect_error "zero focus distance" "focus-distance must be a positive distance" 
 expect_error "negative focus distance" "focus-distance must be a positive distance" -- "$bin" render "$scene" -o "$tmp/x.png" --focus-distance -1 --device pocl
 expect_error "unknown filter" "filter must be box, tent or gaussian" -- "$bin" render "$scene" -o "$tmp/x.png" --filter lanczos --device pocl
 expect_error "unknown sampler" "sampler must be sobol or independent" -- "$bin" render "$scene" -o "$tmp/x.png" --sampler halton --device pocl
+expect_error "unknown default light" "default-light must be auto, on or off" -- "$bin" render "$scene" -o "$tmp/x.png" --default-light maybe --device pocl
+expect_error "unknown light units" "light-units must be photometric or radiometric" -- "$bin" render "$scene" -o "$tmp/x.png" --light-units nits --device pocl
+expect_error "camera index out of range" "the scene has one camera (0)" -- "$bin" render "$scene" -o "$tmp/x.png" --camera 3 --device pocl
+expect_error "info on a missing scene" "scene file not found" -- "$bin" info "$tmp/nope.gltf"
+
+# candela info: geometry, cameras, lights and the default light's choice of a shipped scene
+if "$bin" info "$scene" >"$tmp/info" 2>&1 && grep -q "^geometry: 32 triangles" "$tmp/info" &&
+    grep -q "^cameras: 1" "$tmp/info" && grep -q "^default light .*: none" "$tmp/info"; then
+  pass "info lists the scene"
+else
+  fail "info lists the scene:"; cat "$tmp/info"
+fi
+
 # The Cornell box seen by an orthographic camera 0.4 wide and 0.3 high
 python3 - "$scene" "$tmp/ortho.gltf" <<'PY'
 import json, sys
@@ -95,26 +108,28 @@ else
   fail "environment scene renders"; cat "$tmp/err"
 fi
 
-# Default lighting: the Cornell box without its light gets the built-in sky, announced on
-# stderr; --no-default-light keeps it black (with a warning)
+# Default lighting: the Cornell box without its light (and without its black background)
+# gets the built-in studio, announced on stderr; --no-default-light keeps it black (with a
+# warning)
 python3 - "$scene" "$tmp/dark.gltf" <<'PY'
 import json, sys
 doc = json.load(open(sys.argv[1]))
 for m in doc["materials"]:
     m.pop("emissiveFactor", None)
     m.get("extensions", {}).pop("KHR_materials_emissive_strength", None)
+doc["scenes"][0].pop("extras", None)
 json.dump(doc, open(sys.argv[2], "w"))
 PY
 mean_of() { oiiotool --stats "$1" | sed -n 's/.*Stats Avg: \([0-9.e+-]*\).*/\1/p' | head -1; }
 if "$bin" render "$tmp/dark.gltf" -o "$tmp/sky.exr" --spp 2 --width 16 --height 16 --device pocl -q >/dev/null 2>"$tmp/err" &&
-  grep -q "note: the scene has no light; lighting it with the built-in sky (--no-default-light keeps it black)" "$tmp/err" &&
+  grep -q "note: lighting the scene with the built-in studio environment: the scene has no light (--default-light off keeps the scene black)" "$tmp/err" &&
   { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) > 0.05" "$(mean_of "$tmp/sky.exr")"; }; then
-  pass "a scene without light gets the built-in sky"
+  pass "a scene without light gets the built-in studio"
 else
-  fail "a scene without light gets the built-in sky"; cat "$tmp/err"
+  fail "a scene without light gets the built-in studio"; cat "$tmp/err"
 fi
 if "$bin" render "$tmp/dark.gltf" -o "$tmp/black.exr" --spp 2 --width 16 --height 16 --device pocl -q --no-default-light \
-    >/dev/null 2>"$tmp/err" && grep -q "the image will be black" "$tmp/err" && ! grep -q "built-in sky" "$tmp/err" &&
+    >/dev/null 2>"$tmp/err" && grep -q "the image will be black" "$tmp/err" && ! grep -q "built-in studio" "$tmp/err" &&
   { ! command -v oiiotool >/dev/null || python3 -c "import sys; assert float(sys.argv[1]) == 0" "$(mean_of "$tmp/black.exr")"; }; then
   pass "--no-default-light keeps it black"
 else

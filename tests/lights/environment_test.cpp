@@ -439,24 +439,52 @@ TEST(EnvironmentLoader, SceneExtras) {
   EXPECT_FALSE(no_folder.warnings.empty());
 }
 
-// The built-in sky: about 1 at the horizon, brighter and bluer at the zenith, darker below
-TEST(EnvironmentLoader, BuiltinSky) {
-  EnvironmentDesc sky = builtin_sky();
-  const TextureDesc& t = sky.image;
-  auto texel = [&](int y) {
-    return glm::vec3(t.rgbaf[4 * size_t(y) * t.width], t.rgbaf[4 * size_t(y) * t.width + 1],
-                     t.rgbaf[4 * size_t(y) * t.width + 2]);
+// The built-in studio: neutral grey, smooth (bilinear, fine enough that neighbouring texels
+// differ by little away from the soft lights), brighter overhead than at the horizon and
+// than the floor, with its key light in front to the left and above
+TEST(EnvironmentLoader, BuiltinStudio) {
+  EnvironmentDesc studio = builtin_environment();
+  const TextureDesc& t = studio.image;
+  EXPECT_FALSE(t.nearest);
+  EXPECT_GE(t.width, 512);
+  auto texel = [&](int x, int y) {
+    const float* p = &t.rgbaf[4 * (size_t(y) * t.width + x)];
+    return glm::vec3(p[0], p[1], p[2]);
   };
-  glm::vec3 zenith = texel(0), above = texel(t.height / 2 - 1), below = texel(t.height / 2),
-            nadir = texel(t.height - 1);
-  EXPECT_NEAR(above.x, 1.0f, 0.02f);
-  EXPECT_GT(zenith.z, zenith.x);
-  EXPECT_GT(zenith.z, above.z);
-  EXPECT_LT(below.y, above.y);
-  EXPECT_LT(nadir.y, 0.5f);
+  // Column w / 4 looks along -X, away from the soft lights; row `y` at height cos(pi (y + 1/2) / h)
+  // 15 degrees above the horizon: row h (90 - 15) / 180; the ceiling there is 0.55 + 0.3 sin 15
+  glm::vec3 zenith = texel(t.width / 4, 0), horizon = texel(t.width / 4, t.height * 75 / 180),
+            nadir = texel(t.width / 4, t.height - 1);
+  EXPECT_EQ(zenith.x, zenith.y);
+  EXPECT_EQ(zenith.y, zenith.z);
+  EXPECT_GT(zenith.x, horizon.x);
+  EXPECT_GT(horizon.x, nadir.x);
+  EXPECT_NEAR(horizon.x, 0.55f + 0.3f * std::sin(15.0f * 3.14159265f / 180.0f), 0.01f);
+  EXPECT_NEAR(nadir.x, 0.18f, 0.01f);
+  // The background (column w / 4 looks along -X, away from the soft lights) has no hard
+  // band: neighbouring rows differ by under 15 % (the former 64 x 32 sky stepped by 25 % at
+  // once), and the horizon blends over at least 10 rows between floor and ceiling
+  int blend_rows = 0;
+  for (int y = 1; y < t.height; ++y) {
+    float a = texel(t.width / 4, y - 1).x, b = texel(t.width / 4, y).x;
+    EXPECT_LT(std::fabs(a - b), 0.15f * std::max(a, b)) << "rows " << y - 1 << " and " << y;
+    blend_rows += b > 0.2f && b < 0.5f;
+  }
+  EXPECT_GE(blend_rows, 10);
+  // The key light: brightest toward (-0.45, 0.75, 0.5)
+  float best = 0.0f;
+  glm::vec3 best_dir(0.0f);
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x)
+      if (texel(x, y).x > best) {
+        best = texel(x, y).x;
+        double theta = kPi * (y + 0.5) / t.height, phi = 2.0 * kPi * (x + 0.5) / t.width;
+        best_dir = glm::vec3(-std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi));
+      }
+  EXPECT_GT(glm::dot(best_dir, glm::normalize(glm::vec3(-0.45f, 0.75f, 0.5f))), 0.99f);
   double mean = environment_mean_luminance(t);
-  EXPECT_GT(mean, 0.6);
-  EXPECT_LT(mean, 1.2);
+  EXPECT_GT(mean, 0.35);
+  EXPECT_LT(mean, 0.7);
 }
 
 }  // namespace candela::test

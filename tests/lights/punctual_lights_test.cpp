@@ -512,7 +512,7 @@ TEST(PunctualLoader, ReadsPositionDirectionIntensityAndCone) {
   EXPECT_EQ(p.type, PunctualType::Point);
   expect_vec(p.position, {1, 2, 3});
   expect_vec(p.color, {1, 0.5f, 0.25f});
-  EXPECT_FLOAT_EQ(p.intensity, 7.0f);
+  EXPECT_FLOAT_EQ(p.intensity, float(7.0 / kLumensPerWatt));  // candela to W/sr
   EXPECT_FLOAT_EQ(p.range, 4.0f);
   const PunctualLightDesc& sp = s.punctual_lights[1];
   EXPECT_EQ(sp.type, PunctualType::Spot);
@@ -550,7 +550,7 @@ TEST(PunctualLoader, NodeTransformRotatesASpotLight) {
   expect_vec(l.position, {1, 0, 0});
   expect_vec(l.direction, {0, 1, 0});
   EXPECT_NEAR(glm::length(l.direction), 1.0f, 1e-6f);
-  EXPECT_FLOAT_EQ(l.intensity, 5.0f);
+  EXPECT_FLOAT_EQ(l.intensity, float(5.0 / kLumensPerWatt));
   EXPECT_FLOAT_EQ(l.outer_cone, 0.5f);
   EXPECT_FLOAT_EQ(l.inner_cone, 0.0f);
 }

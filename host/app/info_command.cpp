@@ -1,0 +1,120 @@
+// `candela info SCENE`: what a scene holds, as candela reads it: size, extensions, cameras,
+// lights, materials, and the warnings of what it leaves out.
+#include <cstdio>
+#include <string>
+
+#include "app/commands.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "scene/default_light.hpp"
+#include "scene/environment.hpp"
+
+namespace candela {
+namespace {
+
+std::string vec(const glm::vec3& v) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.4g, %.4g, %.4g)", v.x, v.y, v.z);
+  return text;
+}
+
+std::string quoted_or(const std::string& name, const std::string& fallback) {
+  return name.empty() ? fallback : "'" + name + "'";
+}
+
+void print_geometry(const Scene& s) {
+  size_t vertices = 0;
+  for (const MeshDesc& m : s.meshes) vertices += m.positions.size();
+  Bounds b = s.bounds();
+  std::printf("geometry: %zu triangles, %zu vertices in %zu primitives; bounds %s to %s\n", s.triangles(), vertices,
+              s.meshes.size(), vec(b.lo).c_str(), vec(b.hi).c_str());
+}
+
+void print_extensions(const Scene& s) {
+  std::printf("extensions used:%s\n", s.extensions_used.empty() ? " none" : "");
+  for (const std::string& e : s.extensions_used)
+    std::printf("  %s%s\n", e.c_str(), supported_gltf_extension(e) ? "" : "  (not supported: ignored)");
+}
+
+void print_cameras(const Scene& s) {
+  std::printf("cameras: %zu%s\n", s.cameras.size(),
+              s.cameras.empty() ? " (render frames the bounds from an elevated three-quarter view)" : "");
+  for (size_t i = 0; i < s.cameras.size(); ++i) {
+    const CameraDesc& c = s.cameras[i];
+    std::string lens = c.projection == Projection::Perspective
+                           ? "perspective, yfov " + std::to_string(int(c.yfov * 180.0f / 3.14159265f + 0.5f)) + " deg"
+                           : "orthographic, half-height " + std::to_string(c.ymag).substr(0, 6);
+    std::printf("  %zu: %s %s at %s looking %s%s\n", i, quoted_or(c.name, "camera").c_str(), lens.c_str(),
+                vec(c.position).c_str(), vec(c.forward).c_str(), i == 0 ? "  (the default; render --camera N)" : "");
+  }
+}
+
+void print_lights(const Scene& s) {
+  const char* kTypes[] = {"point", "spot", "directional"};
+  std::printf("punctual lights: %zu (intensities read as %s)\n", s.punctual_lights.size(),
+              enum_name(kLightUnitNames, s.light_units));
+  for (const PunctualLightDesc& l : s.punctual_lights)
+    std::printf("  %s, colour %s x %.4g %s, at %s\n", kTypes[int(l.type)], vec(l.color).c_str(), l.intensity,
+                l.type == PunctualType::Directional ? "W/m^2" : "W/sr", vec(l.position).c_str());
+  size_t emissive = 0, triangles = 0;
+  for (const MeshDesc& m : s.meshes) {
+    const glm::vec3& e = s.materials.at(m.material).emission;
+    if (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f) {
+      ++emissive;
+      triangles += m.triangles();
+    }
+  }
+  std::printf("emissive primitives: %zu (%zu triangles)\n", emissive, triangles);
+  if (s.environment)
+    std::printf("environment: %s, strength %.4g, rotation %.4g deg\n", s.environment->source.c_str(),
+                s.environment->strength, s.environment->rotation);
+  else
+    std::printf("background: %s\n", vec(s.background).c_str());
+  EnvironmentDesc studio = builtin_environment();
+  DefaultLightChoice c = choose_default_light(s, DefaultLight::Auto, s.lighting_given || s.environment.has_value(),
+                                              environment_mean_luminance(studio.image));
+  std::printf("default light (render --default-light auto): %s: %s\n",
+              c.use_environment ? "the built-in studio" : "none", c.reason.c_str());
+}
+
+void print_materials(const Scene& s) {
+  const char* kSlots[TEX_SLOTS] = {"base colour",         "metallic-roughness", "normal",          "emission",
+                                   "transmission",        "specular",           "specular colour", "clearcoat",
+                                   "clearcoat roughness", "anisotropy"};
+  size_t n = s.materials.size() - 1;  // the last is the glTF default material
+  std::printf("materials: %zu\n", n);
+  for (size_t i = 0; i < n; ++i) {
+    const MaterialDesc& m = s.materials[i];
+    std::string textures;
+    for (int k = 0; k < TEX_SLOTS; ++k)
+      if (m.texture(k).index != NO_TEXTURE) textures += std::string(textures.empty() ? "" : ", ") + kSlots[k];
+    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
+                m.type == MATERIAL_CONDUCTOR ? "measured conductor" : "glTF metallic-roughness", m.metallic,
+                m.roughness, m.transmission > 0.0f ? ", transmissive" : "", m.clearcoat > 0.0f ? ", clearcoat" : "",
+                textures.empty() ? "" : ("; textures: " + textures).c_str());
+  }
+}
+
+}  // namespace
+
+CLI::App* add_info_command(CLI::App* app, InfoArgs* args) {
+  CLI::App* info = app->add_subcommand("info",
+                                       "Print what a glTF scene holds as candela reads it: geometry, "
+                                       "extensions, cameras, lights, materials and warnings");
+  info->add_option("scene", args->scene, "Scene file (.gltf or .glb)")->required();
+  return info;
+}
+
+int run_info_command(const InfoArgs& args) {
+  Scene s = load_gltf(args.scene);
+  std::printf("scene: %s\n", args.scene.c_str());
+  print_geometry(s);
+  print_extensions(s);
+  print_cameras(s);
+  print_lights(s);
+  print_materials(s);
+  std::printf("warnings: %zu\n", s.warnings.size());
+  for (const std::string& w : s.warnings) std::printf("  %s\n", w.c_str());
+  return 0;
+}
+
+}  // namespace candela

@@ -1,0 +1,198 @@
+#include "scene/default_light.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace candela {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kPoints = 512;           // surface points the share is the median over
+constexpr size_t kMaxEmitters = 4096;  // emissive triangles beyond this are subsampled by power
+
+struct Point {
+  glm::dvec3 p, n;
+};
+
+// An emissive triangle as a small source: its centroid, unit normal, area and radiance
+// luminance (texture mean included), and whether it emits from both faces
+struct Emitter {
+  glm::dvec3 c, n;
+  double area = 0.0, radiance = 0.0, weight = 1.0;  // weight: 1 / selection probability
+  bool two_sided = false;
+};
+
+double mean_emission(const Scene& scene, const MaterialDesc& m, std::vector<double>* texture_mean) {
+  double lum = dev::luminance_rgb(m.emission.x, m.emission.y, m.emission.z);
+  int tex = m.texture(TEX_EMISSION).index;
+  if (lum <= 0.0 || tex == NO_TEXTURE) return lum;
+  double& mean = (*texture_mean)[size_t(tex)];
+  if (mean < 0.0) mean = scene.textures[size_t(tex)].mean_luminance();
+  return lum * mean;
+}
+
+// Triangles of non-emissive materials, with their areas (the points' population), and the
+// emitters that are lights: brighter than white (radiance > 1, which glTF reaches only
+// through KHR_materials_emissive_strength). Emission up to white is a glowing material
+// (a screen, a label, a visor), which a glTF viewer never lets light anything.
+void gather(const Scene& scene, std::vector<Point>* tris_c, std::vector<double>* tris_area, std::vector<Emitter>* em,
+            double* emissive_area) {
+  std::vector<double> texture_mean(scene.textures.size(), -1.0);
+  for (const MeshDesc& mesh : scene.meshes) {
+    const MaterialDesc& m = scene.materials.at(mesh.material);
+    double peak = std::max({m.emission.x, m.emission.y, m.emission.z});
+    double radiance = peak > 1.0 ? mean_emission(scene, m, &texture_mean) : 0.0;
+    for (size_t t = 0; t < mesh.triangles(); ++t) {
+      glm::dvec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
+                 c = mesh.positions[mesh.indices[3 * t + 2]];
+      glm::dvec3 cr = glm::cross(b - a, c - a);
+      double len = glm::length(cr);
+      if (!(len > 0.0) || !std::isfinite(len)) continue;
+      glm::dvec3 n = cr / len, centroid = (a + b + c) / 3.0;
+      if (peak > 0.0) *emissive_area += 0.5 * len;
+      if (radiance > 0.0) {
+        em->push_back({centroid, n, 0.5 * len, radiance, 1.0, m.double_sided});
+      } else {
+        // Points are drawn later, uniformly inside the chosen triangle: keep its corners
+        tris_c->push_back({a, n});
+        tris_c->push_back({b, n});
+        tris_c->push_back({c, n});
+        tris_area->push_back(0.5 * len);
+      }
+    }
+  }
+}
+
+// At most kMaxEmitters emitters, drawn by power with replacement and weighted so that the sum
+// over them estimates the sum over all
+std::vector<Emitter> subsample(std::vector<Emitter> all, std::mt19937_64* rng) {
+  if (all.size() <= kMaxEmitters) return all;
+  std::vector<double> power(all.size());
+  for (size_t i = 0; i < all.size(); ++i) power[i] = all[i].radiance * all[i].area;
+  std::discrete_distribution<size_t> pick(power.begin(), power.end());
+  double total = 0.0;
+  for (double p : power) total += p;
+  std::vector<Emitter> out;
+  for (size_t k = 0; k < kMaxEmitters; ++k) {
+    size_t i = pick(*rng);
+    Emitter e = all[i];
+    e.weight = total / (power[i] * double(kMaxEmitters));
+    out.push_back(e);
+  }
+  return out;
+}
+
+// Irradiance at p on its brighter side (n or -n) from the emitters and punctual lights,
+// unoccluded; a source closer than its own size contributes at most pi x its radiance
+double irradiance(const Point& q, const std::vector<Emitter>& emitters, const Scene& scene) {
+  double front = 0.0, back = 0.0;
+  auto add = [&](double e, double cos_p) { (cos_p > 0.0 ? front : back) += e * std::fabs(cos_p); };
+  for (const Emitter& e : emitters) {
+    glm::dvec3 d = e.c - q.p;
+    double r2 = glm::dot(d, d);
+    if (!(r2 > 0.0)) continue;
+    glm::dvec3 w = d / std::sqrt(r2);
+    double cos_e = -glm::dot(w, e.n);  // > 0: q is in front of the emitting face
+    if (e.two_sided) cos_e = std::fabs(cos_e);
+    if (cos_e <= 0.0) continue;
+    double solid_angle = std::min(e.area * cos_e / r2, 2.0 * kPi);
+    add(e.weight * e.radiance * solid_angle, glm::dot(w, q.n));
+  }
+  for (const PunctualLightDesc& l : scene.punctual_lights) {
+    double power = dev::luminance_rgb(l.color.x, l.color.y, l.color.z) * l.intensity;
+    if (!(power > 0.0)) continue;
+    if (l.type == PunctualType::Directional) {
+      add(power, -glm::dot(glm::dvec3(l.direction), q.n));
+      continue;
+    }
+    glm::dvec3 d = glm::dvec3(l.position) - q.p;
+    double r2 = glm::dot(d, d);
+    if (!(r2 > 0.0)) continue;
+    glm::dvec3 w = d / std::sqrt(r2);
+    double scale = 1.0;
+    if (l.range > 0.0f) scale = std::clamp(1.0 - std::pow(std::sqrt(r2) / l.range, 4.0), 0.0, 1.0);
+    if (l.type == PunctualType::Spot) {
+      double c = -glm::dot(w, glm::dvec3(l.direction));
+      double lo = std::cos(double(l.outer_cone)), hi = std::cos(double(l.inner_cone));
+      double t = std::clamp((c - lo) / std::max(hi - lo, 1e-3), 0.0, 1.0);
+      scale *= t * t;
+    }
+    add(power * scale / r2, glm::dot(w, q.n));
+  }
+  return std::max(front, back);
+}
+
+}  // namespace
+
+OwnLight own_light_share(const Scene& scene, double environment_radiance) {
+  std::vector<Point> corners;
+  std::vector<double> areas;
+  std::vector<Emitter> emitters;
+  double emissive_area = 0.0;
+  gather(scene, &corners, &areas, &emitters, &emissive_area);
+  double lit_area = 0.0;
+  for (double a : areas) lit_area += a;
+  OwnLight own;
+  own.lights = !emitters.empty() || scene.punctual_light_count() > 0;
+  // Mostly emitters: the asset is its glowing parts, with little for them to light
+  own.mostly_emissive = !(lit_area > emissive_area);
+  if (!own.lights || own.mostly_emissive) return own;
+  std::mt19937_64 rng(0x63616e64656c61ull);  // fixed: the same scene gives the same answer
+  emitters = subsample(std::move(emitters), &rng);
+  std::discrete_distribution<size_t> pick(areas.begin(), areas.end());
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  double e_env = kPi * environment_radiance;
+  std::vector<double> share;
+  for (int k = 0; k < kPoints; ++k) {
+    size_t t = pick(rng);
+    double su = std::sqrt(u01(rng)), v = u01(rng);
+    const Point &a = corners[3 * t], &b = corners[3 * t + 1], &c = corners[3 * t + 2];
+    Point q{(1.0 - su) * a.p + su * (1.0 - v) * b.p + su * v * c.p, a.n};
+    q.p += 1e-4 * q.n * std::max(1.0, glm::length(q.p));  // off the surface, as a ray would start
+    share.push_back(irradiance(q, emitters, scene) / e_env);
+  }
+  std::nth_element(share.begin(), share.begin() + kPoints / 2, share.end());
+  own.share = share[kPoints / 2];
+  return own;
+}
+
+DefaultLightChoice choose_default_light(const Scene& scene, DefaultLight mode, bool environment_given,
+                                        double environment_radiance) {
+  DefaultLightChoice c;
+  if (environment_given) {
+    c.reason = "the scene's own environment or background lights it";
+    return c;
+  }
+  if (mode == DefaultLight::Off) {
+    c.reason = "--default-light off";
+    return c;
+  }
+  if (mode == DefaultLight::On) {
+    c.use_environment = true;
+    c.reason = "--default-light on";
+    return c;
+  }
+  if (!scene.has_light()) {
+    c.use_environment = true;
+    c.reason = "the scene has no light";
+    return c;
+  }
+  OwnLight own = own_light_share(scene, environment_radiance);
+  c.own_share = own.share;
+  c.use_environment = c.own_share < kOwnLightShareThreshold;
+  if (!own.lights) {
+    c.reason = "its only emitters glow (no brighter than white): they are materials, not lights";
+  } else if (own.mostly_emissive) {
+    c.reason = "its emitters are most of its surface, with little for them to light";
+  } else {
+    char text[160];
+    std::snprintf(text, sizeof text, "its own lights give %.2g%% of the light the studio would on its surfaces",
+                  100.0 * c.own_share);
+    c.reason = text;
+  }
+  return c;
+}
+
+}  // namespace candela

@@ -1,0 +1,182 @@
+// The default light's rule (scene/default_light.hpp), the framing camera of scenes without
+// one (scene/scene.hpp), and KHR_lights_punctual's photometric units (gltf/lights.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "base/error.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "scene/default_light.hpp"
+#include "support/gltf_builder.hpp"
+
+namespace candela::test {
+namespace {
+
+// An axis-aligned quad of `material` spanning [lo, hi] (one coordinate equal), facing `n`
+void add_quad(Scene* s, glm::vec3 lo, glm::vec3 hi, glm::vec3 n, uint32_t material) {
+  MeshDesc m;
+  glm::vec3 a = lo, c = hi, b, d;
+  if (lo.y == hi.y) {
+    b = {hi.x, lo.y, lo.z};
+    d = {lo.x, lo.y, hi.z};
+  } else if (lo.z == hi.z) {
+    b = {hi.x, lo.y, lo.z};
+    d = {lo.x, hi.y, lo.z};
+  } else {
+    b = {lo.x, hi.y, lo.z};
+    d = {lo.x, lo.y, hi.z};
+  }
+  m.positions = {a, b, c, d};
+  glm::vec3 face = glm::cross(b - a, c - a);
+  m.indices =
+      glm::dot(face, n) > 0.0f ? std::vector<uint32_t>{0, 1, 2, 0, 2, 3} : std::vector<uint32_t>{0, 2, 1, 0, 3, 2};
+  m.material = material;
+  s->meshes.push_back(m);
+}
+
+MaterialDesc emitter(float radiance) {
+  MaterialDesc m;
+  m.emission = glm::vec3(radiance);
+  return m;
+}
+
+// A 2 x 2 floor with a square emitter of side `side` and radiance `radiance` at height 1
+Scene floor_under_light(float radiance, float side) {
+  Scene s;
+  s.materials = {MaterialDesc(), emitter(radiance)};
+  add_quad(&s, {-1, 0, -1}, {1, 0, 1}, {0, 1, 0}, 0);
+  add_quad(&s, {-side / 2, 1, -side / 2}, {side / 2, 1, side / 2}, {0, -1, 0}, 1);
+  return s;
+}
+
+TEST(DefaultLight, OwnLightShareIsTheIrradianceRatio) {
+  // A small emitter right above the floor's centre: at the median floor point (about
+  // 0.7 from the centre) the irradiance is L A cos^2 / r^2 ~ L A / 1.5^2 * (1 / 1.5): ~ 0.004 L
+  // for A = 0.01, against pi x 1 from an environment of radiance 1
+  OwnLight own = own_light_share(floor_under_light(100.0f, 0.1f), 1.0);
+  EXPECT_TRUE(own.lights);
+  EXPECT_FALSE(own.mostly_emissive);
+  EXPECT_GT(own.share, 0.05);
+  EXPECT_LT(own.share, 0.3);
+  // Ten times the radiance, ten times the share (the same points)
+  OwnLight brighter = own_light_share(floor_under_light(1000.0f, 0.1f), 1.0);
+  EXPECT_NEAR(brighter.share, 10.0 * own.share, 1e-6 * own.share);
+}
+
+TEST(DefaultLight, GlowingMaterialsAreNotLights) {
+  // Emission no brighter than white is a glowing material: the studio lights the scene
+  Scene glow = floor_under_light(1.0f, 0.5f);
+  DefaultLightChoice c = choose_default_light(glow, DefaultLight::Auto, false, 0.5);
+  EXPECT_TRUE(c.use_environment);
+  EXPECT_FALSE(own_light_share(glow, 0.5).lights);
+  // A bright light over the floor lights it: no studio
+  DefaultLightChoice lit = choose_default_light(floor_under_light(50.0f, 0.5f), DefaultLight::Auto, false, 0.5);
+  EXPECT_FALSE(lit.use_environment) << lit.reason;
+  EXPECT_GT(lit.own_share, kOwnLightShareThreshold);
+}
+
+TEST(DefaultLight, AssetsMadeOfEmittersGetTheStudio) {
+  // The floor is small next to a large bright emitter: the emitters are the asset
+  Scene s = floor_under_light(50.0f, 3.0f);
+  OwnLight own = own_light_share(s, 0.5);
+  EXPECT_TRUE(own.mostly_emissive);
+  EXPECT_TRUE(choose_default_light(s, DefaultLight::Auto, false, 0.5).use_environment);
+}
+
+TEST(DefaultLight, PunctualLightsCount) {
+  Scene s = floor_under_light(0.0f, 0.1f);
+  PunctualLightDesc sun;
+  sun.type = PunctualType::Directional;
+  sun.direction = {0, -1, 0};
+  sun.intensity = 3.0f;  // W/m^2: about the studio's pi x 0.5 irradiance
+  s.punctual_lights.push_back(sun);
+  OwnLight own = own_light_share(s, 0.5);
+  EXPECT_NEAR(own.share, 3.0 / (3.14159265 * 0.5), 1e-3);
+  EXPECT_FALSE(choose_default_light(s, DefaultLight::Auto, false, 0.5).use_environment);
+}
+
+TEST(DefaultLight, ModesAndGivenLighting) {
+  Scene dark = floor_under_light(0.0f, 0.1f);  // no light at all
+  EXPECT_TRUE(choose_default_light(dark, DefaultLight::Auto, false, 0.5).use_environment);
+  EXPECT_FALSE(choose_default_light(dark, DefaultLight::Off, false, 0.5).use_environment);
+  EXPECT_FALSE(choose_default_light(dark, DefaultLight::Auto, true, 0.5).use_environment);
+  EXPECT_FALSE(choose_default_light(dark, DefaultLight::On, true, 0.5).use_environment);
+  Scene lit = floor_under_light(50.0f, 0.5f);
+  EXPECT_TRUE(choose_default_light(lit, DefaultLight::On, false, 0.5).use_environment);
+}
+
+// Where the eight corners of b project in the camera's image (x right, y up, in units of
+// the half-extent of the view: inside the frame is |x|, |y| <= 1)
+std::vector<glm::vec2> projected_corners(const CameraDesc& cam, const Bounds& b, float aspect) {
+  glm::vec3 f = glm::normalize(cam.forward), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+  float ty = std::tan(0.5f * cam.yfov), tx = ty * aspect;
+  std::vector<glm::vec2> out;
+  for (int i = 0; i < 8; ++i) {
+    glm::vec3 p(i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z);
+    glm::vec3 q = p - cam.position;
+    float z = glm::dot(q, f);
+    EXPECT_GT(z, 0.0f) << "corner " << i << " behind the camera";
+    out.push_back({glm::dot(q, r) / (z * tx), glm::dot(q, u) / (z * ty)});
+  }
+  return out;
+}
+
+TEST(Framing, ThreeQuarterViewFillsTheFrameWithTheBounds) {
+  for (float aspect : {1.0f, 2.0f, 0.5f}) {
+    // A cube: seen from above and from the side, never face-on, and filling the frame
+    Scene cube;
+    cube.materials = {MaterialDesc()};
+    add_quad(&cube, {-1, 0, -1}, {1, 0, 1}, {0, 1, 0}, 0);
+    add_quad(&cube, {-1, 2, -1}, {1, 2, 1}, {0, 1, 0}, 0);
+    CameraDesc cam = framing_camera(cube, aspect);
+    glm::vec3 back = -glm::normalize(cam.forward);
+    EXPECT_NEAR(std::asin(back.y) * 180.0 / 3.14159265, 20.0, 0.01);
+    EXPECT_NEAR(std::atan2(back.x, back.z) * 180.0 / 3.14159265, 30.0, 0.01);
+    float widest = 0.0f;
+    for (glm::vec2 p : projected_corners(cam, cube.bounds(), aspect)) {
+      EXPECT_LE(std::fabs(p.x), 0.951f);
+      EXPECT_LE(std::fabs(p.y), 0.951f);
+      widest = std::max({widest, std::fabs(p.x), std::fabs(p.y)});
+    }
+    EXPECT_GT(widest, 0.94f) << "the bounds should touch the margin";
+  }
+}
+
+TEST(Framing, FlatScenesAreSeenFromHigherUp) {
+  Scene plane;
+  plane.materials = {MaterialDesc()};
+  add_quad(&plane, {-5, 0, -5}, {5, 0, 5}, {0, 1, 0}, 0);
+  CameraDesc cam = framing_camera(plane);
+  EXPECT_NEAR(std::asin(-glm::normalize(cam.forward).y) * 180.0 / 3.14159265, 50.0, 0.01);
+  for (glm::vec2 p : projected_corners(cam, plane.bounds(), 1.0f)) EXPECT_LE(std::fabs(p.y), 0.951f);
+}
+
+// A glTF with one point light of `intensity` and, optionally, scene extras light_units
+std::string point_light_gltf(double intensity, const char* units) {
+  GltfBuilder g;
+  float quad[4][3] = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
+  g.add_node({{"mesh", g.add_mesh({quad_primitive(quad, -1)})}});
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", intensity}}};
+  g.add_node({{"translation", {0, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  if (units) g.doc["scenes"][0]["extras"]["candela"]["light_units"] = units;
+  return g.document().dump();
+}
+
+TEST(LightUnits, CandelaAndLuxAreReadBy683LumensPerWatt) {
+  Scene photometric = load_gltf_from_memory(point_light_gltf(683.0 * 2.5, nullptr), "");
+  ASSERT_EQ(photometric.punctual_lights.size(), 1u);
+  EXPECT_EQ(photometric.light_units, LightUnits::Photometric);
+  EXPECT_EQ(photometric.punctual_lights[0].intensity, 2.5f);  // exact: the division is in double
+  Scene radiometric = load_gltf_from_memory(point_light_gltf(2.5, "radiometric"), "");
+  EXPECT_EQ(radiometric.punctual_lights[0].intensity, 2.5f);
+  // The command line's choice wins over the scene's
+  LoadOptions options;
+  options.light_units = LightUnits::Photometric;
+  Scene overridden = load_gltf_from_memory(point_light_gltf(683.0, "radiometric"), "", options);
+  EXPECT_EQ(overridden.punctual_lights[0].intensity, 1.0f);
+  EXPECT_THROW(load_gltf_from_memory(point_light_gltf(1.0, "watts"), ""), Error);
+}
+
+}  // namespace
+}  // namespace candela::test
