@@ -87,44 +87,17 @@ struct GpuTrace {
 };
 
 // rays: pairs (org + tmax, dir)
-GpuTrace trace(KernelRig& rig, const Bvh& bvh, const std::vector<cl_float4>& rays) {
-  const auto& tris = bvh.tris;
+GpuTrace trace(const KernelRig& rig, const Bvh& bvh, const std::vector<cl_float4>& rays) {
   size_t n = rays.size() / 2;
-  cl::Buffer nodes(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bvh.nodes.size() * sizeof(dev::BvhNode),
-                   const_cast<dev::BvhNode*>(bvh.nodes.data()));
-  cl::Buffer tri_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, tris.size() * sizeof(dev::BvhTriangle),
-                     const_cast<dev::BvhTriangle*>(tris.data()));
-  cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4),
-                     const_cast<cl_float4*>(rays.data()));
-  cl::Buffer out_bvh(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Buffer out_brute(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Buffer out_occ(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_int));
-  cl::Kernel kb(rig.program, "test_trace_bvh");
-  kb.setArg(0, nodes);
-  kb.setArg(1, tri_buf);
-  kb.setArg(2, ray_buf);
-  kb.setArg(3, out_bvh);
-  kb.setArg(4, out_occ);
-  rig.queue.enqueueNDRangeKernel(kb, cl::NullRange, cl::NDRange(n));
-  cl::Kernel kf(rig.program, "test_trace_brute");
-  kf.setArg(0, tri_buf);
-  kf.setArg(1, cl_uint(tris.size()));
-  kf.setArg(2, ray_buf);
-  kf.setArg(3, out_brute);
-  rig.queue.enqueueNDRangeKernel(kf, cl::NullRange, cl::NDRange(n));
-  GpuTrace r;
-  r.bvh_hits.resize(n);
-  r.brute_hits.resize(n);
-  r.occluded.resize(n);
-  rig.queue.enqueueReadBuffer(out_bvh, CL_TRUE, 0, n * sizeof(cl_float4), r.bvh_hits.data());
-  rig.queue.enqueueReadBuffer(out_brute, CL_TRUE, 0, n * sizeof(cl_float4), r.brute_hits.data());
-  rig.queue.enqueueReadBuffer(out_occ, CL_TRUE, 0, n * sizeof(cl_int), r.occluded.data());
-  return r;
+  cl::Buffer tris = rig.input(bvh.tris), ray_buf = rig.input(rays);
+  auto bvh_hits = rig.output<cl_float4>(n), brute_hits = rig.output<cl_float4>(n);
+  auto occluded = rig.output<cl_int>(n);
+  rig.run("test_trace_bvh", n, rig.input(bvh.nodes), tris, ray_buf, bvh_hits, occluded);
+  rig.run("test_trace_brute", n, tris, cl_uint(bvh.tris.size()), ray_buf, brute_hits);
+  return {bvh_hits.read(), brute_hits.read(), occluded.read()};
 }
 
-cl_float4 f4(glm::vec3 v, float w) { return cl_float4{{v.x, v.y, v.z, w}}; }
-
-class BvhTest : public ::testing::TestWithParam<std::string> {};
+class BvhTest : public DeviceTest {};
 
 }  // namespace
 
@@ -251,9 +224,6 @@ TEST(BvhBuilder, SameTreeOnAnyThreadCount) {
 }
 
 TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
-  DeviceEntry device;
-  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
-  KernelRig rig(device);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<Tri> scene = icosphere(2, glm::vec3(0.3f, -0.2f, 0.1f), 0.6f);
@@ -272,7 +242,7 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
     rays.push_back(f4(o, tmax));
     rays.push_back(f4(d, 0));
   }
-  GpuTrace gpu = trace(rig, bvh, rays);
+  GpuTrace gpu = trace(rig(), bvh, rays);
   int hits = 0, checked = 0;
   for (size_t i = 0; i < rays.size() / 2; ++i) {
     glm::dvec3 o(rays[2 * i].s[0], rays[2 * i].s[1], rays[2 * i].s[2]);
@@ -301,9 +271,6 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
 }
 
 TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
-  DeviceEntry device;
-  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
-  KernelRig rig(device);
   glm::vec3 center(0.1f, 0.2f, -0.3f);
   std::vector<Tri> sphere = icosphere(3, center, 2.0f);
   Bvh bvh = Soup(sphere).bvh;
@@ -319,7 +286,7 @@ TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
           rays.push_back(f4(glm::normalize(target - o), 0));
         }
       }
-  GpuTrace gpu = trace(rig, bvh, rays);
+  GpuTrace gpu = trace(rig(), bvh, rays);
   int leaks = 0;
   for (size_t i = 0; i < rays.size() / 2; ++i) {
     const cl_float4& h = gpu.bvh_hits[i];
@@ -337,7 +304,6 @@ TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {
   EXPECT_EQ(leaks, 0) << "of " << rays.size() / 2 << " rays through edges and vertices";
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, BvhTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, BvhTest, kernel_devices(), DeviceParamName());
 
 }  // namespace candela::test

@@ -3,7 +3,7 @@
 // independent Monte Carlo estimate; the albedo of compensated lobes through bsdf_sample
 // weights (white rough metal keeps >= 98 %, white lobes stay at 1 and nothing exceeds it);
 // the BSDF harness's checks for compensated lobes, whose sampling gains a cosine component
-// (tests/bsdf_test.cpp sees the lobes without the table); and a white furnace: a white
+// (tests/bsdf/bsdf_test.cpp sees the lobes without the table); and a white furnace: a white
 // rough metal sphere under a background of 1 renders as 1.
 #include <gtest/gtest.h>
 
@@ -15,15 +15,15 @@
 #include <random>
 
 #include "device/energy.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kSamples = 1 << 20;
 
 // How far the table may be from the converged integral: quadrature (2e-4) and bilinear
@@ -32,9 +32,6 @@ const double kTableTolerance = 1e-3;
 // E5 (nodes uniform in mu): linear interpolation of (1 - mu)^5 between nodes 1/31 apart
 // errs by up to h^2 / 8 max|d2/dmu2| = 2.6e-3 for smooth lobes
 const double kTable5Tolerance = 3e-3;
-
-cl_float4 f4(glm::dvec3 v) { return {{float(v.x), float(v.y), float(v.z), 0.0f}}; }
-glm::dvec3 d3(const cl_float4& v) { return {v.s[0], v.s[1], v.s[2]}; }
 
 // Direction at polar angle theta (degrees) from +z in the xz-plane
 glm::dvec3 at_angle(double theta_deg) {
@@ -90,45 +87,23 @@ dev::Material conductor(glm::dvec3 eta, glm::dvec3 k, double roughness) {
   return m;
 }
 
-const glm::dvec3 kGoldEta(0.143119, 0.374957, 1.44248), kGoldK(3.98316, 2.38572, 1.60322);
-
 // The PoCL test program and its GGX albedo table, computed afresh (no cache)
 struct EnergyRig {
-  KernelRig rig{pocl_device()};
+  const KernelRig& rig = kernel_rig("pocl");
   GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, "");
-
-  template <typename T>
-  std::vector<T> read(const cl::Buffer& b, size_t n) {
-    std::vector<T> v(n);
-    rig.queue.enqueueReadBuffer(b, CL_TRUE, 0, n * sizeof(T), v.data());
-    return v;
-  }
-  template <typename T>
-  cl::Buffer input(const std::vector<T>& v) {
-    return cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                      const_cast<T*>(v.data()));
-  }
 
   // (E(mu), E_avg, E5(mu), E5_avg) as the lobes look them up, for (mu, roughness) queries
   std::vector<cl_float4> lookup(const std::vector<cl_float2>& q) {
-    cl::Buffer in = input(q), out(rig.context, CL_MEM_WRITE_ONLY, q.size() * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_lookup");
-    k.setArg(0, table.buffer);
-    k.setArg(1, in);
-    k.setArg(2, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(q.size()));
-    return read<cl_float4>(out, q.size());
+    auto out = rig.output<cl_float4>(q.size());
+    rig.run("test_energy_lookup", q.size(), table.buffer, rig.input(q), out);
+    return out.read();
   }
 
   // E(mu) by the table's quadrature with n x n points, anywhere
   std::vector<float> quadrature(const std::vector<cl_float2>& q, cl_uint n) {
-    cl::Buffer in = input(q), out(rig.context, CL_MEM_WRITE_ONLY, q.size() * sizeof(float));
-    cl::Kernel k(rig.program, "test_energy_quadrature");
-    k.setArg(0, in);
-    k.setArg(1, n);
-    k.setArg(2, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(q.size()));
-    return read<float>(out, q.size());
+    auto out = rig.output<float>(q.size());
+    rig.run("test_energy_quadrature", q.size(), rig.input(q), n, out);
+    return out.read();
   }
 
   // Independent Monte Carlo estimate of E(mu, roughness), or of E5 with `fresnel5`, from
@@ -136,17 +111,10 @@ struct EnergyRig {
   Mean albedo_mc(float mu, float roughness, cl_uint seed, bool fresnel5 = false) {
     const cl_uint per_item = 64;
     const size_t items = kSamples / per_item;
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, items * sizeof(cl_float2));
-    cl::Kernel k(rig.program, "test_energy_albedo_mc");
-    k.setArg(0, mu);
-    k.setArg(1, roughness);
-    k.setArg(2, cl_uint(fresnel5));
-    k.setArg(3, seed);
-    k.setArg(4, per_item);
-    k.setArg(5, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(items));
+    auto out = rig.output<cl_float2>(items);
+    rig.run("test_energy_albedo_mc", items, mu, roughness, cl_uint(fresnel5), seed, per_item, out);
     double sum = 0.0, sum2 = 0.0;
-    for (const cl_float2& s : read<cl_float2>(out, items)) {
+    for (const cl_float2& s : out.read()) {
       sum += s.s[0];
       sum2 += s.s[1];
     }
@@ -158,17 +126,9 @@ struct EnergyRig {
   // writes `per_item` float4 per work-item
   std::vector<cl_float4> per_sample(const char* kernel, const dev::Material& m, bool with_table, glm::dvec3 wo,
                                     cl_uint seed, size_t n, size_t per_item) {
-    cl::Buffer mat = input(std::vector<dev::Material>{m});
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, per_item * n * sizeof(cl_float4));
-    cl::Kernel k(rig.program, kernel);
-    k.setArg(0, mat);
-    k.setArg(1, table.buffer);
-    k.setArg(2, cl_uint(with_table));
-    k.setArg(3, f4(wo));
-    k.setArg(4, seed);
-    k.setArg(5, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    return read<cl_float4>(out, per_item * n);
+    auto out = rig.output<cl_float4>(per_item * n);
+    rig.run(kernel, n, rig.input(std::vector<dev::Material>{m}), table.buffer, cl_uint(with_table), f4(wo), seed, out);
+    return out.read();
   }
 
   // kSamples of bsdf_sample: per sample (wi, pdf), (f, flags), (bsdf_eval, bsdf_pdf)
@@ -183,16 +143,10 @@ struct EnergyRig {
       in.push_back(f4(wo));
       in.push_back(f4(wi));
     }
-    cl::Buffer mat = input(std::vector<dev::Material>{m}), pb = input(in);
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, pairs.size() * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_eval");
-    k.setArg(0, mat);
-    k.setArg(1, table.buffer);
-    k.setArg(2, cl_uint(1));
-    k.setArg(3, pb);
-    k.setArg(4, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(pairs.size()));
-    return read<cl_float4>(out, pairs.size());
+    auto out = rig.output<cl_float4>(pairs.size());
+    rig.run("test_energy_eval", pairs.size(), rig.input(std::vector<dev::Material>{m}), table.buffer, cl_uint(1),
+            rig.input(in), out);
+    return out.read();
   }
 
   // Mean sample weight f cos / pdf per channel (0 for a failed sample): the albedo
@@ -305,7 +259,7 @@ TEST(Energy, CompensatedAlbedoIsOneForWhiteAndAtMostOneForAll) {
          return metal({1.0, 0.78, 0.34}, a);
        },
        false, 0.0},
-      {"gold conductor", [](double a) { return conductor(kGoldEta, kGoldK, a); }, false, 0.0},
+      {"gold conductor", [](double a) { return conductor(gold_eta(), gold_k(), a); }, false, 0.0},
       {"anisotropic metal", [](double a) { return metal(glm::dvec3(1.0), a, 0.7); }, false, 0.03},
   };
   cl_uint seed = 10;
@@ -356,7 +310,7 @@ TEST(Energy, WhitePlasticReflectsOneAtEveryAngle) {
     }
 }
 
-// The harness's checks (tests/bsdf_test.cpp) for compensated lobes: every sample's f and pdf
+// The harness's checks (tests/bsdf/bsdf_checks.hpp) for compensated lobes: every sample's f and pdf
 // are bsdf_eval's and bsdf_pdf's, sampled directions follow bsdf_pdf (chi-square over the
 // hemisphere, alpha = 0.01 with the Sidak correction), samples are returned as often as
 // the pdf integrates to, and eval is reciprocal
@@ -365,7 +319,7 @@ TEST(Energy, CompensatedLobesSampleTheirPdfAndAreReciprocal) {
   const std::pair<std::string, dev::Material> cases[] = {
       {"white metal 1.0", metal(glm::dvec3(1.0), 1.0)},
       {"gold metal 0.5", metal({1.0, 0.78, 0.34}, 0.5)},
-      {"gold conductor 0.6", conductor(kGoldEta, kGoldK, 0.6)},
+      {"gold conductor 0.6", conductor(gold_eta(), gold_k(), 0.6)},
       {"plastic 0.7", plastic({0.2, 0.5, 0.8}, 0.7)},
       {"anisotropic metal 0.6", metal(glm::dvec3(0.9), 0.6, 0.8)},
   };
@@ -455,9 +409,7 @@ TEST_P(EnergyFurnaceTest, WhiteRoughMetalSphereVanishes) {
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 1.0f, 3, mat)})}});
   g.add_camera({0, 0, 3.2f}, {0, 0, 0}, 0.75f);  // the sphere spans 0.84 of the image height
   g.set_background({1, 1, 1});
-  std::string path = ::testing::TempDir() + "energy-furnace-" + GetParam() + ".gltf";
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "energy-furnace-" + GetParam() + ".gltf");
   for (Strategy strategy : {Strategy::Nee, Strategy::Bsdf})
     for (bool compensate : {true, false}) {
       RenderSettings s;
@@ -480,7 +432,6 @@ TEST_P(EnergyFurnaceTest, WhiteRoughMetalSphereVanishes) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, EnergyFurnaceTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, EnergyFurnaceTest, kernel_devices(), DeviceParamName());
 
 }  // namespace candela::test

@@ -16,26 +16,23 @@
 #include "base/error.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // ---- Sampled offsets -------------------------------------------------------------------
 
-std::vector<cl_float2> run_offsets_kernel(KernelRig& rig, const char* name, std::vector<cl_uint> args, size_t n) {
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float2));
-  cl::Kernel k(rig.program, name);
-  cl_uint a = 0;
-  for (cl_uint v : args) k.setArg(a++, v);
-  k.setArg(a, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float2> got(n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float2), got.data());
-  return got;
+// n offsets (one per work-item) of test kernel `name`, its arguments `args` and then the output
+template <typename... Args>
+std::vector<cl_float2> run_offsets_kernel(const char* name, size_t n, const Args&... args) {
+  const KernelRig& rig = kernel_rig("pocl");
+  auto out = rig.output<cl_float2>(n);
+  rig.run(name, n, args..., out);
+  return out.read();
 }
 
 // CDFs of one coordinate of each filter's offset, in pixels
@@ -70,7 +67,6 @@ const size_t kOffsets = size_t(1) << 20;
 const double kAlpha = sidak_alpha(0.01, 4);  // three filters and the disk
 
 TEST(PixelFilter, SampledOffsetsFollowTheFilterDensity) {
-  KernelRig rig(pocl_device());
   struct Case {
     PixelFilter filter;
     const char* name;
@@ -81,7 +77,7 @@ TEST(PixelFilter, SampledOffsetsFollowTheFilterDensity) {
                              {PixelFilter::Tent, "tent", tent_cdf, 1.0, 1.0},
                              {PixelFilter::Gaussian, "gaussian", gaussian_cdf, 1.5, 3.0}};
   for (const Case& c : cases) {
-    auto xy = run_offsets_kernel(rig, "test_filter_offsets", {cl_uint(c.filter), 7u}, kOffsets);
+    auto xy = run_offsets_kernel("test_filter_offsets", kOffsets, cl_uint(c.filter), 7u);
     double max_abs = 0.0;
     for (const auto& p : xy) max_abs = std::max({max_abs, std::fabs(double(p.s[0])), std::fabs(double(p.s[1]))});
     EXPECT_LE(max_abs, c.max_offset) << c.name;
@@ -99,8 +95,7 @@ TEST(PixelFilter, BoxIsTheDefault) { EXPECT_EQ(RenderSettings().filter, PixelFil
 
 // Uniform on the unit disk: r^2 and the angle are independent and uniform
 TEST(ThinLens, ConcentricDiskIsUniform) {
-  KernelRig rig(pocl_device());
-  auto xy = run_offsets_kernel(rig, "test_concentric_disk", {11u}, kOffsets);
+  auto xy = run_offsets_kernel("test_concentric_disk", kOffsets, 11u);
   const int nr = 16, nphi = 32;
   std::vector<double> observed(nr * nphi, 0.0), expected(nr * nphi, double(kOffsets) / (nr * nphi));
   for (const auto& p : xy) {
@@ -126,11 +121,7 @@ MaterialDesc emitter(float radiance) {
 
 // Quad (x0, y0) - (x1, y1) at z = z, facing +z
 void add_rect(Scene* s, float x0, float y0, float x1, float y1, float z, uint32_t material) {
-  MeshDesc m;
-  m.positions = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.material = material;
-  s->meshes.push_back(m);
+  add_polygon(s, {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}}, material);
 }
 
 // Emission seen directly (max depth 0) under a black background: every sample is 0 or 1
@@ -302,8 +293,7 @@ TEST_P(CameraRenderTest, OrthographicCameraCoversTheExpectedPixelsAtAnyDistance)
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, CameraRenderTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, CameraRenderTest, kernel_devices(), DeviceParamName());
 
 // A thin lens of radius 0 is the pinhole camera, bit for bit; any aperture changes the image
 TEST(ThinLens, ZeroApertureIsThePinholeImage) {

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <map>
 
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
@@ -20,18 +20,12 @@ constexpr int kSobol = 0, kIndependent = 1;
 
 // Dimensions [0, dims) of samples [sample_begin, sample_begin + samples) of pixels
 // [pixel_begin, pixel_begin + pixels): out[((p * samples) + s) * dims + d]
-std::vector<cl_uint> draw(KernelRig& rig, int which, cl_uint pixel_begin, size_t pixels, cl_uint sample_begin,
+std::vector<cl_uint> draw(const KernelRig& rig, int which, cl_uint pixel_begin, size_t pixels, cl_uint sample_begin,
                           cl_uint samples, cl_uint seed, cl_uint dims) {
   size_t items = pixels * samples;
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, items * dims * sizeof(cl_uint));
-  cl::Kernel k(rig.program, "test_sampler_draw");
-  cl_uint arg = 0;
-  for (cl_uint v : {cl_uint(which), pixel_begin, sample_begin, samples, seed, dims}) k.setArg(arg++, v);
-  k.setArg(arg, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(items));
-  std::vector<cl_uint> v(items * dims);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, v.size() * sizeof(cl_uint), v.data());
-  return v;
+  auto out = rig.output<cl_uint>(items * dims);
+  rig.run("test_sampler_draw", items, cl_uint(which), pixel_begin, sample_begin, samples, seed, dims, out);
+  return out.read();
 }
 
 // Points (x[i * stride], y[i * stride]) for i in [begin, begin + 2^m): a (0,m,2)-net in
@@ -61,15 +55,7 @@ double joint_p_value(const std::vector<double>& a, const std::vector<double>& b,
 
 double to_unit(cl_uint x) { return (x >> 8) * 0x1.0p-24; }
 
-class SamplerTest : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    DeviceEntry device;
-    CANDELA_DEVICE_OR_SKIP(GetParam(), device);
-    rig_ = std::make_unique<KernelRig>(device);
-  }
-  std::unique_ptr<KernelRig> rig_;
-};
+class SamplerTest : public DeviceTest {};
 
 }  // namespace
 
@@ -81,8 +67,8 @@ TEST_P(SamplerTest, EveryDimensionAndPairIsUniform) {
   const int bins = 64, g = 24;
   const int tests = 2 * dims + dims / 2;
   const double alpha = sidak_alpha(0.01, tests);
-  std::vector<cl_uint> across = draw(*rig_, kSobol, 1000, 1 << 18, 3, 1, 11, dims);
-  std::vector<cl_uint> within = draw(*rig_, kSobol, 0, 256, 0, 1024, 11, dims);
+  std::vector<cl_uint> across = draw(rig(), kSobol, 1000, 1 << 18, 3, 1, 11, dims);
+  std::vector<cl_uint> within = draw(rig(), kSobol, 0, 256, 0, 1024, 11, dims);
   for (const auto* v : {&across, &within})
     for (cl_uint d = 0; d < dims; ++d) {
       size_t n = v->size() / dims;
@@ -110,7 +96,7 @@ TEST_P(SamplerTest, EveryPrefixOfEveryPairIsANet) {
   const cl_uint dims = 128, samples = 4096;
   for (cl_uint seed : {0u, 9u})
     for (cl_uint pixel : {0u, 1u, 77u, 123456u}) {
-      std::vector<cl_uint> v = draw(*rig_, kSobol, pixel, 1, 0, samples, seed, dims);
+      std::vector<cl_uint> v = draw(rig(), kSobol, pixel, 1, 0, samples, seed, dims);
       for (cl_uint pair : {0u, 1u, 2u, 3u, 17u, 63u}) {
         const cl_uint* x = &v[2 * pair];
         const cl_uint* y = &v[2 * pair + 1];
@@ -124,7 +110,7 @@ TEST_P(SamplerTest, EveryPrefixOfEveryPairIsANet) {
         }
       }
     }
-  std::vector<cl_uint> v = draw(*rig_, kIndependent, 5, 1, 0, 256, 0, 2);
+  std::vector<cl_uint> v = draw(rig(), kIndependent, 5, 1, 0, 256, 0, 2);
   EXPECT_NE(net_failure(&v[0], &v[1], 2, 0, 8), "") << "independent numbers are no net";
 }
 
@@ -136,7 +122,7 @@ TEST_P(SamplerTest, EveryPrefixOfEveryPairIsANet) {
 TEST_P(SamplerTest, PointsAreJitteredWithinTheirStrata) {
   const int m = 4;
   const cl_uint dims = 8, samples = 1u << m, pixels = 512;
-  std::vector<cl_uint> v = draw(*rig_, kSobol, 300, pixels, 0, samples, 5, dims);
+  std::vector<cl_uint> v = draw(rig(), kSobol, 300, pixels, 0, samples, 5, dims);
   for (cl_uint d = 0; d < dims; ++d) {
     double sum_var = 0.0;
     for (cl_uint p = 0; p < pixels; ++p) {
@@ -162,7 +148,7 @@ TEST_P(SamplerTest, PixelsPairsAndSeedsAreDecorrelated) {
   const cl_uint dims = 8, samples = 1 << 16;
   const cl_uint a = 4242;
   auto dim = [&](cl_uint pixel, cl_uint seed, cl_uint d) {
-    std::vector<cl_uint> v = draw(*rig_, kSobol, pixel, 1, 0, samples, seed, dims);
+    std::vector<cl_uint> v = draw(rig(), kSobol, pixel, 1, 0, samples, seed, dims);
     std::vector<double> u(samples);
     for (cl_uint i = 0; i < samples; ++i) u[i] = to_unit(v[i * dims + d]);
     return u;
@@ -196,20 +182,11 @@ TEST_P(SamplerTest, InterfaceLaysDimensionsOutInPairs) {
   const std::vector<cl_uint> dim_of = {0, 1, 4, 2, 3, 5, 6, 7, 8, 9, 10, 11, 12, 14, 15, 13};
   const std::vector<size_t> points = {3, 6, 10, 13};  // outputs where a 2D point starts
   const cl_uint outputs = cl_uint(dim_of.size()), dims = 16, samples = 1024, pixels = 3;
-  cl::Buffer ops_buffer(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, ops.size() * sizeof(cl_uint),
-                        const_cast<cl_uint*>(ops.data()));
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, pixels * samples * outputs * sizeof(float));
-  cl::Kernel k(rig_->program, "test_sampler_interface");
-  cl_uint arg = 0;
-  for (cl_uint v : {cl_uint(40), cl_uint(0), samples, cl_uint(21)}) k.setArg(arg++, v);
-  k.setArg(arg++, ops_buffer);
-  k.setArg(arg++, cl_uint(ops.size()));
-  k.setArg(arg++, outputs);
-  k.setArg(arg, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(pixels * samples));
-  std::vector<float> got(pixels * samples * outputs);
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, got.size() * sizeof(float), got.data());
-  std::vector<cl_uint> want = draw(*rig_, kSobol, 40, pixels, 0, samples, 21, dims);
+  auto out = rig().output<float>(pixels * samples * outputs);
+  rig().run("test_sampler_interface", pixels * samples, cl_uint(40), cl_uint(0), samples, cl_uint(21), rig().input(ops),
+            cl_uint(ops.size()), outputs, out);
+  std::vector<float> got = out.read();
+  std::vector<cl_uint> want = draw(rig(), kSobol, 40, pixels, 0, samples, 21, dims);
   for (size_t i = 0; i < pixels * samples; ++i)
     for (cl_uint d = 0; d < outputs; ++d) {
       ASSERT_LT(got[i * outputs + d], 1.0f);
@@ -227,35 +204,22 @@ TEST_P(SamplerTest, InterfaceLaysDimensionsOutInPairs) {
 // The same numbers on every device
 TEST_P(SamplerTest, SameNumbersAsPocl) {
   if (GetParam() == "pocl") GTEST_SKIP() << "the reference device itself";
-  KernelRig pocl(pocl_device());
   for (int which : {kSobol, kIndependent})
-    EXPECT_EQ(draw(*rig_, which, 7, 64, 100, 64, 5, 40), draw(pocl, which, 7, 64, 100, 64, 5, 40)) << which;
+    EXPECT_EQ(draw(rig(), which, 7, 64, 100, 64, 5, 40), draw(kernel_rig("pocl"), which, 7, 64, 100, 64, 5, 40))
+        << which;
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, SamplerTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, SamplerTest, kernel_devices(), DeviceParamName());
 
 // A diffuse floor under a square area light, with a small occluder between them casting a
 // soft shadow, direct lighting only. Against a 4096-spp Sobol reference (another seed),
 // the image's relMSE (epsilon 0.01) at 16, 64 and 256 spp, mean of two seeds, for both
 // samplers: Sobol's at 256 spp must be well below the independent sampler's.
 TEST(SamplerConvergence, SobolBeatsIndependentOnAnAreaLitFloor) {
-  std::string path = ::testing::TempDir() + "sampler-floor.gltf";
   const float h = 0.6f, s = 0.2f, o = 0.08f, oh = 0.3f;
-  std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),       // floor, facing +y
-      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1),       // light, facing -y
-      quad_primitive({{-o, oh, o}, {o, oh, o}, {o, oh, -o}, {-o, oh, -o}}, 0)};  // occluder
-  GltfBuilder g;                                                                 // black background
-  g.add_node({{"mesh", g.add_mesh(quads)}});
-  g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
-     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
-    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
-     "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])");
+  GltfBuilder g = floor_under_square_light(h, s, 4, {quad_facing_up(o, oh, 0)});  // an occluder of the floor's material
   g.add_camera({0.0f, 1.3f, 1.1f}, {0, 0, 0}, 0.9f);
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "sampler-floor.gltf");
 
   const int size = 32;
   auto render = [&](Sampler sampler, uint32_t seed, uint32_t spp) {
@@ -267,20 +231,11 @@ TEST(SamplerConvergence, SobolBeatsIndependentOnAnAreaLitFloor) {
     return scene_renderer(pocl_device(), scene, settings).render(0, spp).film;
   };
   Film reference = render(Sampler::Sobol, 1000, 4096);
-  auto rel_mse = [&](const Film& f) {
-    double sum = 0.0;
-    for (size_t i = 0; i < f.pixels(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        double r = reference.pixel(i)[c], d = f.pixel(i)[c] - r;
-        sum += d * d / (r * r + 0.01);
-      }
-    return sum / (3.0 * f.pixels());
-  };
   std::map<std::pair<Sampler, uint32_t>, double> err;
   for (Sampler sampler : {Sampler::Independent, Sampler::Sobol})
     for (uint32_t spp : {16u, 64u, 256u}) {
       double e = 0.0;
-      for (uint32_t seed : {1u, 2u}) e += 0.5 * rel_mse(render(sampler, seed, spp));
+      for (uint32_t seed : {1u, 2u}) e += 0.5 * rel_mse(render(sampler, seed, spp), reference);
       err[{sampler, spp}] = e;
       std::printf("[ relMSE   ] %-11s %3u spp: %.3e\n", sampler == Sampler::Sobol ? "sobol" : "independent", spp, e);
     }

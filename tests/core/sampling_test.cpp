@@ -7,27 +7,21 @@
 #include <glm/glm.hpp>
 
 #include "compile/scene_compiler.hpp"
+#include "support/reference.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kSamples = 1 << 20;
 constexpr int kTestsInFile = 5;
 const double kAlpha = sidak_alpha(0.01, kTestsInFile);
 
-std::vector<cl_float4> run_direction_kernel(KernelRig& rig, cl_uint which, cl_uint seed) {
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_float4));
-  cl::Kernel k(rig.program, "test_sample_direction");
-  k.setArg(0, which);
-  k.setArg(1, seed);
-  k.setArg(2, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
-  std::vector<cl_float4> v(kSamples);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_float4), v.data());
-  return v;
+std::vector<cl_float4> run_direction_kernel(const KernelRig& rig, cl_uint which, cl_uint seed) {
+  auto out = rig.output<cl_float4>(kSamples);
+  rig.run("test_sample_direction", kSamples, which, seed, out);
+  return out.read();
 }
 
 // Histogram over (cos theta, phi) cells against the pdf integrated over each cell
@@ -81,24 +75,18 @@ double clipped_area(std::vector<glm::dvec2> poly, double x0, double x1, double y
 
 class SamplingTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { rig_ = new KernelRig(pocl_device()); }
-  static void TearDownTestSuite() {
-    delete rig_;
-    rig_ = nullptr;
-  }
-  static KernelRig* rig_;
+  const KernelRig& rig() { return kernel_rig("pocl"); }
 };
-KernelRig* SamplingTest::rig_ = nullptr;
 
 }  // namespace
 
 TEST_F(SamplingTest, CosineHemisphereMatchesPdf) {
-  auto dirs = run_direction_kernel(*rig_, 0, 1234);
+  auto dirs = run_direction_kernel(rig(), 0, 1234);
   for (size_t i = 0; i < 1000; ++i) {
     const auto& d = dirs[i];
     ASSERT_NEAR(d.s[0] * d.s[0] + d.s[1] * d.s[1] + d.s[2] * d.s[2], 1.0, 1e-5);
     ASSERT_GE(d.s[2], 0.0f);
-    ASSERT_NEAR(d.s[3], d.s[2] / kPi, 1e-6);  // pdf = cos(theta) / pi
+    ASSERT_NEAR(d.s[3], cosine_hemisphere_pdf(d.s[2]), 1e-6);
   }
   // Integral of cos(theta)/pi over a cell: dphi / pi * (c1^2 - c0^2) / 2
   auto prob = [](double c0, double c1, double dphi) { return dphi / kPi * 0.5 * (c1 * c1 - c0 * c0); };
@@ -107,8 +95,8 @@ TEST_F(SamplingTest, CosineHemisphereMatchesPdf) {
 }
 
 TEST_F(SamplingTest, UniformSphereMatchesPdf) {
-  auto dirs = run_direction_kernel(*rig_, 1, 99);
-  for (size_t i = 0; i < 1000; ++i) ASSERT_NEAR(dirs[i].s[3], 1.0 / (4.0 * kPi), 1e-7);
+  auto dirs = run_direction_kernel(rig(), 1, 99);
+  for (size_t i = 0; i < 1000; ++i) ASSERT_NEAR(dirs[i].s[3], uniform_sphere_pdf(), 1e-7);
   auto prob = [](double c0, double c1, double dphi) { return dphi * (c1 - c0) / (4.0 * kPi); };
   ChiSquare r = direction_chi_square(dirs, -1.0, 30, 40, prob);
   EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
@@ -116,16 +104,9 @@ TEST_F(SamplingTest, UniformSphereMatchesPdf) {
 
 TEST_F(SamplingTest, TriangleSamplingIsUniformInArea) {
   glm::dvec2 a(0.1, 0.0), b(1.0, 0.2), c(0.35, 0.9);
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_float4));
-  cl::Kernel k(rig_->program, "test_sample_triangle");
-  k.setArg(0, cl_uint(7));
-  k.setArg(1, cl_float4{{float(a.x), float(a.y), 0.0f, 0.0f}});
-  k.setArg(2, cl_float4{{float(b.x), float(b.y), 0.0f, 0.0f}});
-  k.setArg(3, cl_float4{{float(c.x), float(c.y), 0.0f, 0.0f}});
-  k.setArg(4, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
-  std::vector<cl_float4> pts(kSamples);
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_float4), pts.data());
+  auto out = rig().output<cl_float4>(kSamples);
+  rig().run("test_sample_triangle", kSamples, cl_uint(7), f4({a, 0.0}), f4({b, 0.0}), f4({c, 0.0}), out);
+  std::vector<cl_float4> pts = out.read();
 
   const int n = 24;
   double area = 0.5 * std::fabs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
@@ -144,13 +125,9 @@ TEST_F(SamplingTest, TriangleSamplingIsUniformInArea) {
 
 TEST_F(SamplingTest, RngIsUniform) {
   const size_t n = kSamples / 4;
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, 4 * n * sizeof(float));
-  cl::Kernel k(rig_->program, "test_rng_uniform");
-  k.setArg(0, cl_uint(5));
-  k.setArg(1, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<float> u(4 * n);
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, u.size() * sizeof(float), u.data());
+  auto out = rig().output<float>(4 * n);
+  rig().run("test_rng_uniform", n, cl_uint(5), out);
+  std::vector<float> u = out.read();
   // Pairs of successive numbers on a 32 x 32 grid: uniformity and independence
   const int g = 32;
   std::vector<double> observed(g * g, 0.0), expected(g * g, double(2 * n) / (g * g));
@@ -185,20 +162,11 @@ TEST_F(SamplingTest, LightSelectionMatchesItsPmf) {
     }
     EXPECT_DOUBLE_EQ(total, 1.0);
 
-    cl::Buffer tb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bins.size() * sizeof(dev::AliasBin),
-                  bins.data());
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, kSamples * sizeof(cl_uint));
+    cl::Buffer tb = rig().input(bins);
+    auto out = rig().output<cl_uint>(kSamples);
     auto select = [&](cl_uint mode, cl_uint stride) {
-      cl::Kernel k(rig_->program, "test_light_select");
-      k.setArg(0, tb);
-      k.setArg(1, cl_uint(weights.size()));
-      k.setArg(2, cl_uint(17));
-      k.setArg(3, mode);
-      k.setArg(4, stride);
-      k.setArg(5, out);
-      rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kSamples));
-      std::vector<cl_uint> picks(kSamples);
-      rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, kSamples * sizeof(cl_uint), picks.data());
+      rig().run("test_light_select", kSamples, tb, cl_uint(weights.size()), cl_uint(17), mode, stride, out);
+      std::vector<cl_uint> picks = out.read();
       std::vector<double> observed(weights.size(), 0.0);
       for (cl_uint p : picks) {
         EXPECT_LT(p, weights.size());
@@ -221,7 +189,7 @@ TEST_F(SamplingTest, LightSelectionMatchesItsPmf) {
 
 // The test itself must be able to fail: a wrong pdf is rejected
 TEST_F(SamplingTest, ChiSquareRejectsAWrongPdf) {
-  auto dirs = run_direction_kernel(*rig_, 0, 1234);
+  auto dirs = run_direction_kernel(rig(), 0, 1234);
   auto uniform = [](double c0, double c1, double dphi) { return dphi * (c1 - c0) / (2.0 * kPi); };
   ChiSquare r = direction_chi_square(dirs, 0.0, 20, 40, uniform);
   EXPECT_LT(r.p_value, 1e-6);

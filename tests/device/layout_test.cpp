@@ -8,11 +8,9 @@
 
 namespace candela::test {
 
-class LayoutTest : public ::testing::TestWithParam<std::string> {};
+class LayoutTest : public DeviceTest {};
 
 TEST_P(LayoutTest, DeviceStructLayoutMatchesHost) {
-  DeviceEntry device;
-  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
   using namespace dev;
   std::vector<cl_uint> want;
   std::vector<std::string> names;
@@ -25,18 +23,13 @@ TEST_P(LayoutTest, DeviceStructLayoutMatchesHost) {
   CD_LAYOUT(WANT_SIZE, WANT_FIELD)
 #undef WANT_SIZE
 #undef WANT_FIELD
-  KernelRig rig(device);
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint));
-  cl::Kernel k(rig.program, "test_struct_layout");
-  k.setArg(0, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));
-  std::vector<cl_uint> got(want.size());
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, got.size() * sizeof(cl_uint), got.data());
+  auto out = rig().output<cl_uint>(want.size());
+  rig().run("test_struct_layout", 1, out);
+  std::vector<cl_uint> got = out.read();
   for (size_t i = 0; i < want.size(); ++i) EXPECT_EQ(got[i], want[i]) << names[i];
   EXPECT_GE(want.size(), 30u) << "every shared struct is listed";
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, LayoutTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, LayoutTest, kernel_devices(), DeviceParamName());
 
 }  // namespace candela::test

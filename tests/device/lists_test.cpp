@@ -145,24 +145,17 @@ TEST(Lists, LightPowerHasEveryType) {
 
 // Each device sees the defaults of the program (test_lists.cl): every feature on, NanoVDB
 // where candela has PNanoVDB
-class ListsOnDevice : public ::testing::TestWithParam<std::string> {};
+class ListsOnDevice : public DeviceTest {};
 
 TEST_P(ListsOnDevice, FeatureDefaultsReachTheKernel) {
-  DeviceEntry device;
-  CANDELA_DEVICE_OR_SKIP(GetParam(), device);
-  KernelRig& rig = shared_rig(GetParam(), device);
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, kFeatures.size() * sizeof(cl_uint));
-  cl::Kernel k(rig.program, "test_feature_defaults");
-  k.setArg(0, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));
-  std::vector<cl_uint> got(kFeatures.size());
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, got.size() * sizeof(cl_uint), got.data());
+  auto out = rig().output<cl_uint>(kFeatures.size());
+  rig().run("test_feature_defaults", 1, out);
+  std::vector<cl_uint> got = out.read();
   bool pnanovdb = test_program_source().rfind("#define CD_PNANOVDB_AVAILABLE 1\n", 0) == 0;
   for (size_t i = 0; i < kFeatures.size(); ++i)
     EXPECT_EQ(got[i], kFeatures[i].fallback == "1" ? 1u : cl_uint(pnanovdb)) << kFeatures[i].macro;
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, ListsOnDevice, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, ListsOnDevice, kernel_devices(), DeviceParamName());
 
 }  // namespace candela::test

@@ -42,14 +42,10 @@ class ScopedCacheDir {
 };
 
 bool kernel_runs(const cl::Context& ctx, const DeviceEntry& d, cl::Program& program) {
-  cl::CommandQueue q(ctx, d.device);
-  cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, 256 * sizeof(cl_uint));  // room for all of CD_LAYOUT
-  cl::Kernel k(program, "test_struct_layout");
-  k.setArg(0, out);
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));
-  cl_uint first = 0;
-  q.enqueueReadBuffer(out, CL_TRUE, 0, sizeof first, &first);
-  return first == sizeof(dev::BvhNode);
+  KernelRig rig(d, ctx, program);
+  auto out = rig.output<cl_uint>(256);  // room for all of CD_LAYOUT
+  rig.run("test_struct_layout", 1, out);
+  return rig.read<cl_uint>(out.buffer, 1)[0] == sizeof(dev::BvhNode);
 }
 
 }  // namespace

@@ -14,7 +14,6 @@
 #include <cmath>
 #include <functional>
 #include <glm/glm.hpp>
-#include <map>
 #include <memory>
 
 #include "base/error.hpp"
@@ -23,13 +22,14 @@
 #include "render/renderer.hpp"
 #include "scene/environment.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kSamples = 1 << 20;
 constexpr int kChiSquareTests = 2 * 2;  // per device: sky and sun at two rotations
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
@@ -101,69 +101,40 @@ EnvironmentDesc env_of(TextureDesc map, float strength, float rotation) {
   return e;
 }
 
-class EnvironmentKernels : public ::testing::TestWithParam<std::string> {
+class EnvironmentKernels : public DeviceTest {
  protected:
-  void SetUp() override {
-    DeviceEntry d;
-    CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &shared_rig(GetParam(), d);
-  }
-
   void use(const EnvironmentDesc& env) {
     compiled_ = compile_scene(environment_only(env));
     ASSERT_NE(compiled_.environment_light, NO_LIGHT);
-    scene_ = std::make_unique<SceneOnDevice>(*rig_, compiled_);
+    scene_ = std::make_unique<SceneOnDevice>(rig(), compiled_);
   }
 
   // out[2i] = (dir, pdf), out[2i+1] = (environment_pdf(dir), radiance)
   std::vector<cl_float4> sample(cl_uint seed, size_t n = kSamples) {
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, 2 * n * sizeof(cl_float4));
-    cl::Kernel k(rig_->program, "test_environment_sample");
-    cl_uint arg = scene_->bind(k, 0);
-    k.setArg(arg++, seed);
-    k.setArg(arg++, out);
-    rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    std::vector<cl_float4> s(2 * n);
-    rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, s.size() * sizeof(cl_float4), s.data());
-    return s;
+    auto out = rig().output<cl_float4>(2 * n);
+    rig().run("test_environment_sample", n, *scene_, seed, out);
+    return out.read();
   }
 
   // Integrals of environment_pdf over cells (cos0, cos1, phi0, phi1)
   std::vector<double> cell_probabilities(const std::vector<cl_float4>& cells, cl_uint mode, cl_uint sub = 8) {
-    cl::Buffer cb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, cells.size() * sizeof(cl_float4),
-                  const_cast<cl_float4*>(cells.data()));
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, cells.size() * sizeof(float));
-    cl::Kernel k(rig_->program, "test_environment_pdf_cells");
-    cl_uint arg = scene_->bind(k, 0);
-    k.setArg(arg++, sub);
-    k.setArg(arg++, mode);
-    k.setArg(arg++, cb);
-    k.setArg(arg++, out);
-    rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(cells.size()));
-    std::vector<float> p(cells.size());
-    rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, p.size() * sizeof(float), p.data());
+    auto out = rig().output<float>(cells.size());
+    rig().run("test_environment_pdf_cells", cells.size(), *scene_, sub, mode, rig().input(cells), out);
+    std::vector<float> p = out.read();
     return std::vector<double>(p.begin(), p.end());
   }
 
   // Radiance that missed rays see along each direction
   std::vector<glm::vec3> radiance(const std::vector<glm::dvec3>& dirs) {
     std::vector<cl_float4> in;
-    for (const auto& d : dirs) in.push_back({{float(d.x), float(d.y), float(d.z), 0.0f}});
-    cl::Buffer ib(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(cl_float4), in.data());
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, in.size() * sizeof(cl_float4));
-    cl::Kernel k(rig_->program, "test_environment_radiance");
-    cl_uint arg = scene_->bind(k, 0);
-    k.setArg(arg++, ib);
-    k.setArg(arg++, out);
-    rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()));
-    std::vector<cl_float4> r(in.size());
-    rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, r.size() * sizeof(cl_float4), r.data());
+    for (const auto& d : dirs) in.push_back(f4(d));
+    auto out = rig().output<cl_float4>(in.size());
+    rig().run("test_environment_radiance", in.size(), *scene_, rig().input(in), out);
     std::vector<glm::vec3> v;
-    for (const auto& c : r) v.push_back({c.s[0], c.s[1], c.s[2]});
+    for (const auto& c : out.read()) v.push_back({c.s[0], c.s[1], c.s[2]});
     return v;
   }
 
-  KernelRig* rig_ = nullptr;
   CompiledScene compiled_;
   std::unique_ptr<SceneOnDevice> scene_;
 };
@@ -305,28 +276,12 @@ TEST_P(EnvironmentKernels, MappingAndRotation) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, EnvironmentKernels, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
-
-namespace {
-
-nlohmann::json lambert(float albedo) {
-  return {{"pbrMetallicRoughness", {{"baseColorFactor", {albedo, albedo, albedo, 1}}, {"metallicFactor", 0.0}}},
-          {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
-}
-
-}  // namespace
+INSTANTIATE_TEST_SUITE_P(Devices, EnvironmentKernels, kernel_devices(), DeviceParamName());
 
 // A closed white Lambertian sphere under a map of constant value 0.6 x strength 1.5 is
 // invisible: every pixel is 0.9, under both strategies (a map, not the constant path)
 TEST(EnvironmentRender, WhiteSphereUnderConstantMapIsInvisible) {
-  GltfBuilder g;
-  int m = g.add("materials", lambert(1.0f));
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  std::string path = ::testing::TempDir() + "env-furnace.gltf";
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(sphere_in_view(lambert_material(1.0f)), "env-furnace.gltf");
   scene.environment = env_of(make_map(16, 8, [](int, int) { return glm::vec3(0.6f); }), 1.5f, 20.0f);
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
     Film f = render_film(scene, s, 16, 16, 256, 1000, 7);
@@ -342,13 +297,11 @@ TEST(EnvironmentRender, WhiteSphereUnderConstantMapIsInvisible) {
 // far lower (BSDF sampling finds the sun on about 1 bounce in 600)
 TEST(EnvironmentRender, TinySunNeeAgreesWithBsdfAndHasLowerVariance) {
   GltfBuilder g;
-  int white = g.add("materials", lambert(0.8f)), grey = g.add("materials", lambert(0.5f));
+  int white = g.add("materials", lambert_material(0.8f)), grey = g.add("materials", lambert_material(0.5f));
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f, 0.5f, 0.0f), 0.5f, 3, white),
-                                   quad_primitive({{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}}, grey)})}});
+                                   quad_facing_up(3.0f, 0.0f, grey)})}});
   g.add_camera(glm::vec3(0.0f, 1.2f, 2.5f), glm::vec3(0.0f, 0.4f, 0.0f), 0.8f);
-  std::string path = ::testing::TempDir() + "env-tiny-sun.gltf";
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "env-tiny-sun.gltf");
   scene.environment = load_environment(scene_path("lights/tiny-sun.hdr"), 1.0f, 0.0f);
   const int size = 16;
   const uint32_t nee_spp = 64, bsdf_spp = 4096;
@@ -409,7 +362,7 @@ TEST(EnvironmentRender, RotationMovesTheSun) {
 // and rotation; a missing file is an error; without a folder the map is not read
 TEST(EnvironmentLoader, SceneExtras) {
   GltfBuilder g;
-  int m = g.add("materials", lambert(0.5f));
+  int m = g.add("materials", lambert_material(0.5f));
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 1, m)})}});
   g.doc["scenes"][0]["extras"] = {
       {"candela", {{"environment", {{"file", "tiny-sun.hdr"}, {"strength", 2.5}, {"rotation", 30}}}}}};

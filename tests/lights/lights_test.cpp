@@ -9,17 +9,17 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
-#include <map>
 #include <memory>
 
 #include "compile/scene_compiler.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kSamples = 1 << 20;
 constexpr int kChiSquareTests = 6 * 2;  // per device: quad 1, environment 3, mixture 2
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
@@ -27,21 +27,14 @@ const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 // Flags of test_lights_sample (tests/lights/test_lights.cl)
 constexpr unsigned kOk = 1, kCompared = 2, kShadowClear = 4, kAtInfinity = 8, kDelta = 16;
 
-cl_float4 f4(const glm::dvec3& v) { return {{float(v.x), float(v.y), float(v.z), 0.0f}}; }
-glm::dvec3 d3(const cl_float4& v) { return {v.s[0], v.s[1], v.s[2]}; }
-
+// A shading point: the test kernels' arguments p, n and transmits
 struct Context {
   glm::dvec3 p, n;  // n = 0: a point in a medium
   bool transmits;
+  cl_uint bind(cl::Kernel& k, cl_uint first) const {
+    return bind_args(k, first, f4(p), f4(n), cl_uint(transmits ? 1 : 0));
+  }
 };
-
-void add_polygon(Scene* s, const std::vector<glm::vec3>& ccw, uint32_t material) {
-  MeshDesc m;
-  m.positions = ccw;
-  for (uint32_t k = 1; k + 1 < ccw.size(); ++k) m.indices.insert(m.indices.end(), {0, k, k + 1});
-  m.material = material;
-  s->meshes.push_back(m);
-}
 
 // Parallelogram c +- a e1 +- b e2, front (counter-clockwise) facing along e2 x e1
 std::vector<glm::vec3> parallelogram(glm::vec3 c, glm::vec3 e1, glm::vec3 e2, float a, float b) {
@@ -104,40 +97,18 @@ struct Samples {
   unsigned flags(size_t i) const { return unsigned(raw[2 * i + 1].s[3]); }
 };
 
-class LightsTest : public ::testing::TestWithParam<std::string> {
+class LightsTest : public DeviceTest {
  protected:
-  void SetUp() override {
-    DeviceEntry d;
-    CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &shared_rig(GetParam(), d);
-  }
-
   void use_scene(const Scene& s) {
     compiled_ = compile_scene(s);
-    scene_ = std::make_unique<SceneOnDevice>(*rig_, compiled_);
-  }
-
-  cl_uint bind_context(cl::Kernel& k, const Context& c) {
-    cl_uint arg = scene_->bind(k, 0);
-    k.setArg(arg++, f4(c.p));
-    k.setArg(arg++, f4(c.n));
-    k.setArg(arg++, cl_uint(c.transmits ? 1 : 0));
-    return arg;
+    scene_ = std::make_unique<SceneOnDevice>(rig(), compiled_);
   }
 
   // check: also evaluate lights_pdf and trace the rays (SamplePdfMatchesLightsPdf)
   Samples sample(const Context& c, cl_uint seed, size_t n = kSamples, bool check = false) {
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, 2 * n * sizeof(cl_float4));
-    cl::Kernel k(rig_->program, "test_lights_sample");
-    cl_uint arg = bind_context(k, c);
-    k.setArg(arg++, seed);
-    k.setArg(arg++, cl_uint(check ? 1 : 0));
-    k.setArg(arg++, out);
-    rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    Samples s;
-    s.raw.resize(2 * n);
-    rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, s.raw.size() * sizeof(cl_float4), s.raw.data());
-    return s;
+    auto out = rig().output<cl_float4>(2 * n);
+    rig().run("test_lights_sample", n, *scene_, c, seed, cl_uint(check ? 1 : 0), out);
+    return {out.read()};
   }
 
   // Cells of directions about a frame: grids [c_lo, c_hi) x [0, 2 pi), stacked in cos
@@ -187,21 +158,10 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
   // Probability of each cell under the summed lights_pdf (mode 1: the wrong pdf)
   std::vector<double> cell_probabilities(const Context& c, const Histogram& h, cl_uint mode = 0, cl_uint sub = 32) {
     std::vector<cl_float4> cells = h.cells();
-    cl::Buffer cb(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, cells.size() * sizeof(cl_float4),
-                  cells.data());
-    cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, cells.size() * sizeof(float));
-    cl::Kernel k(rig_->program, "test_lights_pdf_cells");
-    cl_uint arg = bind_context(k, c);
-    k.setArg(arg++, f4(h.t));
-    k.setArg(arg++, f4(h.b));
-    k.setArg(arg++, f4(h.a));
-    k.setArg(arg++, sub);
-    k.setArg(arg++, mode);
-    k.setArg(arg++, cb);
-    k.setArg(arg++, out);
-    rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(cells.size()));
-    std::vector<float> p(cells.size());
-    rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, p.size() * sizeof(float), p.data());
+    auto out = rig().output<float>(cells.size());
+    rig().run("test_lights_pdf_cells", cells.size(), *scene_, c, f4(h.t), f4(h.b), f4(h.a), sub, mode,
+              rig().input(cells), out);
+    std::vector<float> p = out.read();
     return std::vector<double>(p.begin(), p.end());
   }
 
@@ -250,7 +210,6 @@ class LightsTest : public ::testing::TestWithParam<std::string> {
     EXPECT_LE(rejected, s.size() / 10000) << "lights_sample returned false";
   }
 
-  KernelRig* rig_ = nullptr;
   CompiledScene compiled_;
   std::unique_ptr<SceneOnDevice> scene_;
 };
@@ -328,7 +287,7 @@ TEST_P(LightsTest, EnvironmentDirectionsMatchPdf) {
       if (hemisphere) {
         ASSERT_GE(cos_n, -1e-6) << "below the hemisphere";
       }
-      ASSERT_NEAR(s.pdf(i), hemisphere ? cos_n / kPi : 0.25 / kPi, 1e-6) << "sample " << i;
+      ASSERT_NEAR(s.pdf(i), hemisphere ? cosine_hemisphere_pdf(cos_n) : uniform_sphere_pdf(), 1e-6) << "sample " << i;
     }
     auto prob = cell_probabilities(c, h);
     expect_normalized(prob);
@@ -454,7 +413,6 @@ TEST_P(LightsTest, MixtureIrradianceEstimate) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, LightsTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, LightsTest, kernel_devices(), DeviceParamName());
 
 }  // namespace candela::test

@@ -13,20 +13,19 @@
 #include <cmath>
 #include <functional>
 #include <glm/gtc/quaternion.hpp>
-#include <map>
-#include <memory>
 
 #include "base/error.hpp"
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
 namespace {
 
 using nlohmann::json;
-constexpr double kPi = 3.14159265358979323846;
 
 // ---------------------------------------------------------------------------------------
 // Closed forms (double precision, from the extension's text)
@@ -50,14 +49,6 @@ double spot_profile(double inner, double outer, double angle) {
 
 constexpr float kAlbedo = 0.6f;
 
-void add_quad(Scene* s, const std::vector<glm::vec3>& ccw, uint32_t material) {
-  MeshDesc m;
-  m.positions = ccw;
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.material = material;
-  s->meshes.push_back(m);
-}
-
 Scene plane_scene(const PunctualLightDesc& light) {
   Scene s;
   MaterialDesc lambert;
@@ -65,7 +56,7 @@ Scene plane_scene(const PunctualLightDesc& light) {
   lambert.base_color = glm::vec4(kAlbedo, kAlbedo, kAlbedo, 1.0f);
   s.materials.push_back(lambert);
   const float h = 50.0f;
-  add_quad(&s, {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, 0);
+  add_polygon(&s, {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, 0);
   s.punctual_lights.push_back(light);
   return s;
 }
@@ -292,12 +283,12 @@ TEST_P(PunctualRender, DirectionalLightGivesECosineAndHardShadows) {
   Scene s = plane_scene(l);
   // A 0.6 x 0.6 blocker at height 1 over x = 1: its shadow is offset by -tan(theta)
   const double bx = 1.0, half = 0.3, bz = 1.0;
-  add_quad(&s,
-           {{float(bx - half), -float(half), float(bz)},
-            {float(bx + half), -float(half), float(bz)},
-            {float(bx + half), float(half), float(bz)},
-            {float(bx - half), float(half), float(bz)}},
-           0);
+  add_polygon(&s,
+              {{float(bx - half), -float(half), float(bz)},
+               {float(bx + half), -float(half), float(bz)},
+               {float(bx + half), float(half), float(bz)},
+               {float(bx - half), float(half), float(bz)}},
+              0);
   CameraDesc cam = camera({0.0f, -3.0f, 2.5f}, {0.3f, 0.0f, 0.0f}, 0.6f);
   View view(cam, 20);
   glm::dvec3 to_light = -glm::dvec3(l.direction);
@@ -335,8 +326,7 @@ TEST_P(PunctualRender, DirectionalLightGivesECosineAndHardShadows) {
   EXPECT_GE(open, 100);
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, PunctualRender, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, PunctualRender, kernel_devices(), DeviceParamName());
 
 // Under --strategy bsdf no sampled ray finds a punctual light: the image is black
 TEST(PunctualLights, ContributeNothingUnderBsdfStrategy) {
@@ -360,8 +350,7 @@ TEST(PunctualLights, ContributeNothingUnderBsdfStrategy) {
 constexpr unsigned kOk = 1, kDelta = 16, kAtInfinity = 8, kShadowClear = 4;
 
 TEST(PunctualLights, SampleIsDeltaWithPmfAndLightsPdfIsZero) {
-  DeviceEntry d = pocl_device();
-  KernelRig rig(d);
+  const KernelRig& rig = kernel_rig("pocl");
   Scene s = plane_scene({});
   s.punctual_lights.clear();
   PunctualLightDesc point, spot, sun;
@@ -384,18 +373,10 @@ TEST(PunctualLights, SampleIsDeltaWithPmfAndLightsPdfIsZero) {
 
   const size_t n = 4096;
   const glm::dvec3 p(0.1, 0.05, 1e-3), normal(0.0, 0.0, 1.0);
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, 2 * n * sizeof(cl_float4));
-  cl::Kernel k(rig.program, "test_lights_sample");
-  cl_uint arg = sd.bind(k, 0);
-  k.setArg(arg++, cl_float4{{float(p.x), float(p.y), float(p.z), 0.0f}});
-  k.setArg(arg++, cl_float4{{0.0f, 0.0f, 1.0f, 0.0f}});
-  k.setArg(arg++, cl_uint(0));
-  k.setArg(arg++, cl_uint(11));
-  k.setArg(arg++, cl_uint(1));  // evaluate lights_pdf and trace the rays
-  k.setArg(arg++, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> raw(2 * n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, raw.size() * sizeof(cl_float4), raw.data());
+  auto out = rig.output<cl_float4>(2 * n);
+  // p, n, transmits, seed, check (evaluate lights_pdf and trace the rays)
+  rig.run("test_lights_sample", n, sd, f4(p), f4({0.0, 0.0, 1.0}), cl_uint(0), cl_uint(11), cl_uint(1), out);
+  std::vector<cl_float4> raw = out.read();
 
   std::vector<size_t> count(3, 0);
   for (size_t i = 0; i < n; ++i) {

@@ -13,15 +13,13 @@
 
 #include <cmath>
 #include <glm/glm.hpp>
-#include <map>
-#include <memory>
 #include <random>
 
 #include "base/error.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
 #include "scene/vdb_grid.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/scenes.hpp"
 #include "support/test_support.hpp"
 
 #ifdef CANDELA_HAVE_OPENVDB
@@ -48,9 +46,7 @@ Scene grid_scene(const json& medium, const std::string& name, GltfBuilder* build
   GltfBuilder& g = builder ? *builder : local;
   int m = g.add("materials", {{"extras", {{"candela", {{"medium", medium}}}}}});
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-3.0f), glm::vec3(3.0f), m))}});
-  std::string path = ::testing::TempDir() + "vdb-" + name + ".gltf";
-  g.write(path);
-  return load_gltf(path);
+  return load_scene(g, "vdb-" + name + ".gltf");
 }
 
 // The ramp: voxel (i, j, k) holds 0.2 + 0.02 i on [0, 63] x [0, 23] x [0, 23], and a second
@@ -118,28 +114,13 @@ glm::dvec3 index_to_world(const openvdb::FloatGrid& grid, glm::dvec3 q) {
   return {w[0], w[1], w[2]};
 }
 
-KernelRig& rig_for(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
-  auto& r = rigs[name];
-  if (!r) r = std::make_unique<KernelRig>(*device_by_name(name));
-  return *r;
-}
-
 // Mean and standard error of test_media_transmittance per channel
-std::vector<std::pair<double, double>> transmittance(KernelRig& rig, const SceneOnDevice& sod, glm::dvec3 org,
+std::vector<std::pair<double, double>> transmittance(const KernelRig& rig, const SceneOnDevice& sod, glm::dvec3 org,
                                                      glm::dvec3 dir, double tmax, cl_uint seed) {
   const size_t n = 1 << 15;
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(rig.program, "test_media_transmittance");
-  cl_uint arg = sod.bind(k, 0);
-  k.setArg(arg++, cl_float4{{float(org.x), float(org.y), float(org.z), 0.0f}});
-  k.setArg(arg++, cl_float4{{float(dir.x), float(dir.y), float(dir.z), 0.0f}});
-  k.setArg(arg++, float(tmax));
-  k.setArg(arg++, seed);
-  k.setArg(arg++, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> v(n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
+  auto out = rig.output<cl_float4>(n);
+  rig.run("test_media_transmittance", n, sod, f4(org), f4(dir), float(tmax), seed, out);
+  std::vector<cl_float4> v = out.read();
   std::vector<std::pair<double, double>> r;
   for (int ch = 0; ch < 3; ++ch) {
     Estimate e = sample_mean(v, ch);
@@ -152,8 +133,13 @@ std::vector<std::pair<double, double>> transmittance(KernelRig& rig, const Scene
 class VolumeVdbRamp : public ::testing::TestWithParam<std::tuple<std::string, std::string, bool>> {
  protected:
   void SetUp() override {
-    if (!device_by_name(std::get<0>(GetParam()))) GTEST_SKIP() << std::get<0>(GetParam()) << " is not available";
+    rig_ = rig_or_null(std::get<0>(GetParam()));
+    if (!rig_) GTEST_SKIP() << std::get<0>(GetParam()) << " is not available";
   }
+  const KernelRig& rig() const { return *rig_; }
+
+ private:
+  const KernelRig* rig_ = nullptr;
 };
 
 // The kernel's world-to-index map and trilinear lookup (cl/media/nanovdb.cl) against OpenVDB's, at
@@ -167,24 +153,17 @@ TEST_P(VolumeVdbRamp, LookupsMatchOpenVdb) {
     load_openvdb_density(::testing::TempDir() + file, "density", &m);
   else
     load_nanovdb_density(::testing::TempDir() + file, "density", &m);
-  KernelRig& rig = rig_for(device);
   const size_t n = 4096;
-  std::vector<cl_float4> points(n), out(n);
+  std::vector<cl_float4> points(n);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-3.0, 112.0), v(-3.0, 28.0);
   for (auto& p : points) {
     glm::dvec3 w = index_to_world(*grid, {u(rng), v(rng), v(rng)});
-    p = cl_float4{{float(w.x), float(w.y), float(w.z), 0.0f}};
+    p = f4(w);
   }
-  cl::Buffer gb(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, m.nanovdb.size() * 4, m.nanovdb.data());
-  cl::Buffer pb(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * sizeof(cl_float4), points.data());
-  cl::Buffer ob(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(rig.program, "test_nanovdb_lookup");
-  k.setArg(0, gb);
-  k.setArg(1, pb);
-  k.setArg(2, ob);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  rig.queue.enqueueReadBuffer(ob, CL_TRUE, 0, n * sizeof(cl_float4), out.data());
+  auto lookups = rig().output<cl_float4>(n);
+  rig().run("test_nanovdb_lookup", n, rig().input(m.nanovdb), rig().input(points), lookups);
+  std::vector<cl_float4> out = lookups.read();
   auto acc = grid->getConstAccessor();
   for (size_t i = 0; i < n; ++i) {
     openvdb::Vec3d q = grid->transform().worldToIndex(openvdb::Vec3d(points[i].s[0], points[i].s[1], points[i].s[2]));
@@ -212,8 +191,7 @@ TEST_P(VolumeVdbRamp, RatioTrackingMatchesTheDensityIntegral) {
   CompiledScene compiled = compile_scene(scene);
   ASSERT_TRUE(compiled.features.nanovdb);
   ASSERT_EQ(compiled.buffers.media[1].type, MEDIUM_NANOVDB);
-  KernelRig& rig = rig_for(device);
-  SceneOnDevice sod(rig, compiled);
+  SceneOnDevice sod(rig(), compiled);
 
   // Segments inside the ramp (index points at least one voxel from its edges): the density
   // is linear along them, so the trapezoid rule is exact
@@ -226,7 +204,7 @@ TEST_P(VolumeVdbRamp, RatioTrackingMatchesTheDensityIntegral) {
     glm::dvec3 d = s.b - s.a;
     double len = glm::length(d);
     double integral = 0.5 * (reference_density(*grid, s.a) + reference_density(*grid, s.b)) * len;
-    auto tr = transmittance(rig, sod, s.a, d / len, len, 5);
+    auto tr = transmittance(rig(), sod, s.a, d / len, len, 5);
     for (int ch = 0; ch < 3; ++ch) {
       double want = std::exp(-double(sigma_t[ch]) * integral);
       EXPECT_NEAR(tr[size_t(ch)].first, want, 5.0 * tr[size_t(ch)].second + 1e-6)
@@ -249,7 +227,7 @@ TEST_P(VolumeVdbRamp, RatioTrackingMatchesTheDensityIntegral) {
     double integral = 0.0, h = t_exit / steps;
     for (int s = 0; s < steps; ++s) integral += reference_density(*grid, r.org + (s + 0.5) * h * r.dir) * h;
     EXPECT_GT(integral, 0.5) << "the ray crosses the grid";
-    auto tr = transmittance(rig, sod, r.org, r.dir, INFINITY, 6);
+    auto tr = transmittance(rig(), sod, r.org, r.dir, INFINITY, 6);
     for (int ch = 0; ch < 3; ++ch) {
       double want = std::exp(-double(sigma_t[ch]) * integral);
       EXPECT_NEAR(tr[size_t(ch)].first, want, 5.0 * tr[size_t(ch)].second + 1e-5)
@@ -259,8 +237,7 @@ TEST_P(VolumeVdbRamp, RatioTrackingMatchesTheDensityIntegral) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Grids, VolumeVdbRamp,
-                         ::testing::Combine(::testing::Values("pocl", "rusticl"), ::testing::Values("vdb", "nanovdb"),
-                                            ::testing::Bool()),
+                         ::testing::Combine(kernel_devices(), ::testing::Values("vdb", "nanovdb"), ::testing::Bool()),
                          [](const auto& info) {
                            return std::get<0>(info.param) + "_" + std::get<1>(info.param) +
                                   (std::get<2>(info.param) ? "_rotated" : "_aligned");

@@ -17,16 +17,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <glm/glm.hpp>
-#include <map>
-#include <memory>
 
 #include "base/error.hpp"
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
 #include "scene/vdb_grid.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
@@ -40,21 +38,10 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kPhaseSamples = 1 << 20;
 const std::vector<float> kPhaseG = {0.0f, 0.3f, 0.5f, 0.7f, -0.3f, -0.5f, -0.9f, 0.95f};
 constexpr int kChiSquareTests = 8 * 2;  // kPhaseG on each device
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
-
-KernelRig& rig_for(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<KernelRig>> rigs;
-  auto& r = rigs[name];
-  if (!r) r = std::make_unique<KernelRig>(*device_by_name(name));  // callers skip absent devices
-  return *r;
-}
-
-// The lecture's Henyey-Greenstein phase function of c = dot(wo, wi)
-double hg(double g, double c) { return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g + 2.0 * g * c, 1.5)); }
 
 const glm::dvec3 kWo = glm::normalize(glm::dvec3(0.3, -0.5, 0.8));
 
@@ -73,22 +60,11 @@ struct PhaseSamples {
   std::vector<float> evals;
 };
 
-PhaseSamples sample_phase(KernelRig& rig, float g, cl_uint seed) {
-  PhaseSamples s;
-  s.wi_pdf.resize(kPhaseSamples);
-  s.evals.resize(kPhaseSamples);
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, kPhaseSamples * sizeof(cl_float4));
-  cl::Buffer evals(rig.context, CL_MEM_WRITE_ONLY, kPhaseSamples * sizeof(float));
-  cl::Kernel k(rig.program, "test_phase_sample");
-  k.setArg(0, g);
-  k.setArg(1, cl_float4{{float(kWo.x), float(kWo.y), float(kWo.z), 0.0f}});
-  k.setArg(2, seed);
-  k.setArg(3, out);
-  k.setArg(4, evals);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(kPhaseSamples));
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, kPhaseSamples * sizeof(cl_float4), s.wi_pdf.data());
-  rig.queue.enqueueReadBuffer(evals, CL_TRUE, 0, kPhaseSamples * sizeof(float), s.evals.data());
-  return s;
+PhaseSamples sample_phase(const KernelRig& rig, float g, cl_uint seed) {
+  auto out = rig.output<cl_float4>(kPhaseSamples);
+  auto evals = rig.output<float>(kPhaseSamples);
+  rig.run("test_phase_sample", kPhaseSamples, g, f4(kWo), seed, out, evals);
+  return {out.read(), evals.read()};
 }
 
 // Cells: kCos rings with edges crowded toward c = -1 and c = 1 (the forward peak at
@@ -110,7 +86,7 @@ std::vector<double> expected_cells(double g) {
     const int n = 200;  // Simpson intervals
     for (int k = 0; k <= n; ++k) {
       double w = k == 0 || k == n ? 1.0 : (k % 2 ? 4.0 : 2.0);
-      ring += w * hg(g, a + (b - a) * k / n);
+      ring += w * henyey_greenstein(g, a + (b - a) * k / n);
     }
     ring *= (b - a) / (3.0 * n) * 2.0 * kPi;
     for (int j = 0; j < kPhi; ++j) p[size_t(i * kPhi + j)] = ring / kPhi;
@@ -134,13 +110,12 @@ std::vector<double> observed_cells(const PhaseSamples& s) {
 class PhaseTest : public ::testing::TestWithParam<std::tuple<std::string, int>> {
  protected:
   void SetUp() override {
-    auto dev = device_by_name(std::get<0>(GetParam()));
-    if (!dev) GTEST_SKIP() << std::get<0>(GetParam()) << " OpenCL device is not available";
-    rig_ = &rig_for(std::get<0>(GetParam()));
+    rig_ = rig_or_null(std::get<0>(GetParam()));
+    if (!rig_) GTEST_SKIP() << std::get<0>(GetParam()) << " OpenCL device is not available";
     g_ = kPhaseG[size_t(std::get<1>(GetParam()))];
     seed_ = cl_uint(17 + std::get<1>(GetParam()) + (std::get<0>(GetParam()) == "rusticl" ? 100 : 0));
   }
-  KernelRig* rig_ = nullptr;
+  const KernelRig* rig_ = nullptr;
   float g_ = 0.0f;
   cl_uint seed_ = 0;
 };
@@ -162,7 +137,7 @@ TEST_P(PhaseTest, SamplesFollowThePdf) {
     const cl_float4& v = s.wi_pdf[i];
     glm::dvec3 wi(v.s[0], v.s[1], v.s[2]);
     ASSERT_NEAR(glm::length(wi), 1.0, 1e-5);
-    double want = hg(g_, glm::dot(wi, f.n));
+    double want = henyey_greenstein(g_, glm::dot(wi, f.n));
     ASSERT_NEAR(v.s[3], want, 2e-4 * want) << "sample " << i;
     ASSERT_NEAR(s.evals[i], v.s[3], 2e-4 * want) << "sample " << i;  // float rounding of wi near the peak
   }
@@ -203,28 +178,20 @@ TEST_P(PhaseTest, PdfIntegratesToOne) {
     for (int j = 0; j < np; ++j) {
       double phi = 2.0 * kPi * (j + 0.5) / np;
       glm::dvec3 d = sn * std::cos(phi) * f.t + sn * std::sin(phi) * f.b + c * f.n;
-      dirs.push_back({{float(d.x), float(d.y), float(d.z), 0.0f}});
+      dirs.push_back(f4(d));
       weights.push_back(dc * 2.0 * kPi / np);
     }
   }
-  cl::Buffer in(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(cl_float4), dirs.data());
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(float));
-  cl::Kernel k(rig_->program, "test_phase_eval");
-  k.setArg(0, g_);
-  k.setArg(1, cl_float4{{float(kWo.x), float(kWo.y), float(kWo.z), 0.0f}});
-  k.setArg(2, in);
-  k.setArg(3, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(dirs.size()));
-  std::vector<float> v(dirs.size());
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, v.size() * sizeof(float), v.data());
+  auto out = rig_->output<float>(dirs.size());
+  rig_->run("test_phase_eval", dirs.size(), g_, f4(kWo), rig_->input(dirs), out);
+  std::vector<float> v = out.read();
   double integral = 0.0;
   for (size_t i = 0; i < v.size(); ++i) integral += v[i] * weights[i];
   EXPECT_NEAR(integral, 1.0, 2e-3) << "g " << g_;
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, PhaseTest,
-                         ::testing::Combine(::testing::Values("pocl", "rusticl"),
-                                            ::testing::Range(0, int(kPhaseG.size()))),
+                         ::testing::Combine(kernel_devices(), ::testing::Range(0, int(kPhaseG.size()))),
                          [](const auto& info) {
                            return std::get<0>(info.param) + "_g" + std::to_string(std::get<1>(info.param));
                          });
@@ -241,42 +208,11 @@ json medium_json(glm::vec3 sigma_a, glm::vec3 sigma_s, double g = 0.0, glm::vec3
 // A null boundary: a material with a medium and no transmission
 json null_material(const json& medium) { return {{"extras", {{"candela", {{"medium", medium}}}}}}; }
 
-json emitter_material() {
-  return {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0.0}}},
-          {"emissiveFactor", {1, 1, 1}},
-          {"extensions",
-           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 1.0}}},
-            {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
-}
-
-// An emitter's emissiveFactor holds at most 1: radiance = factor x strength
-json emitter(glm::vec3 radiance) {
-  float s = std::max({radiance.x, radiance.y, radiance.z});
-  json m = emitter_material();
-  m["emissiveFactor"] = {radiance.x / s, radiance.y / s, radiance.z / s};
-  m["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = s;
-  return m;
-}
-
-json diffuse(float albedo) {
-  return {{"pbrMetallicRoughness", {{"baseColorFactor", {albedo, albedo, albedo, 1}}, {"metallicFactor", 0.0}}},
-          {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
-}
-
-Scene load(const GltfBuilder& g, const std::string& name) {
-  std::string path = ::testing::TempDir() + "volume-" + name + ".gltf";
-  g.write(path);
-  return load_gltf(path);
-}
+Scene load(const GltfBuilder& g, const std::string& name) { return load_scene(g, "volume-" + name + ".gltf"); }
 
 Film render(const Scene& scene, Strategy s, int size, uint32_t spp, uint32_t max_depth, uint32_t seed,
             const std::string& device = "pocl") {
-  RenderSettings settings;
-  settings.width = settings.height = size;
-  settings.strategy = s;
-  settings.max_depth = max_depth;
-  settings.seed = seed;
-  return scene_renderer(*device_by_name(device), scene, settings).render(0, spp).film;
+  return render_film(scene, s, size, size, spp, max_depth, seed, *device_by_name(device));
 }
 
 const char* name(Strategy s) { return s == Strategy::Nee ? "nee" : "bsdf"; }
@@ -307,7 +243,7 @@ class VolumeRender : public ::testing::TestWithParam<std::string> {
     return render(load(g, label + "-" + GetParam()), s, 8, spp, 64, 5, GetParam());
   }
   void add_emitter(GltfBuilder& g, glm::vec3 radiance) {
-    int light = g.add("materials", emitter(radiance));
+    int light = g.add("materials", emissive_material(radiance));
     g.add_node({{"mesh", g.add_mesh({quad_primitive({{-2, -2, -1}, {2, -2, -1}, {2, 2, -1}, {-2, 2, -1}}, light)})}});
   }
 };
@@ -438,17 +374,12 @@ json constant_grid(glm::vec3 lo, glm::vec3 hi, float value) {
 
 TEST_P(VolumeFurnace, InvisibleUnderUniformBackground) {
   auto [s, g_value, grid] = GetParam();
-  GltfBuilder g;
   json medium = medium_json(glm::vec3(0.0f), glm::vec3(1.0f, 2.0f, 4.0f), g_value);
   if (grid) {
     medium["grid"] = constant_grid(glm::vec3(-0.6f), glm::vec3(0.6f), 0.25f);
     medium["density_scale"] = 4.0;  // density 1: the same medium
   }
-  int m = g.add("materials", null_material(medium));
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  g.set_background(glm::vec3(1.0f));
-  Film f = render(load(g, "furnace"), s, 16, 256, 1000, 11);
+  Film f = render(load(furnace_sphere(null_material(medium)), "furnace"), s, 16, 256, 1000, 11);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << name(s) << " g " << g_value << " SE " << e.standard_error;
@@ -466,18 +397,13 @@ TEST_P(VolumeFurnace, InvisibleUnderUniformBackground) {
 class GlassFurnace : public ::testing::TestWithParam<Strategy> {};
 
 TEST_P(GlassFurnace, ScatteringGlassIsInvisible) {
-  GltfBuilder g;
   json glass = {
       {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
       {"extensions",
        {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
         {"KHR_materials_volume", {{"thicknessFactor", 1.0}}}}},
       {"extras", {{"candela", {{"medium", medium_json(glm::vec3(0.0f), glm::vec3(2.0f, 1.0f, 0.5f), 0.5)}}}}}};
-  int m = g.add("materials", glass);
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  g.set_background(glm::vec3(1.0f));
-  Film f = render(load(g, "glass-furnace"), GetParam(), 16, 128, 1000, 21);
+  Film f = render(load(furnace_sphere(glass), "glass-furnace"), GetParam(), 16, 128, 1000, 21);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << name(GetParam()) << " SE " << e.standard_error;
@@ -489,12 +415,8 @@ INSTANTIATE_TEST_SUITE_P(Media, GlassFurnace, ::testing::Values(Strategy::Nee, S
 
 // The furnace has power: the same sphere with absorption (albedo 2/3) is visibly darker
 TEST(VolumeFurnaceControl, AbsorbingSphereIsDarker) {
-  GltfBuilder g;
-  int m = g.add("materials", null_material(medium_json(glm::vec3(0.5f, 1.0f, 2.0f), glm::vec3(1.0f, 2.0f, 4.0f))));
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  g.set_background(glm::vec3(1.0f));
-  Film f = render(load(g, "furnace-absorbing"), Strategy::Nee, 16, 64, 1000, 12);
+  json medium = medium_json(glm::vec3(0.5f, 1.0f, 2.0f), glm::vec3(1.0f, 2.0f, 4.0f));
+  Film f = render(load(furnace_sphere(null_material(medium)), "furnace-absorbing"), Strategy::Nee, 16, 64, 1000, 12);
   for (int c = 0; c < 3; ++c) {
     Estimate e = region_mean(f, c, 4, 12, 4, 12);
     EXPECT_LT(e.mean, 0.9) << "channel " << c;
@@ -514,8 +436,8 @@ INSTANTIATE_TEST_SUITE_P(Media, VolumeFurnace,
 // A box of scattering, absorbing medium on a floor under an area light
 Scene lit_medium_scene(bool grid) {
   GltfBuilder g;
-  int floor = g.add("materials", diffuse(0.5f));
-  int light = g.add("materials", emitter(glm::vec3(8.0f)));
+  int floor = g.add("materials", lambert_material(0.5f));
+  int light = g.add("materials", emissive_material(glm::vec3(8.0f)));
   json medium = medium_json(glm::vec3(0.2f, 0.4f, 0.8f), glm::vec3(1.5f, 1.0f, 0.5f), 0.4);
   if (grid) {
     medium["grid"] = constant_grid(glm::vec3(-0.8f, 0.0f, -0.8f), glm::vec3(0.8f, 0.9f, 0.8f), 0.5f);
@@ -523,8 +445,7 @@ Scene lit_medium_scene(bool grid) {
   }
   int box = g.add("materials", null_material(medium));
   const float l = 0.4f, h = 1.8f;
-  g.add_node({{"mesh", g.add_mesh({quad_primitive({{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}}, floor),
-                                   quad_primitive({{-l, h, l}, {-l, h, -l}, {l, h, -l}, {l, h, l}}, light)})}});
+  g.add_node({{"mesh", g.add_mesh({quad_facing_up(3.0f, 0.0f, floor), quad_facing_down_rotated(l, h, light)})}});
   g.add_node({{"mesh", g.add_mesh(box_primitives({-0.6f, 0.0f, -0.6f}, {0.6f, 0.9f, 0.6f}, box))}});
   g.add_camera(glm::vec3(0.0f, 1.2f, 2.6f), glm::vec3(0.0f, 0.4f, 0.0f), 0.8f);
   return load(g, grid ? "lit-grid" : "lit");
@@ -593,7 +514,7 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-1.0f), glm::vec3(1.0f), box))}});
   Scene scene = load(g, "linear-grid");
   CompiledScene compiled = compile_scene(scene);
-  KernelRig& rig = rig_for("pocl");
+  const KernelRig& rig = kernel_rig("pocl");
   SceneOnDevice sod(rig, compiled);
   auto density_at = [](double x) { return 0.2 + 0.8 * (x + 1.0) / 2.0; };
   struct Case {
@@ -605,17 +526,9 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
   for (const Case& c : {Case{{-0.5, 0.1, 0.0}, {1, 0, 0}, 1.2}, Case{{-0.9, -0.2, 0.1}, oblique, INFINITY},
                         Case{{0.8, 0.3, -0.2}, backward, INFINITY}}) {
     const size_t n = 1 << 16;
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_media_transmittance");
-    cl_uint arg = sod.bind(k, 0);
-    k.setArg(arg++, cl_float4{{float(c.org.x), float(c.org.y), float(c.org.z), 0.0f}});
-    k.setArg(arg++, cl_float4{{float(c.dir.x), float(c.dir.y), float(c.dir.z), 0.0f}});
-    k.setArg(arg++, float(c.tmax));
-    k.setArg(arg++, cl_uint(3));
-    k.setArg(arg++, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    std::vector<cl_float4> v(n);
-    rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
+    auto out = rig.output<cl_float4>(n);
+    rig.run("test_media_transmittance", n, sod, f4(c.org), f4(c.dir), float(c.tmax), cl_uint(3), out);
+    std::vector<cl_float4> v = out.read();
     // Path inside the box: up to tmax or to the box's exit
     double t_exit = INFINITY;
     for (int a = 0; a < 3; ++a)
@@ -652,20 +565,13 @@ TEST(VolumeGrid, EmissionGridKeepsTransmittance) {
   // The majorant cells: raised to 1 / cell size except the first layer along z (the ramp is
   // 0 at z = 0 but rises within that cell's trilinear reach, so it is raised too)
   EXPECT_FLOAT_EQ(media[1].majorant, 8.0f / d);
-  KernelRig& rig = rig_for("pocl");
+  const KernelRig& rig = kernel_rig("pocl");
   SceneOnDevice sod(rig, compiled);
   const size_t n = 1 << 16;
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(rig.program, "test_media_transmittance");
-  cl_uint arg = sod.bind(k, 0);
-  k.setArg(arg++, cl_float4{{0.1f, 0.2f, d + 1.0f, 0.0f}});
-  k.setArg(arg++, cl_float4{{0.0f, 0.0f, -1.0f, 0.0f}});
-  k.setArg(arg++, float(INFINITY));
-  k.setArg(arg++, cl_uint(11));
-  k.setArg(arg++, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> v(n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
+  auto out = rig.output<cl_float4>(n);
+  rig.run("test_media_transmittance", n, sod, cl_float4{{0.1f, 0.2f, d + 1.0f, 0.0f}}, f4({0.0, 0.0, -1.0}),
+          float(INFINITY), cl_uint(11), out);
+  std::vector<cl_float4> v = out.read();
   for (int ch = 0; ch < 3; ++ch) {
     auto [mean, se] = sample_mean(v, ch);
     double want = std::exp(-double(kSigmaA[ch]) * density * d);
@@ -689,7 +595,7 @@ TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
   thin["extensions"].erase("KHR_materials_volume");
   int m_glass = g.add("materials", glass), m_clear = g.add("materials", clear), m_thin = g.add("materials", thin);
   int m_null = g.add("materials", null_material(medium_json(glm::vec3(1.0f), glm::vec3(0.0f))));
-  int m_opaque = g.add("materials", diffuse(0.5f));
+  int m_opaque = g.add("materials", lambert_material(0.5f));
   float x = 0.0f;
   for (int m : {m_glass, m_clear, m_thin, m_null, m_opaque}) {
     g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(x), glm::vec3(x + 1.0f), m))}});
@@ -791,8 +697,8 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   }
   // A global medium that emits where nothing attenuates would give infinite radiance
   GltfBuilder g;
-  g.add_node(
-      {{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f), g.add("materials", diffuse(0.5f))))}});
+  g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f),
+                                                 g.add("materials", lambert_material(0.5f))))}});
   g.doc["scenes"][0]["extras"]["candela"]["medium"] =
       medium_json(glm::vec3(0.0f, 1.0f, 1.0f), glm::vec3(0.0f), 0.0, glm::vec3(1.0f));
   EXPECT_THROW(load(g, "bad-emitting-fog"), Error);
@@ -835,8 +741,7 @@ TEST(VolumeNanoVdb, FogSphereLoadsAndIsAFurnace) {
 #endif
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, VolumeRender, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, VolumeRender, kernel_devices(), DeviceParamName());
 
 }  // namespace
 }  // namespace candela::test

@@ -22,9 +22,10 @@
 #include <string>
 #include <vector>
 
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/reference.hpp"
+#include "support/scenes.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -32,21 +33,14 @@ namespace {
 
 using nlohmann::json;
 
-KernelRig& pocl_rig() {
-  static KernelRig rig(pocl_device());
-  return rig;
-}
-
 json scattering_medium(glm::vec3 sigma_s, double g) {
   return {{"sigma_a", {0, 0, 0}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"g", g}};
 }
 
 json null_boundary(const json& medium) { return {{"extras", {{"candela", {{"medium", medium}}}}}}; }
 
-Scene load_scene(const GltfBuilder& g, const std::string& name) {
-  std::string path = ::testing::TempDir() + "volume-tracking-" + name + ".gltf";
-  g.write(path);
-  return load_gltf(path);
+Scene load_tracking_scene(const GltfBuilder& g, const std::string& name) {
+  return load_scene(g, "volume-tracking-" + name + ".gltf");
 }
 
 // --- Tracking against quadrature ---
@@ -201,7 +195,7 @@ struct TrackingScene {
   CompiledScene compiled;
   SceneOnDevice sod;
   TrackingScene(const HostGrid& grid, double density_scale, const std::string& name)
-      : scene(make(grid, density_scale, name)), compiled(compile_scene(scene)), sod(pocl_rig(), compiled) {}
+      : scene(make(grid, density_scale, name)), compiled(compile_scene(scene)), sod(kernel_rig("pocl"), compiled) {}
   static Scene make(const HostGrid& grid, double density_scale, const std::string& name) {
     GltfBuilder g;
     json medium = scattering_medium(glm::vec3(1.0f), 0.0);
@@ -212,26 +206,17 @@ struct TrackingScene {
     medium["density_scale"] = density_scale;
     int box = g.add("materials", null_boundary(medium));
     g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(grid.lo), glm::vec3(grid.hi), box))}});
-    return load_scene(g, name);
+    return load_tracking_scene(g, name);
   }
 };
 
 // n estimates from one of the test kernels: (value per channel, w)
 std::vector<cl_float4> run_tracking(const TrackingScene& ts, const char* kernel, const TrackRay& r, size_t n,
                                     cl_uint seed) {
-  KernelRig& rig = pocl_rig();
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(rig.program, kernel);
-  cl_uint arg = ts.sod.bind(k, 0);
-  k.setArg(arg++, cl_float4{{float(r.org.x), float(r.org.y), float(r.org.z), 0.0f}});
-  k.setArg(arg++, cl_float4{{float(r.dir.x), float(r.dir.y), float(r.dir.z), 0.0f}});
-  k.setArg(arg++, float(r.tmax));
-  k.setArg(arg++, seed);
-  k.setArg(arg++, out);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> v(n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
-  return v;
+  const KernelRig& rig = kernel_rig("pocl");
+  auto out = rig.output<cl_float4>(n);
+  rig.run(kernel, n, ts.sod, f4(r.org), f4(r.dir), float(r.tmax), seed, out);
+  return out.read();
 }
 
 struct Moments {
@@ -422,37 +407,22 @@ TEST(VolumeTracking, ComparisonRejectsAWrongReference) {
 // 30x the critical value; pdf errors up to 36 %); since D is the same for every g (the
 // samples are a monotone map of the same u), it passes with D = 6.7e-4.
 TEST(VolumePhaseNearOne, DeflectionAnglesFollowTheCdf) {
-  KernelRig& rig = pocl_rig();
+  const KernelRig& rig = kernel_rig("pocl");
   const size_t n = 1 << 20;
   const glm::vec3 wo_f = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
   const glm::dvec3 travel = -glm::dvec3(wo_f);  // the incoming travel direction
   for (float g : {0.99f, -0.99f, 0.999f, -0.999f}) {
     SCOPED_TRACE("g " + std::to_string(g));
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-    cl::Buffer evals(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(float));
-    cl::Kernel k(rig.program, "test_phase_sample");
-    k.setArg(0, g);
-    k.setArg(1, cl_float4{{wo_f.x, wo_f.y, wo_f.z, 0.0f}});
-    k.setArg(2, cl_uint(5));
-    k.setArg(3, out);
-    k.setArg(4, evals);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    std::vector<cl_float4> v(n);
-    std::vector<float> e(n);
-    rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), v.data());
-    rig.queue.enqueueReadBuffer(evals, CL_TRUE, 0, n * sizeof(float), e.data());
+    auto out = rig.output<cl_float4>(n);
+    auto evals = rig.output<float>(n);
+    rig.run("test_phase_sample", n, g, cl_float4{{wo_f.x, wo_f.y, wo_f.z, 0.0f}}, cl_uint(5), out, evals);
+    std::vector<cl_float4> v = out.read();
+    std::vector<float> e = evals.read();
     const double gd = g;
-    // 1 - mu = 2 sin^2(theta / 2), mu the cosine of the deflection; the cdf of mu is
-    // P(mu) = (1 - g^2) / (2 g) [(1 + g^2 - 2 g mu)^(-1/2) - 1 / (1 + g)], written in terms of
-    // x = 1 - mu: 1 + g^2 - 2 g mu = (1 - g)^2 + 2 g x
-    auto cdf_x = [&](double x) {  // P(1 - mu <= x) = 1 - P(mu < 1 - x)
-      double p_mu =
-          (1.0 - gd * gd) / (2.0 * gd) * (1.0 / std::sqrt((1.0 - gd) * (1.0 - gd) + 2.0 * gd * x) - 1.0 / (1.0 + gd));
-      return 1.0 - p_mu;
-    };
-    auto hg_x = [&](double x) {  // the phase function at deflection 1 - mu = x
-      return (1.0 - gd * gd) / (4.0 * 3.14159265358979323846 * std::pow((1.0 - gd) * (1.0 - gd) + 2.0 * gd * x, 1.5));
-    };
+    // 1 - mu = 2 sin^2(theta / 2), mu the cosine of the deflection: the phase function and
+    // its cdf in terms of x = 1 - mu (henyey_greenstein_deflection)
+    auto cdf_x = [&](double x) { return henyey_greenstein_deflection_cdf(gd, x); };
+    auto hg_x = [&](double x) { return henyey_greenstein_deflection(gd, x); };
     std::vector<double> xs(n);
     size_t pdf_off = 0;
     double worst_pdf = 0.0;
@@ -494,7 +464,6 @@ struct FurnaceCase {
 };
 
 Film render_furnace(const FurnaceCase& c, uint32_t seed) {
-  GltfBuilder g;
   json medium = scattering_medium(c.sigma_s, c.g);
   if (c.grid) {  // a constant grid of density 0.25 x 4: the same medium through delta tracking
     medium["grid"] = {{"size", {2, 2, 2}},
@@ -503,16 +472,8 @@ Film render_furnace(const FurnaceCase& c, uint32_t seed) {
                       {"density", std::vector<float>(8, 0.25f)}};
     medium["density_scale"] = 4.0;
   }
-  int m = g.add("materials", null_boundary(medium));
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  g.set_background(glm::vec3(1.0f));
-  RenderSettings s;
-  s.width = s.height = 16;
-  s.strategy = c.strategy;
-  s.max_depth = c.max_depth;
-  s.seed = seed;
-  return scene_renderer(pocl_device(), load_scene(g, std::string("furnace-") + c.name), s).render(0, c.spp).film;
+  Scene scene = load_tracking_scene(furnace_sphere(null_boundary(medium)), std::string("furnace-") + c.name);
+  return render_film(scene, c.strategy, 16, 16, c.spp, c.max_depth, seed);
 }
 
 constexpr uint32_t kNoDepthCap = 1u << 24;  // never reached: paths end by escaping

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/scenes.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -17,14 +17,7 @@ using nlohmann::json;
 
 // A sphere of `material` filling most of the view under a uniform background of 1
 Scene furnace_scene(const json& material, const std::string& file) {
-  GltfBuilder g;
-  int m = g.add("materials", material);
-  g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 0.5f, 3, m)})}});
-  g.add_camera(glm::vec3(0.0f, 0.3f, 2.0f), glm::vec3(0.0f), 0.6f);
-  g.set_background(glm::vec3(1.0f));
-  std::string path = ::testing::TempDir() + file;
-  g.write(path);
-  return load_gltf(path);
+  return load_scene(furnace_sphere(material), file);
 }
 
 json glass(double roughness, bool volume) {
@@ -107,23 +100,13 @@ TEST_P(SpecularShowsLight, NeeSeesTheLightAndStrategiesAgree) {
                            {"extras", {{"candela", {{"conductor", "silver"}}}}}}
                     : glass(0.0, true);
   int obj = g.add("materials", object);
-  int floor =
-      g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"metallicFactor", 0.0}}},
-                          {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
-  int light =
-      g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0.0}}},
-                          {"emissiveFactor", {1, 1, 1}},
-                          {"extensions",
-                           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 20.0}}},
-                            {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}});
+  int floor = g.add("materials", lambert_material(0.5));
+  int light = g.add("materials", emissive_material(glm::vec3(20.0f)));
   const float l = 0.3f, h = 1.5f;
   g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f, 0.5f, 0.0f), 0.5f, 3, obj),
-                                   quad_primitive({{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}}, floor),
-                                   quad_primitive({{-l, h, l}, {-l, h, -l}, {l, h, -l}, {l, h, l}}, light)})}});
+                                   quad_facing_up(3.0f, 0.0f, floor), quad_facing_down_rotated(l, h, light)})}});
   g.add_camera(glm::vec3(0.0f, 0.9f, 2.2f), glm::vec3(0.0f, 0.5f, 0.0f), 0.7f);
-  std::string path = ::testing::TempDir() + "specular-" + GetParam() + ".gltf";
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "specular-" + GetParam() + ".gltf");
   const int size = 24;
   Film nee = render_film(scene, Strategy::Nee, size, size, 256, 12, 3);
   Film bsdf = render_film(scene, Strategy::Bsdf, size, size, 2048, 12, 4);
@@ -178,9 +161,7 @@ TEST_P(ShadingNormals, NoBlackFringesAtSilhouettesOfSmoothedCoarseMeshes) {
   g.add_node({{"mesh", g.add_mesh({sphere})}});
   g.add_camera(glm::vec3(0.0f, 0.0f, 2.0f), glm::vec3(0.0f), 0.6f);
   g.set_background(glm::vec3(1.0f));
-  std::string path = ::testing::TempDir() + "fringe-sphere.gltf";
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "fringe-sphere.gltf");
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
     Film f = render_film(scene, s, 64, 64, 64, 8, 3);
     // Dark pixels: the BSDF-sampled furnace is nearly noise-free (every path ends in the

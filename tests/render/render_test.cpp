@@ -9,6 +9,7 @@
 #include "base/error.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/scenes.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -64,8 +65,7 @@ TEST_P(FurnaceTest, WhiteObjectsUnderWhiteBackgroundAreInvisible) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, FurnaceTest,
-                         ::testing::Combine(::testing::Values("pocl", "rusticl"),
-                                            ::testing::Values(Strategy::Nee, Strategy::Bsdf)),
+                         ::testing::Combine(kernel_devices(), ::testing::Values(Strategy::Nee, Strategy::Bsdf)),
                          [](const auto& info) {
                            return std::get<0>(info.param) + "_" + strategy_name(std::get<1>(info.param));
                          });
@@ -103,27 +103,14 @@ TEST_P(CornellTest, StrategiesAgreeWithinStandardError) {
   EXPECT_LT(whole_bsdf.standard_error, 0.05 * whole_bsdf.mean);
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, CornellTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, CornellTest, kernel_devices(), DeviceParamName());
 
 // A small light hovering just above a floor near the origin: shadow rays toward it must
 // not hit the light itself, so NEE and BSDF sampling agree there too
 TEST(Render, StrategiesAgreeForALightCloseToASurface) {
-  std::string path = ::testing::TempDir() + "near-light.gltf";
-  const float h = 0.01f, s = 0.05f;
-  std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),   // floor, facing +y
-      quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};  // light, facing -y
-  GltfBuilder g;                                                             // black background
-  g.add_node({{"mesh", g.add_mesh(quads)}});
-  g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
-     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
-    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
-     "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}])");
+  GltfBuilder g = floor_under_square_light(0.01f, 0.05f, 5);
   g.add_camera({0.0f, 0.25f, 0.3f}, {0, 0, 0}, 0.5f);
-  g.write(path);
-  Scene scene = load_gltf(path);
+  Scene scene = load_scene(g, "near-light.gltf");
   RenderSettings settings;
   settings.width = settings.height = 16;
   settings.max_depth = 4;
@@ -148,23 +135,13 @@ TEST(Render, EmissiveTextureIsSampledWhereTheLightIsSampled) {
   ASSERT_TRUE(out && out->open(dir + "emit.png", OIIO::ImageSpec(2, 1, 3, OIIO::TypeDesc::UINT8)));
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
   out->close();
-  const float s = 0.25f, h = 0.3f;
-  std::vector<GltfBuilder::Primitive> quads = {quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),
-                                               quad_primitive({{-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}}, 1)};
-  GltfBuilder g;  // black background
-  g.add_node({{"mesh", g.add_mesh(quads)}});
-  g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
-     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
-    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
-     "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0},
-     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}])");
+  GltfBuilder g = floor_under_square_light(0.3f, 0.25f, 4);
+  g.doc["materials"][1]["emissiveTexture"] = {{"index", 0}};
   g.add("images", {{"uri", "emit.png"}});
   g.add("samplers", {{"magFilter", 9729}, {"wrapS", 33071}, {"wrapT", 33071}});
   g.add("textures", {{"source", 0}, {"sampler", 0}});
   g.add_camera({0.0f, 1.2f, 0.01f}, {0, 0, 0}, 1.2f);
-  g.write(dir + "emissive-texture.gltf");
-  Scene scene = load_gltf(dir + "emissive-texture.gltf");
+  Scene scene = load_scene(g, "emissive-texture.gltf");
   ASSERT_NE(scene.materials[1].texture(TEX_EMISSION).index, NO_TEXTURE);
   RenderSettings settings;
   settings.width = settings.height = 16;

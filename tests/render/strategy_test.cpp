@@ -26,16 +26,6 @@ namespace {
 
 constexpr int kWidth = 96, kHeight = 64;
 
-double rel_mse(const Film& f, const Film& ref) {
-  double sum = 0.0;
-  for (size_t i = 0; i < f.pixels(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      double r = ref.pixel(i)[c], d = f.pixel(i)[c] - r;
-      sum += d * d / (r * r + 0.01);
-    }
-  return sum / double(3 * f.pixels());
-}
-
 struct Errors {
   double nee = 0.0, bsdf = 0.0, automatic = 0.0;
 };

@@ -11,12 +11,10 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
-#include <map>
-#include <memory>
 #include <random>
 
-#include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/scenes.hpp"
 #include "support/stats.hpp"
 #include "support/test_support.hpp"
 
@@ -93,7 +91,7 @@ struct Traced {
 };
 
 // Rays from (x, y, 1) along -z with tmax, through test_alpha_trace
-Traced trace(KernelRig& rig, const Scene& scene, const std::vector<glm::vec2>& points, float tmax) {
+Traced trace(const KernelRig& rig, const Scene& scene, const std::vector<glm::vec2>& points, float tmax) {
   CompiledScene compiled = compile_scene(scene);
   SceneOnDevice on_device(rig, compiled);
   std::vector<cl_float4> rays;
@@ -102,22 +100,10 @@ Traced trace(KernelRig& rig, const Scene& scene, const std::vector<glm::vec2>& p
     rays.push_back({{0.0f, 0.0f, -1.0f, 0.0f}});
   }
   size_t n = points.size();
-  cl::Buffer ray_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, rays.size() * sizeof(cl_float4),
-                     rays.data());
-  cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Buffer occ(rig.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_int));
-  cl::Kernel k(rig.program, "test_alpha_trace");
-  cl_uint arg = on_device.bind(k, 0);
-  k.setArg(arg++, ray_buf);
-  k.setArg(arg++, out);
-  k.setArg(arg++, occ);
-  rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  Traced t;
-  t.hits.resize(n);
-  t.occluded.resize(n);
-  rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_float4), t.hits.data());
-  rig.queue.enqueueReadBuffer(occ, CL_TRUE, 0, n * sizeof(cl_int), t.occluded.data());
-  return t;
+  auto hits = rig.output<cl_float4>(n);
+  auto occluded = rig.output<cl_int>(n);
+  rig.run("test_alpha_trace", n, on_device, rig.input(rays), hits, occluded);
+  return {hits.read(), occluded.read()};
 }
 
 // Random points of the card away from the checker's cell borders and the card's edges
@@ -132,18 +118,13 @@ std::vector<glm::vec2> card_points(size_t n) {
   return p;
 }
 
-class AlphaTraceTest : public ::testing::TestWithParam<std::string> {
+class AlphaTraceTest : public DeviceTest {
  protected:
-  void SetUp() override {
-    DeviceEntry d;
-    CANDELA_DEVICE_OR_SKIP(GetParam(), d);
-    rig_ = &shared_rig(GetParam(), d);
-  }
   // Closest hits over the whole ray, and shadow rays that end between card and wall
   // agreeing with closest hits over the same span, ray by ray
   Traced trace_checked(const Scene& s, const std::vector<glm::vec2>& points) {
-    Traced full = trace(*rig_, s, points, 10.0f);
-    Traced half = trace(*rig_, s, points, 1.5f);
+    Traced full = trace(rig(), s, points, 10.0f);
+    Traced half = trace(rig(), s, points, 1.5f);
     for (size_t i = 0; i < points.size(); ++i) {
       EXPECT_TRUE(full.on_card(i) || full.on_wall(i)) << "ray " << i;
       EXPECT_EQ(full.occluded[i], 1);
@@ -153,7 +134,6 @@ class AlphaTraceTest : public ::testing::TestWithParam<std::string> {
     }
     return full;
   }
-  KernelRig* rig_ = nullptr;
 };
 
 TEST_P(AlphaTraceTest, MaskCutsOutExactlyWhereAlphaIsBelowTheCutoff) {
@@ -188,7 +168,7 @@ TEST_P(AlphaTraceTest, BlendStopsARayWithProbabilityAlpha) {
   for (size_t i = 0; i < points.size(); ++i) stopped += t.on_card(i);
   double n = double(points.size());
   EXPECT_NEAR(stopped / n, 0.5, 4.0 * std::sqrt(0.25 / n));
-  Traced again = trace(*rig_, card_scene(card(AlphaMode::Blend, 0.5f, false)), points, 10.0f);
+  Traced again = trace(rig(), card_scene(card(AlphaMode::Blend, 0.5f, false)), points, 10.0f);
   for (size_t i = 0; i < points.size(); ++i) ASSERT_EQ(again.on_card(i), t.on_card(i)) << "ray " << i;
 
   Traced textured = trace_checked(card_scene(card(AlphaMode::Blend, 1.0f, true)), points);
@@ -204,16 +184,9 @@ TEST_P(AlphaTraceTest, StochasticOpacityNumbersAreUniform) {
     float dx = 1e-6f * float(i % 256), dy = 1e-6f * float(i / 256);
     dirs[i] = {{dx, dy, -1.0f, 0.0f}};
   }
-  cl::Buffer dir_buf(rig_->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * sizeof(cl_float4), dirs.data());
-  cl::Buffer out(rig_->context, CL_MEM_WRITE_ONLY, n * sizeof(float));
-  cl::Kernel k(rig_->program, "test_alpha_random");
-  k.setArg(0, cl_uint(3));
-  k.setArg(1, cl_float4{{0.25f, 0.5f, 1.0f, 0.0f}});
-  k.setArg(2, dir_buf);
-  k.setArg(3, out);
-  rig_->queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<float> u(n);
-  rig_->queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(float), u.data());
+  auto out = rig().output<float>(n);
+  rig().run("test_alpha_random", n, cl_uint(3), f4({0.25, 0.5, 1.0}), rig().input(dirs), out);
+  std::vector<float> u = out.read();
   const int cells = 64;
   std::vector<double> observed(cells, 0.0), expected(cells, double(n) / cells);
   for (float x : u) {
@@ -223,31 +196,14 @@ TEST_P(AlphaTraceTest, StochasticOpacityNumbersAreUniform) {
   EXPECT_GT(chi_square_test(observed, expected).p_value, 0.001);
 }
 
-INSTANTIATE_TEST_SUITE_P(Devices, AlphaTraceTest, ::testing::Values("pocl", "rusticl"),
-                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, AlphaTraceTest, kernel_devices(), DeviceParamName());
 
 // ---------------------------------------------------------------------------------------
 // Renders on PoCL
 
-struct Estimate {
-  double mean = 0.0, standard_error = 0.0;
-};
-
-// Green channel over pixels [x0,x1) x [y0,y1), with its standard error
-Estimate region_mean(const Film& f, int x0, int x1, int y0, int y1) {
-  double sum = 0.0, var = 0.0;
-  int n = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      size_t i = size_t(y) * f.width + x;
-      sum += f.pixel(i).y;
-      var += f.variance_of_mean(i).y;
-      ++n;
-    }
-  return {sum / n, std::sqrt(var) / n};
-}
-
-Estimate image_mean(const Film& f) { return region_mean(f, 0, f.width, 0, f.height); }
+// Green channel over pixels [x0,x1) x [y0,y1), and over the image, with its standard error
+Estimate green_mean(const Film& f, int x0, int x1, int y0, int y1) { return region_mean(f, 1, x0, x1, y0, y1); }
+Estimate green_mean(const Film& f) { return region_mean(f, 1, 0, f.width, 0, f.height); }
 
 double z_score(const Estimate& a, const Estimate& b) {
   return (a.mean - b.mean) / std::sqrt(a.standard_error * a.standard_error + b.standard_error * b.standard_error);
@@ -281,7 +237,7 @@ TEST(AlphaRender, CameraRaysSeeThroughMaskHoles) {
       EXPECT_EQ(f.pixel(size_t(15 - y) * 16 + x).y, 1.0f) << "bottom-left " << x << "," << y;
       EXPECT_EQ(f.pixel(size_t(15 - y) * 16 + 15 - x).y, 0.0f) << "bottom-right " << x << "," << y;
     }
-  Estimate e = image_mean(f);
+  Estimate e = green_mean(f);
   EXPECT_NEAR(e.mean, 0.5, 4.0 * e.standard_error + 1e-6);
   // OPAQUE ignores alpha: the same card, factor alpha 0 and the checker, hides everything
   Film opaque = render_film(window_scene(card(AlphaMode::Opaque, 0.0f, true)), Strategy::Nee, 16, 16, 8, 4, 1);
@@ -291,12 +247,12 @@ TEST(AlphaRender, CameraRaysSeeThroughMaskHoles) {
 // BLEND at alpha 0.5: every pixel shows half the background, within its standard error
 TEST(AlphaRender, BlendAtHalfAlphaTransmitsHalfTheBackground) {
   Film f = render_film(window_scene(card(AlphaMode::Blend, 0.5f, false)), Strategy::Nee, 16, 16, 64, 4, 3);
-  Estimate e = image_mean(f);
+  Estimate e = green_mean(f);
   EXPECT_NEAR(e.mean, 0.5, 4.0 * e.standard_error);
   EXPECT_LT(e.standard_error, 0.01);
   for (int by = 0; by < 16; by += 4)
     for (int bx = 0; bx < 16; bx += 4) {
-      Estimate b = region_mean(f, bx, bx + 4, by, by + 4);
+      Estimate b = green_mean(f, bx, bx + 4, by, by + 4);
       EXPECT_NEAR(b.mean, 0.5, 4.5 * b.standard_error) << "block " << bx << "," << by;
     }
 }
@@ -345,11 +301,11 @@ Scene shadow_scene(Card kind) {
 TEST(AlphaRender, MaskedAndBlendedCardsCastHalfTheShadow) {
   const int size = 24;
   const uint32_t spp = 64;
-  Estimate none = image_mean(render_film(shadow_scene(Card::None), Strategy::Nee, size, size, spp, 1, 1));
-  Estimate full = image_mean(render_film(shadow_scene(Card::Opaque), Strategy::Nee, size, size, spp, 1, 2));
-  Estimate mask = image_mean(render_film(shadow_scene(Card::Mask), Strategy::Nee, size, size, spp, 1, 3));
-  Estimate inverted = image_mean(render_film(shadow_scene(Card::MaskInverted), Strategy::Nee, size, size, spp, 1, 4));
-  Estimate blend = image_mean(render_film(shadow_scene(Card::Blend), Strategy::Nee, size, size, spp, 1, 5));
+  Estimate none = green_mean(render_film(shadow_scene(Card::None), Strategy::Nee, size, size, spp, 1, 1));
+  Estimate full = green_mean(render_film(shadow_scene(Card::Opaque), Strategy::Nee, size, size, spp, 1, 2));
+  Estimate mask = green_mean(render_film(shadow_scene(Card::Mask), Strategy::Nee, size, size, spp, 1, 3));
+  Estimate inverted = green_mean(render_film(shadow_scene(Card::MaskInverted), Strategy::Nee, size, size, spp, 1, 4));
+  Estimate blend = green_mean(render_film(shadow_scene(Card::Blend), Strategy::Nee, size, size, spp, 1, 5));
   EXPECT_LT(full.mean, 0.7 * none.mean) << "the card must cast a clear shadow";
   Estimate half{0.5 * (none.mean + full.mean),
                 0.5 * std::sqrt(none.standard_error * none.standard_error + full.standard_error * full.standard_error)};
@@ -369,29 +325,19 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
   ASSERT_TRUE(out && out->open(dir + "alpha-checker.png", OIIO::ImageSpec(2, 2, 4, OIIO::TypeDesc::UINT8)));
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
   out->close();
-  const float l = 0.3f, c = 0.3f;
-  std::vector<GltfBuilder::Primitive> quads = {
-      quad_primitive({{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, 0),               // floor
-      quad_primitive({{-l, 1, -l}, {l, 1, -l}, {l, 1, l}, {-l, 1, l}}, 1),               // light, facing -y
-      quad_primitive({{-c, 0.5f, c}, {c, 0.5f, c}, {c, 0.5f, -c}, {-c, 0.5f, -c}}, 2)};  // occluder
-  GltfBuilder g;                                                                         // black background
-  g.add_node({{"mesh", g.add_mesh(quads)}});
-  g.doc["materials"] = nlohmann::json::parse(R"([
-    {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0},
-     "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
+  // The light (material 1) masked by the checker, and an occluder of material 2
+  GltfBuilder g = floor_under_square_light(1.0f, 0.3f, 6, {quad_facing_up(0.3f, 0.5f, 2)});
+  g.doc["materials"][1]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  g.doc["materials"][1]["alphaMode"] = "MASK";
+  g.add("materials", nlohmann::json::parse(R"(
     {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
                               "baseColorTexture": {"index": 0}},
-     "alphaMode": "MASK", "emissiveFactor": [1, 1, 1],
-     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 6}}},
-    {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
-                              "baseColorTexture": {"index": 0}},
-     "alphaMode": "MASK", "alphaCutoff": 0.25, "doubleSided": true}])");
+     "alphaMode": "MASK", "alphaCutoff": 0.25, "doubleSided": true})"));
   g.add("images", {{"uri", "alpha-checker.png"}});
   g.add("samplers", {{"magFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}});
   g.add("textures", {{"source", 0}, {"sampler", 0}});
   g.add_camera({0.0f, 0.35f, 0.01f}, {0, 0, 0}, 1.8f);
-  g.write(dir + "alpha-masked.gltf");
-  Scene scene = load_gltf(dir + "alpha-masked.gltf");
+  Scene scene = load_scene(g, "alpha-masked.gltf");
   ASSERT_EQ(scene.materials[1].alpha_mode, AlphaMode::Mask);
   ASSERT_TRUE(scene.textures.at(0).nearest);
   ASSERT_TRUE(scene.features().alpha);
@@ -402,15 +348,15 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
   int blocks = 0;
   for (int by = 0; by < size; by += 4)
     for (int bx = 0; bx < size; bx += 4) {
-      double z = z_score(region_mean(nee, bx, bx + 4, by, by + 4), region_mean(bsdf, bx, bx + 4, by, by + 4));
+      double z = z_score(green_mean(nee, bx, bx + 4, by, by + 4), green_mean(bsdf, bx, bx + 4, by, by + 4));
       EXPECT_LT(std::fabs(z), 4.5) << "block " << bx << "," << by;
       chi2 += z * z;
       ++blocks;
     }
   EXPECT_LT(chi2, blocks + 5.0 * std::sqrt(2.0 * blocks));
-  Estimate e = image_mean(nee);
+  Estimate e = green_mean(nee);
   EXPECT_GT(e.mean, 0.05);
-  EXPECT_LT(image_mean(bsdf).standard_error, 0.05 * e.mean);
+  EXPECT_LT(green_mean(bsdf).standard_error, 0.05 * e.mean);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -418,7 +364,7 @@ TEST(AlphaRender, StrategiesAgreeOnAMaskedScene) {
 
 // 2x1 texture, texels (0.2, 0.4, 0.6, 1) and (1, 0.8, 0, 0.5), linear RGBA8, repeating
 TEST(Textures, NearestLookupReturnsExactTexelsWhereBilinearBlends) {
-  KernelRig& rig = shared_rig("pocl", pocl_device());
+  const KernelRig& rig = kernel_rig("pocl");
   Scene s;
   TextureDesc t;
   t.width = 2;
@@ -437,17 +383,9 @@ TEST(Textures, NearestLookupReturnsExactTexelsWhereBilinearBlends) {
   std::vector<cl_float2> uvs = {{{0.25f, 0.5f}}, {{0.75f, 0.5f}}, {{0.4f, 0.3f}},  {{0.6f, 0.9f}},
                                 {{0.05f, 0.1f}}, {{0.95f, 0.5f}}, {{1.3f, -0.2f}}, {{-0.3f, 2.7f}}};
   auto lookup = [&](uint32_t material) {
-    cl::Buffer uv_buf(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, uvs.size() * sizeof(cl_float2), uvs.data());
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, uvs.size() * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_alpha_texture_lookup");
-    cl_uint arg = on_device.bind(k, 0);
-    k.setArg(arg++, cl_uint(material));
-    k.setArg(arg++, uv_buf);
-    k.setArg(arg++, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(uvs.size()));
-    std::vector<cl_float4> r(uvs.size());
-    rig.queue.enqueueReadBuffer(out, CL_TRUE, 0, r.size() * sizeof(cl_float4), r.data());
-    return r;
+    auto out = rig.output<cl_float4>(uvs.size());
+    rig.run("test_alpha_texture_lookup", uvs.size(), on_device, cl_uint(material), rig.input(uvs), out);
+    return out.read();
   };
   std::vector<cl_float4> bilinear = lookup(0), nearest = lookup(1);
   const float texel[2][4] = {{0.2f, 0.4f, 0.6f, 1.0f}, {1.0f, 0.8f, 0.0f, 128 / 255.0f}};

@@ -1,4 +1,5 @@
-// Shared helpers for kernel tests: devices, the test program, scene paths.
+// Shared helpers for tests: the device-kernel fixture (support/kernels.hpp), renders and
+// their estimates, scene paths.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -13,48 +14,9 @@
 #include "render/film.hpp"
 #include "render/renderer.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/kernels.hpp"
 
 namespace candela::test {
-
-// PoCL, the device every test runs on (a missing PoCL fails the test)
-DeviceEntry pocl_device();
-
-// Mesa's rusticl device, if one is installed and enabled
-std::optional<DeviceEntry> rusticl_device();
-
-// Device by test-parameter name: "pocl" or "rusticl"; skips the test when absent
-#define CANDELA_DEVICE_OR_SKIP(name, out)                                         \
-  do {                                                                            \
-    auto candela_dev_ = ::candela::test::device_by_name(name);                    \
-    if (!candela_dev_) GTEST_SKIP() << name << " OpenCL device is not available"; \
-    out = *candela_dev_;                                                          \
-  } while (0)
-std::optional<DeviceEntry> device_by_name(const std::string& name);
-
-// Context, queue and the test program (real cl/ sources + the test kernels of tests/*/) on one device
-struct KernelRig {
-  DeviceEntry device;
-  cl::Context context;
-  cl::CommandQueue queue;
-  cl::Program program;
-  std::string program_cache_file;  // its entry in the kernel cache (ProgramBuild::cache_file)
-  explicit KernelRig(const DeviceEntry& d);
-};
-
-// The test program on the device called `name` ("pocl", "rusticl"), built on first use and
-// kept for the rest of the process
-KernelRig& shared_rig(const std::string& name, const DeviceEntry& device);
-
-// A compiled scene uploaded for test kernels that take CD_SCENE_BUFFERS(CD_SCENE_PARAM)
-// followed by a `__global const RenderParams*` (as render_paths does): bind() sets those
-// arguments from `first_arg` on and returns the index of the next argument.
-struct SceneOnDevice {
-  std::vector<cl::Buffer> buffers;  // CD_SCENE_BUFFERS order
-  cl::Buffer params;
-  dev::RenderParams params_host{};
-  SceneOnDevice(KernelRig& rig, const CompiledScene& scene);
-  cl_uint bind(cl::Kernel& kernel, cl_uint first_arg) const;
-};
 
 // A mean over pixels with its standard error from the per-pixel sample variances
 struct Estimate {
@@ -65,6 +27,9 @@ Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1);  // 
 Estimate image_mean(const Film& f);                                          // all pixels, channels averaged
 // The mean of component c of a kernel's samples, with its standard error
 Estimate sample_mean(const std::vector<cl_float4>& samples, int c);
+
+// relMSE of f against a reference: the mean over pixels and channels of (x - r)^2 / (r^2 + 0.01)
+double rel_mse(const Film& f, const Film& reference);
 
 std::string scene_path(const std::string& relative);  // relative to scenes/
 
