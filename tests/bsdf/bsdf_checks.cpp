@@ -275,7 +275,7 @@ double normal_quantile(double alpha) {
 
 }  // namespace
 
-// The file's chi-square tests: one per device x material x geometry it runs at
+// The harness's chi-square tests: one per device x material x geometry it runs at
 double bsdf_alpha() {
   static const double alpha =
       sidak_alpha(0.01, int(all_materials().size() * (geometries().size() + kRusticlGeometries.size())));

@@ -44,7 +44,7 @@ json medium_with_grid(glm::vec3 sigma_a, glm::vec3 sigma_s, const json& grid) {
 Scene grid_scene(const json& medium, const std::string& name, GltfBuilder* builder = nullptr) {
   GltfBuilder local;
   GltfBuilder& g = builder ? *builder : local;
-  int m = g.add("materials", {{"extras", {{"candela", {{"medium", medium}}}}}});
+  int m = g.add("materials", null_boundary_material(medium));
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-3.0f), glm::vec3(3.0f), m))}});
   return load_scene(g, "vdb-" + name + ".gltf");
 }

@@ -205,9 +205,6 @@ json medium_json(glm::vec3 sigma_a, glm::vec3 sigma_s, double g = 0.0, glm::vec3
           {"emission", {emission.x, emission.y, emission.z}}};
 }
 
-// A null boundary: a material with a medium and no transmission
-json null_material(const json& medium) { return {{"extras", {{"candela", {{"medium", medium}}}}}}; }
-
 Scene load(const GltfBuilder& g, const std::string& name) { return load_scene(g, "volume-" + name + ".gltf"); }
 
 Film render(const Scene& scene, Strategy s, int size, uint32_t spp, uint32_t max_depth, uint32_t seed,
@@ -253,7 +250,7 @@ TEST_P(VolumeRender, AbsorbingSlabTransmits) {
   const float d = 0.8f;
   GltfBuilder g;
   add_emitter(g, kLight);
-  int slab = g.add("materials", null_material(medium_json(kSigmaA, glm::vec3(0.0f))));
+  int slab = g.add("materials", null_boundary_material(medium_json(kSigmaA, glm::vec3(0.0f))));
   g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
   Film f = render_view(g, "slab", 16);
   glm::dvec3 want;
@@ -266,7 +263,7 @@ TEST_P(VolumeRender, AbsorbingSlabTransmits) {
 TEST_P(VolumeRender, CameraInsideMedia) {
   GltfBuilder g;
   add_emitter(g, kLight);
-  int box = g.add("materials", null_material(medium_json(kSigmaA, glm::vec3(0.0f))));
+  int box = g.add("materials", null_boundary_material(medium_json(kSigmaA, glm::vec3(0.0f))));
   g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 1}, {1, 1, 4}, box))}});
   const glm::vec3 fog(0.1f, 0.05f, 0.02f);
   g.doc["scenes"][0]["extras"]["candela"]["medium"] = medium_json(fog, glm::vec3(0.0f));
@@ -282,7 +279,7 @@ TEST_P(VolumeRender, EmissiveSlab) {
   const float d = 1.5f;
   const glm::vec3 e(0.4f, 0.8f, 1.2f);
   GltfBuilder g;  // no light: only the medium emits
-  int slab = g.add("materials", null_material(medium_json(kSigmaA, glm::vec3(0.0f), 0.0, e)));
+  int slab = g.add("materials", null_boundary_material(medium_json(kSigmaA, glm::vec3(0.0f), 0.0, e)));
   g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
   for (Strategy s : {Strategy::Nee, Strategy::Bsdf}) {
     Film f = render_view(g, std::string("emissive-") + name(s), 16, s);
@@ -317,7 +314,7 @@ TEST_P(VolumeRender, EmissionGridRamp) {
   const glm::vec3 e(0.4f, 0.8f, 1.2f);
   for (float density : {0.0f, 1.0f}) {
     GltfBuilder g;  // no light: only the medium emits
-    int slab = g.add("materials", null_material(emission_slab(d, e, density, scale, c0, c1)));
+    int slab = g.add("materials", null_boundary_material(emission_slab(d, e, density, scale, c0, c1)));
     g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
     glm::dvec3 want(0.0);
     const int steps = 20000;  // midpoint rule, converged far below the tolerance
@@ -379,7 +376,7 @@ TEST_P(VolumeFurnace, InvisibleUnderUniformBackground) {
     medium["grid"] = constant_grid(glm::vec3(-0.6f), glm::vec3(0.6f), 0.25f);
     medium["density_scale"] = 4.0;  // density 1: the same medium
   }
-  Film f = render(load(furnace_sphere(null_material(medium)), "furnace"), s, 16, 256, 1000, 11);
+  Film f = render(load(furnace_sphere(null_boundary_material(medium)), "furnace"), s, 16, 256, 1000, 11);
   Estimate e = image_mean(f);
   EXPECT_LT(e.standard_error, 0.01) << "too noisy to test anything";
   EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << name(s) << " g " << g_value << " SE " << e.standard_error;
@@ -416,7 +413,8 @@ INSTANTIATE_TEST_SUITE_P(Media, GlassFurnace, ::testing::Values(Strategy::Nee, S
 // The furnace has power: the same sphere with absorption (albedo 2/3) is visibly darker
 TEST(VolumeFurnaceControl, AbsorbingSphereIsDarker) {
   json medium = medium_json(glm::vec3(0.5f, 1.0f, 2.0f), glm::vec3(1.0f, 2.0f, 4.0f));
-  Film f = render(load(furnace_sphere(null_material(medium)), "furnace-absorbing"), Strategy::Nee, 16, 64, 1000, 12);
+  Film f = render(load(furnace_sphere(null_boundary_material(medium)), "furnace-absorbing"), Strategy::Nee, 16, 64,
+                  1000, 12);
   for (int c = 0; c < 3; ++c) {
     Estimate e = region_mean(f, c, 4, 12, 4, 12);
     EXPECT_LT(e.mean, 0.9) << "channel " << c;
@@ -443,7 +441,7 @@ Scene lit_medium_scene(bool grid) {
     medium["grid"] = constant_grid(glm::vec3(-0.8f, 0.0f, -0.8f), glm::vec3(0.8f, 0.9f, 0.8f), 0.5f);
     medium["density_scale"] = 2.0;
   }
-  int box = g.add("materials", null_material(medium));
+  int box = g.add("materials", null_boundary_material(medium));
   const float l = 0.4f, h = 1.8f;
   g.add_node({{"mesh", g.add_mesh({quad_facing_up(3.0f, 0.0f, floor), quad_facing_down_rotated(l, h, light)})}});
   g.add_node({{"mesh", g.add_mesh(box_primitives({-0.6f, 0.0f, -0.6f}, {0.6f, 0.9f, 0.6f}, box))}});
@@ -510,7 +508,7 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
     for (int y = 0; y < 2; ++y)
       for (int x = 0; x < nx; ++x) density.push_back(0.2f + 0.8f * float(x) / float(nx - 1));
   medium["grid"] = {{"size", {nx, 2, 2}}, {"min", {-1, -1, -1}}, {"max", {1, 1, 1}}, {"density", density}};
-  int box = g.add("materials", null_material(medium));
+  int box = g.add("materials", null_boundary_material(medium));
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-1.0f), glm::vec3(1.0f), box))}});
   Scene scene = load(g, "linear-grid");
   CompiledScene compiled = compile_scene(scene);
@@ -551,7 +549,7 @@ TEST(VolumeGrid, RatioTrackingMatchesLinearDensity) {
 TEST(VolumeGrid, EmissionGridKeepsTransmittance) {
   GltfBuilder g;
   const float d = 1.5f, density = 0.1f;  // sigma_t bound 0.2 < 1 / cell size = 16 / 1.5
-  int slab = g.add("materials", null_material(emission_slab(d, glm::vec3(1.0f), density, 1.0f, 0.0f, 1.0f)));
+  int slab = g.add("materials", null_boundary_material(emission_slab(d, glm::vec3(1.0f), density, 1.0f, 0.0f, 1.0f)));
   g.add_node({{"mesh", g.add_mesh(box_primitives({-1, -1, 0}, {1, 1, d}, slab))}});
   Scene scene = load(g, "emission-grid-transmittance");
   CompiledScene compiled = compile_scene(scene);
@@ -594,7 +592,7 @@ TEST(VolumeLoader, MediaFromExtensionsExtrasAndScene) {
   json thin = clear;
   thin["extensions"].erase("KHR_materials_volume");
   int m_glass = g.add("materials", glass), m_clear = g.add("materials", clear), m_thin = g.add("materials", thin);
-  int m_null = g.add("materials", null_material(medium_json(glm::vec3(1.0f), glm::vec3(0.0f))));
+  int m_null = g.add("materials", null_boundary_material(medium_json(glm::vec3(1.0f), glm::vec3(0.0f))));
   int m_opaque = g.add("materials", lambert_material(0.5f));
   float x = 0.0f;
   for (int m : {m_glass, m_clear, m_thin, m_null, m_opaque}) {
@@ -680,7 +678,7 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   for (const auto& [medium, message] : bad_emission) {
     GltfBuilder g;
     g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f),
-                                                   g.add("materials", null_material(medium))))}});
+                                                   g.add("materials", null_boundary_material(medium))))}});
     try {
       load(g, "bad-emission-" + std::to_string(k++));
       ADD_FAILURE() << "no error for " << medium.dump();
@@ -692,7 +690,7 @@ TEST(VolumeLoader, MalformedMediaAreClearErrors) {
   for (const json& medium : bad) {
     GltfBuilder g;
     g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(0.0f), glm::vec3(1.0f),
-                                                   g.add("materials", null_material(medium))))}});
+                                                   g.add("materials", null_boundary_material(medium))))}});
     EXPECT_THROW(load(g, "bad-" + std::to_string(i++)), Error) << medium.dump();
   }
   // A global medium that emits where nothing attenuates would give infinite radiance
@@ -718,7 +716,7 @@ TEST(VolumeNanoVdb, FogSphereLoadsAndIsAFurnace) {
   GltfBuilder g;
   json medium = medium_json(glm::vec3(0.0f), glm::vec3(1.0f, 2.0f, 4.0f), 0.3);
   medium["grid"] = {{"nanovdb", "volume-sphere.nvdb"}, {"name", "density"}};
-  int m = g.add("materials", null_material(medium));
+  int m = g.add("materials", null_boundary_material(medium));
   g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(-0.8f), glm::vec3(0.8f), m))}});
   g.add_camera(glm::vec3(0.0f, 0.3f, 2.5f), glm::vec3(0.0f), 0.6f);
   g.set_background(glm::vec3(1.0f));

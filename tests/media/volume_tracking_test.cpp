@@ -37,8 +37,6 @@ json scattering_medium(glm::vec3 sigma_s, double g) {
   return {{"sigma_a", {0, 0, 0}}, {"sigma_s", {sigma_s.x, sigma_s.y, sigma_s.z}}, {"g", g}};
 }
 
-json null_boundary(const json& medium) { return {{"extras", {{"candela", {{"medium", medium}}}}}}; }
-
 Scene load_tracking_scene(const GltfBuilder& g, const std::string& name) {
   return load_scene(g, "volume-tracking-" + name + ".gltf");
 }
@@ -204,7 +202,7 @@ struct TrackingScene {
                       {"max", {grid.hi.x, grid.hi.y, grid.hi.z}},
                       {"density", grid.v}};
     medium["density_scale"] = density_scale;
-    int box = g.add("materials", null_boundary(medium));
+    int box = g.add("materials", null_boundary_material(medium));
     g.add_node({{"mesh", g.add_mesh(box_primitives(glm::vec3(grid.lo), glm::vec3(grid.hi), box))}});
     return load_tracking_scene(g, name);
   }
@@ -472,7 +470,7 @@ Film render_furnace(const FurnaceCase& c, uint32_t seed) {
                       {"density", std::vector<float>(8, 0.25f)}};
     medium["density_scale"] = 4.0;
   }
-  Scene scene = load_tracking_scene(furnace_sphere(null_boundary(medium)), std::string("furnace-") + c.name);
+  Scene scene = load_tracking_scene(furnace_sphere(null_boundary_material(medium)), std::string("furnace-") + c.name);
   return render_film(scene, c.strategy, 16, 16, c.spp, c.max_depth, seed);
 }
 

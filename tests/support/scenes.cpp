@@ -24,6 +24,8 @@ json emissive_material(glm::vec3 radiance) {
             {"KHR_materials_specular", {{"specularFactor", 0.0}}}}}};
 }
 
+json null_boundary_material(const json& medium) { return {{"extras", {{"candela", {{"medium", medium}}}}}}; }
+
 GltfBuilder::Primitive quad_facing_up(float h, float y, int material) {
   return quad_primitive({{-h, y, h}, {h, y, h}, {h, y, -h}, {-h, y, -h}}, material);
 }

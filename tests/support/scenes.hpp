@@ -22,6 +22,10 @@ nlohmann::json lambert_material(double albedo);
 // KHR_materials_emissive_strength m, m the largest channel (emissiveFactor holds at most 1)
 nlohmann::json emissive_material(glm::vec3 radiance);
 
+// A null boundary: a material with no surface of its own that bounds `medium` (candela's
+// extras.candela.medium, docs/volumes.md)
+nlohmann::json null_boundary_material(const nlohmann::json& medium);
+
 // ---- Horizontal squares |x|, |z| <= half at height y ----------------------------------------
 
 // Facing +y (a floor, an occluder seen from below a light): corners (-h, h) (h, h) (h, -h)
