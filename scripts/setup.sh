@@ -8,7 +8,7 @@ CANDELA_PACKAGES=(
   cmake g++ make pkg-config python3
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
   mesa-opencl-icd
-  libtinygltf-dev nlohmann-json3-dev
+  libtinygltf-dev nlohmann-json3-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
   googletest libgtest-dev clang-format
   python3-numpy python3-openimageio python3-matplotlib python3-pil

@@ -11,6 +11,7 @@ namespace candela {
 // Choices the user makes about reading a file (the command line's), over the file's own
 struct LoadOptions {
   std::optional<LightUnits> light_units;  // else the scene extras' candela.light_units, else photometric
+  std::string variant;                    // a KHR_materials_variants name; empty: the default materials
 };
 
 // Whether the loader implements glTF extension `name` (others are named in a warning)

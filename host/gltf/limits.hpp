@@ -22,6 +22,18 @@ constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;  // decoded RGBA: 16384^2
 // least a bit on each 8x8 block, so a whole JPEG has at most 512 texels a byte: allow twice.
 constexpr uint64_t kMaxJpegTexelsPerByte = 1024;
 
+// EXT_meshopt_compression: its codecs spend at least 2 bits on 16 bytes of attribute data
+// (64:1), a byte on a triangle's 6 or 12 bytes and on each index: a bufferView may decode to
+// at most 64 times its compressed size, and never past the bufferView's own byteLength
+constexpr uint64_t kMaxMeshoptExpansion = 64;
+
+// EXT_mesh_gpu_instancing: each instance is a copy of the mesh's triangles (no two-level
+// BVH), so the instanced triangles of a scene are bounded (33.5 M: several GB with the BVH);
+// and an instance accessor without a bufferView, which takes no room in the file, holds at
+// most this many instances
+constexpr size_t kMaxInstancedTriangles = size_t(1) << 25;
+constexpr size_t kMaxZeroFilledInstances = 1024;
+
 // Array and object nesting of the JSON: tinygltf converts extras and extensions
 // recursively, and deep nesting would overflow the stack. glTF itself needs under 10.
 constexpr size_t kMaxJsonDepth = 64;

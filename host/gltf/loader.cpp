@@ -1,5 +1,6 @@
-// The glTF loader's entry points: the file or bytes through tinygltf, then each reader in
-// turn (materials, then the node trees with their meshes, cameras and lights, then the
+// The glTF loader's entry points: the file or bytes through tinygltf, compressed geometry
+// decoded (EXT_meshopt_compression, KHR_draco_mesh_compression), then each reader in turn
+// (materials, then the node trees with their meshes, cameras and lights, then the
 // environment map the extras name).
 #include <filesystem>
 #include <fstream>
@@ -24,7 +25,13 @@ bool supported_extension(const std::string& name) {
                                                    "KHR_materials_volume",
                                                    "KHR_materials_clearcoat",
                                                    "KHR_materials_anisotropy",
-                                                   "KHR_lights_punctual"};
+                                                   "KHR_lights_punctual",
+                                                   "KHR_draco_mesh_compression",
+                                                   "EXT_meshopt_compression",
+                                                   "EXT_mesh_gpu_instancing",
+                                                   "EXT_texture_webp",
+                                                   "KHR_materials_pbrSpecularGlossiness",
+                                                   "KHR_materials_variants"};
   return kSupported.count(name) > 0;
 }
 
@@ -37,8 +44,8 @@ void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
     if (!supported_extension(ext))
       warn->add("the scene requires glTF extension " + ext +
                 ", which candela does not support: the image may be wrong");
-  if (!model.animations.empty()) warn->add("animations are ignored (the first frame is rendered)");
-  if (!model.skins.empty()) warn->add("skins are ignored (meshes render in their bind pose)");
+  if (!model.animations.empty())
+    warn->add("animations are ignored: the scene renders as posed by its node transforms and default morph weights");
 }
 
 // tinygltf file access that finds no file: glTF from memory without a base folder
@@ -101,7 +108,11 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   Warnings warnings(&scene.warnings);
   scene.extensions_used = model.extensionsUsed;
   warn_model_wide(model, &warnings);
+  decode_meshopt_views(&model);
+  decode_draco_primitives(&model, &warnings);
+  scene.variants = variant_names(model);
   ReadContext ctx{model, scene, warnings, base_dir, image_errors, options};
+  ctx.variant = chosen_variant(model, options.variant);
   if (options.light_units) scene.light_units = *options.light_units;
   read_materials(ctx);
   read_nodes(ctx);

@@ -210,7 +210,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   std::string name = "material '" + (gm.name.empty() ? std::to_string(index) : gm.name) + "'";
   MaterialDesc m;
   m.name = gm.name;
-  read_metallic_roughness(ctx, gm, &m);
+  if (!read_specular_glossiness(ctx, gm, &m)) read_metallic_roughness(ctx, gm, &m);
   read_normal_texture(ctx, gm, &m);
   read_emission(ctx, gm, name, &m);
   m.double_sided = gm.doubleSided;

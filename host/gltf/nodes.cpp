@@ -1,4 +1,6 @@
-// glTF nodes: the default scene's node trees with their transforms, and the first camera.
+// glTF nodes: the default scene's node trees with their transforms (walked without
+// recursion, however deep), the cameras, and EXT_mesh_gpu_instancing's instance transforms.
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -6,25 +8,21 @@
 #include <optional>
 
 #include "base/error.hpp"
+#include "gltf/limits.hpp"
 #include "gltf/reader.hpp"
 
 namespace candela::gltf {
 namespace {
 
-glm::mat4 local_transform(const tinygltf::Node& node) {
-  if (node.matrix.size() == 16) {
-    glm::mat4 m;
-    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = float(node.matrix[i]);  // column-major
-    return m;
-  }
+// Translation x rotation x scale, each optional (empty: identity), as glTF orders them
+glm::mat4 trs(const std::vector<double>& t, const std::vector<double>& r, const std::vector<double>& s) {
   glm::mat4 m(1.0f);
-  if (node.translation.size() == 3)
-    m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
-  if (node.rotation.size() == 4) {
-    glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]), float(node.rotation[2]));
+  if (t.size() == 3) m = glm::translate(m, glm::vec3(t[0], t[1], t[2]));
+  if (r.size() == 4) {
+    glm::quat q(static_cast<float>(r[3]), static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2]));
     m *= glm::mat4_cast(glm::normalize(q));
   }
-  if (node.scale.size() == 3) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+  if (s.size() == 3) m = glm::scale(m, glm::vec3(s[0], s[1], s[2]));
   return m;
 }
 
@@ -84,27 +82,40 @@ void read_camera(ReadContext& ctx, int index, const glm::mat4& world) {
   if (!ctx.scene.camera) ctx.scene.camera = cam;  // the first is the default (render --camera N picks another)
 }
 
-// Each node once: glTF 3.5.2 makes nodes disjoint strict trees (no node has two parents,
-// no cycles)
-void visit(ReadContext& ctx, int index, const glm::mat4& parent) {
-  if (index < 0 || index >= (int)ctx.model.nodes.size())
-    throw Error("glTF node " + std::to_string(index) + " does not exist");
-  if (ctx.visited[size_t(index)])
-    throw Error("glTF node " + std::to_string(index) + " has two parents or is part of a cycle");
-  ctx.visited[size_t(index)] = true;
-  const tinygltf::Node& node = ctx.model.nodes[size_t(index)];
-  glm::mat4 world = parent * local_transform(node);
-  if (node.mesh >= 0) {
-    if (node.mesh >= (int)ctx.model.meshes.size())
-      throw Error("glTF node " + std::to_string(index) + " refers to a missing mesh");
-    read_mesh(ctx, ctx.model.meshes[size_t(node.mesh)], world);
-    if (!node.weights.empty() || !ctx.model.meshes[size_t(node.mesh)].weights.empty())
-      ctx.warn.add("morph targets are not supported yet: base geometry is rendered");
+// Each node of the default scene once, parents before children, in depth-first order
+// (children in their order); glTF 3.5.2 makes nodes disjoint strict trees (no node has two
+// parents, no cycles). An explicit stack: a file can nest nodes a million deep.
+std::vector<int> walk_scene(ReadContext& ctx, const std::vector<int>& roots) {
+  const size_t n = ctx.model.nodes.size();
+  ctx.visited.assign(n, false);
+  ctx.world.assign(n, glm::mat4(1.0f));
+  std::vector<int> order;
+  std::vector<std::pair<int, int>> stack;  // (node, parent or -1)
+  for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.emplace_back(*r, -1);
+  while (!stack.empty()) {
+    auto [index, parent] = stack.back();
+    stack.pop_back();
+    if (index < 0 || index >= (int)n) throw Error("glTF node " + std::to_string(index) + " does not exist");
+    if (ctx.visited[size_t(index)])
+      throw Error("glTF node " + std::to_string(index) + " has two parents or is part of a cycle");
+    ctx.visited[size_t(index)] = true;
+    const tinygltf::Node& node = ctx.model.nodes[size_t(index)];
+    glm::mat4 local = local_transform(node);
+    ctx.world[size_t(index)] = parent < 0 ? glm::mat4(1.0f) * local : ctx.world[size_t(parent)] * local;
+    order.push_back(index);
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.emplace_back(*c, index);
   }
+  return order;
+}
+
+// A node's mesh, camera and light, placed by its world transform
+void read_node(ReadContext& ctx, int index) {
+  const tinygltf::Node& node = ctx.model.nodes[size_t(index)];
+  const glm::mat4& world = ctx.world[size_t(index)];
+  if (node.mesh >= 0) read_node_mesh(ctx, index);
   if (node.camera >= 0) read_camera(ctx, node.camera, world);
   if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
     read_node_light(ctx, index, ext->second, world);
-  for (int child : node.children) visit(ctx, child, world);
 }
 
 // The default scene's roots (and its extras); without scenes, every node no other names
@@ -130,10 +141,58 @@ std::vector<int> root_nodes(ReadContext& ctx) {
 
 }  // namespace
 
+glm::mat4 local_transform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    glm::mat4 m;
+    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = float(node.matrix[i]);  // column-major
+    return m;
+  }
+  return trs(node.translation, node.rotation, node.scale);
+}
+
+std::vector<glm::mat4> instance_transforms(ReadContext& ctx, int node_index) {
+  const tinygltf::Node& node = ctx.model.nodes[size_t(node_index)];
+  auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == node.extensions.end() || !ext->second.Has("attributes")) return {};
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  const std::string where = "glTF node " + std::to_string(node_index) + " EXT_mesh_gpu_instancing";
+  std::vector<double> columns[3];  // TRANSLATION, ROTATION, SCALE
+  const char* kNames[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  size_t count = 0;
+  bool any = false;
+  for (int a = 0; a < 3; ++a) {
+    if (!attributes.Has(kNames[a])) continue;
+    const tinygltf::Value& v = attributes.Get(kNames[a]);
+    int accessor = v.IsNumber() ? int(std::clamp(v.GetNumberAsDouble(), -1.0, 1e9)) : -1;
+    if (accessor < 0 || accessor >= (int)ctx.model.accessors.size())
+      throw Error(where + ": " + kNames[a] + " is not a valid accessor");
+    const tinygltf::Accessor& acc = ctx.model.accessors[size_t(accessor)];
+    if (acc.bufferView < 0 && acc.count > kMaxZeroFilledInstances)
+      throw Error(where + ": " + kNames[a] + " has " + std::to_string(acc.count) +
+                  " instances but no bufferView (at most " + std::to_string(kMaxZeroFilledInstances) + ")");
+    std::vector<float> values = read_accessor(ctx.model, accessor, a == 1 ? 4 : 3);
+    size_t n = acc.count;
+    if (any && n != count) throw Error(where + ": its accessors have different counts");
+    count = n;
+    any = true;
+    columns[a].assign(values.begin(), values.end());
+  }
+  std::vector<glm::mat4> out;
+  out.reserve(count);
+  for (size_t i = 0; i < count; ++i) {
+    auto part = [&](int a, int comps) {
+      return columns[a].empty() ? std::vector<double>()
+                                : std::vector<double>(columns[a].begin() + ptrdiff_t(i * comps),
+                                                      columns[a].begin() + ptrdiff_t((i + 1) * comps));
+    };
+    out.push_back(trs(part(0, 3), part(1, 4), part(2, 3)));
+  }
+  return out;
+}
+
 void read_nodes(ReadContext& ctx) {
   std::vector<int> roots = root_nodes(ctx);
-  ctx.visited.assign(ctx.model.nodes.size(), false);
-  for (int r : roots) visit(ctx, r, glm::mat4(1.0f));
+  for (int index : walk_scene(ctx, roots)) read_node(ctx, index);
   if (ctx.degenerate > 0) ctx.warn.add(std::to_string(ctx.degenerate) + " zero-area triangles were skipped");
 }
 

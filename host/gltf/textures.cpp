@@ -67,15 +67,19 @@ std::string decode_image(const ReadContext& ctx, int source, bool srgb, TextureD
   return "";
 }
 
-// The texture's core `source`, else the image of EXT_texture_webp, KHR_texture_basisu or
-// MSFT_texture_dds if that one decodes; false with the first image's reason when none does
+// The image of EXT_texture_webp (which a client that reads WebP prefers), else the core
+// `source`, else the image of KHR_texture_basisu or MSFT_texture_dds, the first that
+// decodes; false with the first image's reason when none does
 bool decode_source(const ReadContext& ctx, const tinygltf::Texture& tex, bool srgb, TextureDesc* t, std::string* why) {
   std::vector<int> sources;
-  if (tex.source >= 0) sources.push_back(tex.source);
-  for (const char* ext : {"EXT_texture_webp", "KHR_texture_basisu", "MSFT_texture_dds"})
+  auto add_extension_source = [&](const char* ext) {
     if (auto it = tex.extensions.find(ext); it != tex.extensions.end())
       if (double source = number_or(it->second, "source", -1, -1.0); source >= 0.0)
         sources.push_back(int(std::min(source, 1e9)));
+  };
+  add_extension_source("EXT_texture_webp");
+  if (tex.source >= 0) sources.push_back(tex.source);
+  for (const char* ext : {"KHR_texture_basisu", "MSFT_texture_dds"}) add_extension_source(ext);
   for (int source : sources) {
     if (source >= (int)ctx.model.images.size()) throw Error("glTF image " + std::to_string(source) + " does not exist");
     std::string reason = decode_image(ctx, source, srgb, t);
@@ -86,24 +90,35 @@ bool decode_source(const ReadContext& ctx, const tinygltf::Texture& tex, bool sr
   return false;
 }
 
+}  // namespace
+
+bool decode_texture(ReadContext& ctx, int gltf_texture, bool srgb, TextureDesc* t) {
+  if (gltf_texture < 0 || gltf_texture >= (int)ctx.model.textures.size())
+    throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
+  const tinygltf::Texture& tex = ctx.model.textures[size_t(gltf_texture)];
+  std::string why;
+  if (decode_source(ctx, tex, srgb, t, &why)) {
+    read_sampler(ctx.model, tex.sampler, t);
+    return true;
+  }
+  ctx.warn.add("glTF texture " + std::to_string(gltf_texture) + " has no image candela can decode (" + why +
+               "): it is ignored, as if the material had no such texture");
+  return false;
+}
+
+namespace {
+
 // Adds the glTF texture's image once, returning its index in Scene::textures (or NO_TEXTURE)
 int texture_index(ReadContext& ctx, int gltf_texture, bool srgb) {
   auto key = std::make_pair(gltf_texture, srgb);
   if (auto it = ctx.textures.find(key); it != ctx.textures.end()) return it->second;
-  if (gltf_texture < 0 || gltf_texture >= (int)ctx.model.textures.size())
-    throw Error("glTF texture " + std::to_string(gltf_texture) + " does not exist");
-  const tinygltf::Texture& tex = ctx.model.textures[size_t(gltf_texture)];
   TextureDesc t;
-  std::string why;
+  bool decoded = decode_texture(ctx, gltf_texture, srgb, &t);
   int& index = ctx.textures[key];
   index = NO_TEXTURE;
-  if (decode_source(ctx, tex, srgb, &t, &why)) {
-    read_sampler(ctx.model, tex.sampler, &t);
+  if (decoded) {
     index = int(ctx.scene.textures.size());
     ctx.scene.textures.push_back(std::move(t));
-  } else {
-    ctx.warn.add("glTF texture " + std::to_string(gltf_texture) + " has no image candela can decode (" + why +
-                 "): it is ignored, as if the material had no such texture");
   }
   return index;
 }
@@ -128,6 +143,19 @@ void set_texture_slot(ReadContext& ctx, MaterialDesc* m, int slot, int gltf_text
   if (gltf_texture < 0) return;
   auto tt = extensions.find("KHR_texture_transform");
   m->textures[slot] = texture_ref(ctx, gltf_texture, texcoord, tt == extensions.end() ? nullptr : &tt->second, srgb);
+}
+
+TextureSlot texture_info(const tinygltf::Value& ext, const char* key) {
+  TextureSlot ref;
+  ref.index = -1;
+  if (!ext.Has(key)) return ref;
+  const tinygltf::Value& info = ext.Get(key);
+  ref.index = int(std::clamp(number_or(info, "index", -1, -1.0), -1.0, 1e9));
+  if (ref.index < 0) throw Error(std::string("glTF ") + key + " has no texture index");
+  ref.texcoord = int(std::clamp(number_or(info, "texCoord", -1, 0.0), -1.0, 1e9));
+  if (info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
+    read_texture_transform(info.Get("extensions").Get("KHR_texture_transform"), &ref);
+  return ref;
 }
 
 void set_texture_slot(ReadContext& ctx, MaterialDesc* m, int slot, const tinygltf::Value& ext, const char* key,

@@ -195,6 +195,7 @@ struct Scene {
   bool lighting_given = false;               // the scene (extras) or the command line set the background or environment
   std::vector<std::string> warnings;         // each unsupported feature named once
   std::vector<std::string> extensions_used;  // the file's extensionsUsed
+  std::vector<std::string> variants;         // KHR_materials_variants names (LoadOptions::variant picks one)
 
   size_t triangles() const;
   Bounds bounds() const;

@@ -56,6 +56,29 @@ int GltfBuilder::add_accessor(const std::vector<T>& data, int component_type, co
   return add("accessors", std::move(extra));
 }
 
+namespace {
+size_t components(const std::string& type) {
+  return type == "SCALAR"                   ? 1
+         : type == "VEC2"                   ? 2
+         : type == "VEC3"                   ? 3
+         : type == "VEC4" || type == "MAT2" ? 4
+         : type == "MAT3"                   ? 9
+                                            : 16;
+}
+}  // namespace
+
+int GltfBuilder::add_floats(const std::vector<float>& values, const char* type) {
+  int a = add_accessor(values, FLOAT, type);
+  doc["accessors"][size_t(a)]["count"] = values.size() / components(type);
+  return a;
+}
+
+int GltfBuilder::add_ushorts(const std::vector<uint16_t>& values, const char* type) {
+  int a = add_accessor(values, UNSIGNED_SHORT, type);
+  doc["accessors"][size_t(a)]["count"] = values.size() / components(type);
+  return a;
+}
+
 int GltfBuilder::add_mesh(const std::vector<Primitive>& primitives) {
   json prims = json::array();
   for (const Primitive& p : primitives) {

@@ -34,6 +34,10 @@ class GltfBuilder {
   // A perspective camera node at `eye` looking at `target`, +y up
   int add_camera(const glm::vec3& eye, const glm::vec3& target, float yfov);
   void set_background(const glm::vec3& rgb);  // candela's scene extras
+  // An accessor of `type` ("SCALAR", "VEC3", "MAT4", ...) over raw values: FLOAT, or
+  // UNSIGNED_SHORT (JOINTS_n)
+  int add_floats(const std::vector<float>& values, const char* type);
+  int add_ushorts(const std::vector<uint16_t>& values, const char* type);
 
   nlohmann::json document() const;  // doc with its buffer
   void write(const std::string& path) const;
