@@ -35,6 +35,12 @@ void print_extensions(const Scene& s) {
     std::printf("  %s%s\n", e.c_str(), supported_gltf_extension(e) ? "" : "  (not supported: ignored)");
 }
 
+void print_variants(const Scene& s) {
+  if (s.variants.empty()) return;
+  std::printf("material variants (KHR_materials_variants; render --variant NAME): %zu\n", s.variants.size());
+  for (const std::string& v : s.variants) std::printf("  '%s'\n", v.c_str());
+}
+
 void print_cameras(const Scene& s) {
   std::printf("cameras: %zu%s\n", s.cameras.size(),
               s.cameras.empty() ? " (render frames the bounds from an elevated three-quarter view)" : "");
@@ -109,6 +115,7 @@ int run_info_command(const InfoArgs& args) {
   std::printf("scene: %s\n", args.scene.c_str());
   print_geometry(s);
   print_extensions(s);
+  print_variants(s);
   print_cameras(s);
   print_lights(s);
   print_materials(s);

@@ -68,6 +68,9 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--light-units", a.light_units,
                      "KHR_lights_punctual intensities: " + enum_names(kLightUnitNames, true) +
                          "; default: the scene's extras candela.light_units, else photometric");
+  render->add_option("--variant", a.variant,
+                     "KHR_materials_variants: render the scene's material variant NAME (candela info lists them; "
+                     "default: the default materials)");
 }
 
 // The camera, replacing or changing the scene's

@@ -25,6 +25,7 @@ struct RenderArgs {
   std::optional<float> env_strength, env_rotation;
   std::string default_light = "auto";  // --default-light auto|on|off (--no-default-light: off)
   std::string light_units;             // --light-units photometric|radiometric; empty: the scene's
+  std::string variant;                 // --variant NAME: a KHR_materials_variants variant; empty: the default
   std::string stats;
   float exposure = 0.0f;
   std::string tonemap = "neutral";

@@ -143,6 +143,7 @@ Scene load_render_scene(RenderArgs* args) {
   RenderArgs& a = *args;
   LoadOptions options;
   if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
+  options.variant = a.variant;
   Scene scene = load_gltf(a.scene, options);
   if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "nee" : scene.strategy;
   apply_background_options(a, &scene);
