@@ -73,6 +73,22 @@ j = json.load(open(sys.argv[1]))
 j["cameras"][0] = {"type": "orthographic", "orthographic": {"xmag": 0.4, "ymag": 0.3, "znear": 0.01, "zfar": 100}}
 json.dump(j, open(sys.argv[2], "w"))
 PY
+# KHR_materials_variants: info lists them; an unknown --variant is one error naming them
+python3 - "$scene" "$tmp/variants.gltf" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+j["extensions"] = dict(j.get("extensions", {}), KHR_materials_variants={"variants": [{"name": "warm"}, {"name": "cold"}]})
+j["extensionsUsed"] = j.get("extensionsUsed", []) + ["KHR_materials_variants"]
+j["meshes"][0]["primitives"][0]["extensions"] = {"KHR_materials_variants": {"mappings": [{"material": 0, "variants": [1]}]}}
+json.dump(j, open(sys.argv[2], "w"))
+PY
+if "$bin" info "$tmp/variants.gltf" >"$tmp/info" 2>&1 && grep -q "^material variants .*: 2" "$tmp/info" &&
+    grep -q "^  'cold'" "$tmp/info"; then
+  pass "info lists the material variants"
+else
+  fail "info lists the material variants:"; cat "$tmp/info"
+fi
+expect_error "unknown material variant" "variant 'hot' is not in the scene (its variants: 'warm', 'cold')" -- "$bin" render "$tmp/variants.gltf" -o "$tmp/x.png" --variant hot --device pocl
 expect_error "aperture on an orthographic camera" "aperture needs a perspective camera" -- "$bin" render "$tmp/ortho.gltf" -o "$tmp/x.png" --aperture 0.01 --device pocl
 mkdir -p "$tmp/broken-cl" && cp -r "$root/cl/." "$tmp/broken-cl/" && echo "this is not OpenCL C;" >>"$tmp/broken-cl/lights/lights.cl"
 expect_error "kernel build failure shows the log" "cl/lights/lights.cl:" -- "$bin" --kernel-dir "$tmp/broken-cl" render "$scene" -o "$tmp/x.png" --device pocl --spp 1
