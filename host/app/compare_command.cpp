@@ -2,6 +2,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/options.hpp"
 #include "base/error.hpp"
 
 namespace candela {
@@ -14,11 +15,12 @@ CLI::App* add_compare_command(CLI::App* app, CompareCommand* c) {
       "(exit 0: consistent, 2: not); options it does not know are passed to every render");
   cmd->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
   cmd->add_option("--devices", c->devices, "Comma-separated device selectors, the first is the reference")->required();
-  cmd->add_option("--spp", a.spp, "Samples per pixel on every device (default 64)")->check(CLI::Range(2u, 1u << 24));
-  cmd->add_option("--width", a.width, "Image width (default 64)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--spp", a.spp, "Samples per pixel on every device (default 64)")->check(integer_in(2, 1 << 24));
+  cmd->add_option("--width", a.width, "Image width (default 64)")->check(integer_in(1, 65536));
   cmd->add_option("--height", a.height, "Image height (default from the camera's aspect ratio)")
-      ->check(CLI::Range(1, 65536));
-  cmd->add_option("--seed", a.seed, "Seed of the first device; device I renders seed + I (default 0)");
+      ->check(integer_in(1, 65536));
+  cmd->add_option("--seed", a.seed, "Seed of the first device; device I renders seed + I (default 0)")
+      ->check(integer_in(0, 4294967295LL));
   cmd->add_flag("--same-seed", a.same_seed,
                 "Render the same seed on every device (correlated noise: the z-test no longer applies)");
   cmd->add_flag("!--no-determinism-check", a.determinism_check,

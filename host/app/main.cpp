@@ -1,5 +1,6 @@
 // The candela executable: the CLI11 app, its subcommands, and the one `candela: error:` handler.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -26,6 +27,14 @@ void enable_rusticl_if_named(const std::string& device) {
 int fail(const std::string& message) {
   std::fprintf(stderr, "candela: error: %s\n", message.c_str());
   return 1;
+}
+
+// A command-line parser message as one line: the parser's text with its line breaks
+// folded, then where to look
+std::string parse_error_message(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text + " (see --help)";
 }
 
 // The subcommand asked for, its exceptions turned into `candela: error:` lines
@@ -63,8 +72,10 @@ int main(int argc, char** argv) {
   CLI::App* info_cmd = add_info_command(&app, &info_args);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return fail(parse_error_message(e.what()));
   }
   enable_rusticl_if_named(render_args.device);
   return run_reporting_errors([&] {

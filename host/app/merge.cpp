@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <set>
 
+#include "base/atomic_file.hpp"
 #include "base/error.hpp"
 #include "render/film.hpp"
 #include "render/image_stats.hpp"
@@ -14,9 +16,15 @@ namespace candela {
 
 namespace {
 
-// Metadata that must agree: the inputs are then samples of the same estimator. (Camera
-// and lighting overrides on the command line are not recorded: keep them the same.)
-const char* const kMustMatch[] = {"scene", "seed", "strategy", "max_depth", "energy_compensation", "filter"};
+// Metadata that must agree: the inputs are then samples of the same estimator (camera and
+// lighting are fingerprints of the device camera and of the background and environment)
+const char* const kMustMatch[] = {"scene",  "seed",    "strategy", "max_depth", "energy_compensation",
+                                  "filter", "sampler", "camera",   "lighting"};
+
+bool partial(const RgbImage& img) {
+  auto it = img.metadata.find("partial_pass");
+  return it != img.metadata.end() && it->second == "1";
+}
 
 bool ends_with_exr(const std::string& path) {
   if (path.size() < 4) return false;
@@ -59,7 +67,8 @@ SampleRanges ranges_of(const RgbImage& img, const std::string& path, uint64_t sp
       if (comma == std::string::npos) break;
       pos = comma + 1;
     }
-    if (total != spp)
+    // A render stopped inside a range holds whole passes (spp) and part of one more
+    if (total != spp && !(partial(img) && total > spp))
       throw Error("cannot merge: " + path + ": candela:sample_ranges holds " + std::to_string(total) +
                   " samples, candela:spp says " + std::to_string(spp));
     return out;
@@ -91,7 +100,8 @@ Input read_input(const std::string& path) {
   if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
     throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
   x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
-  if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no samples (candela:spp 0)");
+  if (x.spp == 0)
+    throw Error("cannot merge " + path + ": it holds no complete pass of samples (candela:spp 0)");
   x.ranges = ranges_of(x.img, path, x.spp);
   return x;
 }
@@ -177,7 +187,15 @@ std::map<std::string, std::string> merged_metadata(const std::vector<Input>& in,
   meta["dropped_samples"] = std::to_string(dropped);
   meta["device"] = device_text;
   meta["merged_from"] = std::to_string(in.size());
+  meta.erase("partial_pass");
+  for (const auto& x : in)
+    if (partial(x.img)) meta["partial_pass"] = "1";
   return meta;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec);
 }
 
 }  // namespace
@@ -185,6 +203,9 @@ std::map<std::string, std::string> merged_metadata(const std::vector<Input>& in,
 int run_merge(const MergeArgs& args) {
   if (args.inputs.size() < 2) throw Error("merge needs at least two input images");
   if (!ends_with_exr(args.output)) throw Error("merge writes an .exr (linear float with metadata): " + args.output);
+  check_writable_path(args.output);
+  for (const auto& path : args.inputs)
+    if (same_file(path, args.output)) throw Error("cannot merge: the output " + args.output + " is one of the inputs");
   std::vector<Input> in;
   for (const auto& path : args.inputs) in.push_back(read_input(path));
   for (size_t i = 1; i < in.size(); ++i) check_same_render(in.front(), in[i]);

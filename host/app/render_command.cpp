@@ -5,7 +5,11 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
+#include <functional>
+#include <unistd.h>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "app/mpi_render.hpp"
@@ -14,6 +18,7 @@
 #include "app/render_devices.hpp"
 #include "app/render_scene.hpp"
 #include "app/report.hpp"
+#include "base/atomic_file.hpp"
 #include "compile/camera.hpp"
 #include "compile/scene_compiler.hpp"
 #include "render/image_stats.hpp"
@@ -23,11 +28,48 @@
 namespace candela {
 namespace {
 
-std::atomic<bool> g_interrupted{false};
+// SIGINT and SIGTERM. Before the render starts (loading, kernel build) nothing is lost
+// by leaving at once; during the render the first one stops it between launches and its
+// samples are written; while writing, every one waits for the write. Exit status 128 +
+// the first signal's number.
+enum Phase : int { kPreparing, kRendering, kWriting };
+std::atomic<int> g_phase{kPreparing};
+std::atomic<int> g_signal{0};
 
-void on_sigint(int) {
-  if (g_interrupted.exchange(true)) std::_Exit(130);  // second Ctrl-C: leave at once
+void on_signal(int sig) {
+  int none = 0;
+  g_signal.compare_exchange_strong(none, sig);
+  if (g_phase.load() == kPreparing) {
+    const char msg[] = "candela: interrupted before rendering; nothing written\n";
+    ssize_t ignored = write(2, msg, sizeof msg - 1);
+    (void)ignored;
+    std::_Exit(128 + sig);
+  }
 }
+
+// Tests send each signal at each phase through CANDELA_RAISE_AT=PHASE:SIGNAL (once), PHASE
+// one of loading, kernel-build, first-pass (inside it), later-pass (after a whole range),
+// mid-pass (inside a later range), writing; SIGNAL INT or TERM
+void raise_if_asked(const char* phase) {
+  static bool raised = false;
+  const char* at = std::getenv("CANDELA_RAISE_AT");
+  if (!at || raised) return;
+  std::string text = at;
+  size_t colon = text.find(':');
+  if (colon == std::string::npos || text.substr(0, colon) != phase) return;
+  std::string name = text.substr(colon + 1);
+  raised = true;
+  if (name == "INT") std::raise(SIGINT);
+  if (name == "TERM") std::raise(SIGTERM);
+}
+
+void catch_signals() {
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+}
+
+void enter_phase(Phase phase) { g_phase.store(phase); }
+bool signalled() { return g_signal.load() != 0; }
 
 // Speed against accuracy (README): --variance and --generic
 void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
@@ -43,7 +85,8 @@ void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
 void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
   render->add_option("--sample-offset", a->sample_offset,
                      "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
-                     "stored as candela:sample_offset");
+                     "stored as candela:sample_offset")
+      ->check(integer_in(0, 4294967295LL));
   render->add_flag("--mpi", a->mpi,
                    "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank "
                    "renders a block of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)");
@@ -57,10 +100,12 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--env", a.env, "Equirectangular environment map (.hdr, .exr, .png, .jpg), replacing the scene's")
       ->excludes(background_opt);
   render->add_option("--env-strength", a.env_strength,
-                     "Environment map strength, a radiance scale (default 1, or the scene's)");
+                     "Environment map strength, a radiance scale (default 1, or the scene's)")
+      ->check(finite_number());
   render->add_option(
       "--env-rotation", a.env_rotation,
-      "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)");
+      "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)")
+      ->check(finite_number());
   render->add_option("--default-light", a.default_light,
                      "The built-in studio environment: " + enum_names(kDefaultLightNames, true));
   render->add_flag_callback(
@@ -77,36 +122,40 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
 void add_camera_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--camera", a.camera,
                      "The scene's camera to render through, by index (candela info lists them; "
-                     "default 0, the first)");
+                     "default 0, the first)")
+      ->check(integer_in(0, 1 << 30));
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
-  render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)");
+  render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)")
+      ->check(finite_number());
   render->add_option(
       "--aperture", a.aperture,
-      "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)");
+      "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)")
+      ->check(finite_number());
   render->add_option("--focus-distance", a.focus_distance,
                      "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
-                     "camera's extras, else the scene bounds' centre)");
+                     "camera's extras, else the scene bounds' centre)")
+      ->check(positive_number());
 }
 
 // Samples, size, devices and the path tracer's settings
 void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
-  auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(CLI::Range(1u, 1u << 24));
+  auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(integer_in(1, 1 << 24));
   render->add_option("--time", a.time, "Render for this many seconds instead of a sample count")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->excludes(spp_opt);
   render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")
-      ->check(CLI::Range(1, 65536));
+      ->check(integer_in(1, 65536));
   render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")
-      ->check(CLI::Range(1, 65536));
+      ->check(integer_in(1, 65536));
   render->add_option(
       "--device", a.device,
       "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first "
       "CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once");
-  render->add_option("--seed", a.seed, "Random seed (default 0)");
+  render->add_option("--seed", a.seed, "Random seed (default 0)")->check(integer_in(0, 4294967295LL));
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")
-      ->check(CLI::Range(0u, 100000u));
+      ->check(integer_in(0, 100000));
   render->add_option("--strategy", a.strategy,
                      enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else nee");
   render->add_flag(
@@ -119,11 +168,39 @@ void check_variance_path(const RenderArgs& a) {
   std::string ext = lowercase(a.variance.size() >= 4 ? a.variance.substr(a.variance.size() - 4) : "");
   if (ext != ".exr")
     throw Error("--variance must name an .exr file (the variance is linear float data): " + a.variance);
+  check_writable_path(a.variance);
 }
 
 void check_sample_offset(const RenderArgs& a, uint32_t spp) {
   if (spp > 0 && uint64_t(a.sample_offset) + spp > (uint64_t(1) << 32))
     throw Error("--sample-offset + --spp must not pass 2^32 sample indices");
+}
+
+// No two outputs, and no output and input, name the same file
+void check_distinct_paths(const RenderArgs& a) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& path) {
+    std::error_code ec;
+    fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
+    return ec ? fs::absolute(path).lexically_normal().string() : p.string();
+  };
+  std::vector<std::pair<std::string, std::string>> outputs;  // (key, option and path)
+  for (const auto& out : a.outputs) outputs.push_back({key(out), "-o " + out});
+  if (!a.variance.empty()) outputs.push_back({key(a.variance), "--variance " + a.variance});
+  if (!a.stats.empty()) outputs.push_back({key(a.stats), "--stats " + a.stats});
+  for (size_t i = 0; i < outputs.size(); ++i)
+    for (size_t j = i + 1; j < outputs.size(); ++j)
+      if (outputs[i].first == outputs[j].first)
+        throw Error(outputs[i].second + " and " + outputs[j].second + " name the same file");
+  std::vector<std::pair<std::string, std::string>> inputs = {{a.scene, "the scene"}};
+  if (!a.env.empty()) inputs.push_back({a.env, "--env"});
+  for (const auto& [path, what] : inputs)
+    for (const auto& out : outputs)
+      if (out.first == key(path)) throw Error(out.second + " would overwrite " + what + " (" + path + ")");
+}
+
+void check_stats_path(const RenderArgs& a) {
+  if (!a.stats.empty()) check_writable_path(a.stats);
 }
 
 // What can be checked before the scene loads: option names and output paths
@@ -136,9 +213,12 @@ RenderSettings check_render_args(const RenderArgs& a) {
   parse_enum(kDefaultLightNames, "--default-light", a.default_light);
   if (!a.light_units.empty()) parse_enum(kLightUnitNames, "--light-units", a.light_units);
   if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number of stops");
+  check_camera_options(a);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
   check_variance_path(a);
+  check_stats_path(a);
+  check_distinct_paths(a);
   return settings;
 }
 
@@ -167,34 +247,77 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
 // The render with its progress bar; Ctrl-C stops it between launches
 RenderResult render_with_progress(Renderer& renderer, const RenderArgs& a, const RenderSettings& settings,
                                   uint32_t first_sample, uint32_t spp) {
-  std::signal(SIGINT, on_sigint);
   ProgressBar bar(!a.quiet, double(settings.width) * settings.height);
   bar.show_device_shares(renderer.worker_count() > 1);
+  enter_phase(kRendering);
   RenderResult r = renderer.render(
-      first_sample, spp, a.time, [&](const RenderProgress& p) { bar.update(p); }, [] { return g_interrupted.load(); });
+      first_sample, spp, a.time,
+      [&](const RenderProgress& p) {
+        bar.update(p);
+        if (p.spp_done == 0 && p.spp_partial > 0) raise_if_asked("first-pass");
+        if (p.spp_done > 0 && p.spp_partial == 0) raise_if_asked("later-pass");
+        if (p.spp_done > 0 && p.spp_partial > 0) raise_if_asked("mid-pass");
+      },
+      [] { return signalled(); });
   bar.finish();
-  std::signal(SIGINT, SIG_DFL);
   return r;
 }
 
-// The images (and the variance image), each with the report as metadata
-void write_outputs(const RenderArgs& a, const Film& film, const RenderReport& report) {
+// The images (and the variance image), each with the report as metadata; each output is
+// written on its own, so one that fails (reported) does not cost the others. False when
+// any failed.
+bool write_outputs(const RenderArgs& a, const Film& film, const RenderReport& report) {
   std::map<std::string, std::string> meta = image_metadata(report);
-  for (const auto& out : a.outputs) {
-    write_image(out, film, meta, {a.exposure, parse_tonemap(a.tonemap)});
-    std::printf("wrote %s\n", out.c_str());
-  }
-  if (a.variance.empty()) return;
-  write_variance_image(a.variance, film, meta);
-  std::printf("wrote %s\n", a.variance.c_str());
+  bool ok = true;
+  auto attempt = [&](const std::string& path, const std::function<void()>& write) {
+    try {
+      write();
+      std::printf("wrote %s\n", path.c_str());
+    } catch (const Error& e) {
+      std::fprintf(stderr, "candela: error: %s\n", e.what());
+      ok = false;
+    }
+  };
+  for (const auto& out : a.outputs)
+    attempt(out, [&] { write_image(out, film, meta, {a.exposure, parse_tonemap(a.tonemap)}); });
+  if (!a.variance.empty()) attempt(a.variance, [&] { write_variance_image(a.variance, film, meta); });
+  return ok;
 }
 
-void print_result(const RenderReport& report, bool partial_pass) {
+bool write_stats_reporting(const RenderReport& report, const std::string& path) {
+  try {
+    write_stats(report, path);
+    return true;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    return false;
+  }
+}
+
+bool any_samples(const Film& film) {
+  for (size_t p = 0; p < film.pixels(); ++p)
+    if (film.samples(p) > 0) return true;
+  return false;
+}
+
+// 0, or 128 + the signal that stopped the render (130 SIGINT, 143 SIGTERM)
+int exit_status(const RenderResult& r) {
+  if (int sig = g_signal.load()) return 128 + sig;
+  return r.interrupted ? 130 : 0;
+}
+
+void print_result(const RenderReport& report, bool partial_pass, const Film& film) {
   std::printf("%u spp in %.2fs: %.3f Msamples/s on %s%s\n", report.spp, report.seconds,
               report.samples_per_second * 1e-6, report.device.c_str(), report.interrupted ? " (interrupted)" : "");
   print_device_shares(report.devices);
-  if (partial_pass)
+  if (partial_pass && report.spp == 0) {
+    size_t with = 0;
+    for (size_t p = 0; p < film.pixels(); ++p) with += film.samples(p) > 0;
+    std::fprintf(stderr, "note: stopped inside the first pass: %.1f %% of the pixels have samples, the others are black\n",
+                 100.0 * double(with) / double(std::max<size_t>(film.pixels(), 1)));
+  } else if (partial_pass) {
     std::fprintf(stderr, "note: stopped inside a pass; some pixels hold more than %u samples\n", report.spp);
+  }
   if (report.dropped_samples)
     std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)report.dropped_samples);
 }
@@ -212,7 +335,8 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   add_sampling_render_options(render, a);
   add_lighting_render_options(render, a);
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
-  render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear");
+  render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear")
+      ->check(finite_number());
   render->add_option("--tonemap", a.tonemap,
                      "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true));
   add_camera_render_options(render, a);
@@ -225,7 +349,9 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
 }
 
 int run_render(RenderArgs a) {
+  catch_signals();
   RenderSettings settings = check_render_args(a);
+  raise_if_asked("loading");
   Scene scene = load_render_scene(&a);
   complete_settings(a, scene, &settings);
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
@@ -233,16 +359,24 @@ int run_render(RenderArgs a) {
   uint32_t first_sample = mpi_shard(&a, &spp);
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", joined_descriptions(devices).c_str());
+  std::string camera = camera_fingerprint(scene, settings.width, settings.height);
+  std::string lighting = lighting_fingerprint(scene);
+  raise_if_asked("kernel-build");
   Renderer renderer = make_renderer(a, &scene, settings, devices);
   if (!a.quiet) print_render_summary(renderer, devices);
   RenderResult r = render_with_progress(renderer, a, settings, first_sample, spp);
-  if (!mpi_combine(&r)) return 0;
-  if (r.spp == 0) throw Error("interrupted before any sample was rendered; nothing written");
+  enter_phase(kWriting);
+  if (!mpi_combine(&r)) return exit_status(r);
+  if (r.spp == 0 && !any_samples(r.film)) throw Error("interrupted before any sample was rendered; nothing written");
   RenderReport report = make_render_report(a, settings, renderer, r, devices);
-  write_outputs(a, r.film, report);
-  print_result(report, r.partial_pass);
-  if (!a.stats.empty()) write_stats(report, a.stats);
-  return r.interrupted ? 130 : 0;
+  report.camera = camera;
+  report.lighting = lighting;
+  raise_if_asked("writing");
+  bool all_written = write_outputs(a, r.film, report);
+  print_result(report, r.partial_pass, r.film);
+  if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
+  if (!all_written) return 1;
+  return exit_status(r);
 }
 
 int run_render_command(const RenderArgs& args) {

@@ -15,12 +15,38 @@
 namespace candela {
 namespace {
 
+}  // namespace
+
 void check_camera_options(const RenderArgs& a) {
   if (a.fov && !(*a.fov > 0 && *a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees (exclusive)");
   if (a.aperture && !(*a.aperture >= 0 && std::isfinite(*a.aperture)))
     throw Error("--aperture must be a non-negative radius in scene units");
   if (a.focus_distance && !(*a.focus_distance > 0 && std::isfinite(*a.focus_distance)))
     throw Error("--focus-distance must be a positive distance in scene units");
+  if (!a.up.empty() && glm::length(parse_vec3(a.up, "--up")) <= 0.0f)
+    throw Error("--up must be a non-zero vector, e.g. 0,1,0");
+  if (!a.look_from.empty()) parse_vec3(a.look_from, "--look-from");
+  if (!a.look_at.empty()) parse_vec3(a.look_at, "--look-at");
+}
+
+namespace {
+
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// The camera's up vector must leave a direction across the view; a lens wider than the
+// scene by far only blurs it into float rounding
+void check_camera_against_scene(const CameraDesc& cam, const Scene& scene) {
+  glm::vec3 f = glm::normalize(cam.forward), u = cam.up;
+  if (!(glm::length(glm::cross(f, u)) > 1e-4f * glm::length(u)))
+    throw Error("the camera's up vector is parallel to its view direction: give --up across the view, e.g. 0,0,1");
+  Bounds b = scene.bounds();
+  float extent = glm::length(b.hi - b.lo);
+  if (cam.aperture_radius > 1000.0f * std::max(extent, cam.focus_distance.value_or(0.0f)))
+    throw Error("--aperture " + format_number(cam.aperture_radius) + " is more than 1000 times the scene's size: every point would be a blur");
 }
 
 // --look-from, --look-at, --up; returns the look-at point's distance when it is given
@@ -72,6 +98,7 @@ void apply_camera_options(const RenderArgs& a, Scene* scene) {
   CameraDesc cam = scene->camera ? *scene->camera : framing_camera(*scene);
   std::optional<float> look_at_distance = aim_camera(a, &cam);
   set_lens(a, look_at_distance, &cam);
+  check_camera_against_scene(cam, *scene);
   scene->camera = cam;
 }
 

@@ -7,6 +7,9 @@
 
 namespace candela {
 
+// Throws Error for camera options that no scene makes valid (run before loading)
+void check_camera_options(const RenderArgs& args);
+
 // Loads args->scene, applies the overrides and prints the scene's warnings; fills in
 // args->strategy from the scene when the command line gives none
 Scene load_render_scene(RenderArgs* args);

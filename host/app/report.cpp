@@ -3,12 +3,16 @@
 
 #include <sys/resource.h>
 #include <algorithm>
-#include <fstream>
+#include <cstdio>
 #include <nlohmann/json.hpp>
+#include <string_view>
 
 #include "app/mpi_render.hpp"
 #include "app/render_command.hpp"
+#include "base/atomic_file.hpp"
 #include "base/error.hpp"
+#include "base/hash.hpp"
+#include "compile/camera.hpp"
 #include "compile/bvh_builder.hpp"
 
 namespace candela {
@@ -63,6 +67,8 @@ void record_render(const RenderArgs& a, const RenderSettings& settings, const Re
   report.height = settings.height;
   report.samples_per_second = r.spp * (double(settings.width) * settings.height) / std::max(r.seconds, 1e-9);
   report.interrupted = r.interrupted;
+  report.partial_pass = r.partial_pass;
+  report.sample_end = uint64_t(a.sample_offset) + r.samples_taken;
   report.generic_kernel = a.generic;
 }
 
@@ -96,8 +102,39 @@ RenderReport make_render_report(const RenderArgs& args, const RenderSettings& se
   return report;
 }
 
+namespace {
+
+std::string hex64(uint64_t h) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", (unsigned long long)h);
+  return text;
+}
+
+template <typename T>
+uint64_t hash_bytes(const T* data, size_t count, uint64_t h) {
+  return fnv1a64(std::string_view(reinterpret_cast<const char*>(data), count * sizeof(T)), h);
+}
+
+}  // namespace
+
+std::string camera_fingerprint(const Scene& scene, int width, int height) {
+  dev::Camera camera = compile_camera(scene, width, height);
+  return hex64(hash_bytes(&camera, 1, fnv1a64("camera")));
+}
+
+std::string lighting_fingerprint(const Scene& scene) {
+  uint64_t h = hash_bytes(&scene.background, 1, fnv1a64("lighting"));
+  if (const auto& env = scene.environment) {
+    h = hash_bytes(env->image.rgbaf.data(), env->image.rgbaf.size(), h);
+    h = hash_bytes(env->image.rgba8.data(), env->image.rgba8.size(), h);
+    h = hash_bytes(&env->strength, 1, h);
+    h = hash_bytes(&env->rotation, 1, h);
+  }
+  return hex64(h);
+}
+
 std::map<std::string, std::string> image_metadata(const RenderReport& r) {
-  return {{"spp", std::to_string(r.spp)},
+  std::map<std::string, std::string> meta = {{"spp", std::to_string(r.spp)},
           {"seconds", std::to_string(r.seconds)},
           {"device", r.device},
           {"seed", std::to_string(r.seed)},
@@ -109,6 +146,14 @@ std::map<std::string, std::string> image_metadata(const RenderReport& r) {
           {"filter", r.filter},
           {"sampler", r.sampler},
           {"sample_offset", std::to_string(r.sample_offset)}};
+  if (!r.camera.empty()) meta["camera"] = r.camera;
+  if (!r.lighting.empty()) meta["lighting"] = r.lighting;
+  // Stopped inside a range: its pixels hold up to sample_end (merge refuses overlaps)
+  if (r.partial_pass) {
+    meta["partial_pass"] = "1";
+    meta["sample_ranges"] = std::to_string(r.sample_offset) + ":" + std::to_string(r.sample_end);
+  }
+  return meta;
 }
 
 void write_stats(const RenderReport& r, const std::string& path) {
@@ -142,10 +187,11 @@ void write_stats(const RenderReport& r, const std::string& path) {
                       {"max_depth", r.max_depth},
                       {"seed", r.seed},
                       {"interrupted", r.interrupted},
+                      {"partial_pass", r.partial_pass},
+                      {"sample_end", r.sample_end},
                       {"dropped_samples", r.dropped_samples},
                       {"generic_kernel", r.generic_kernel}};
-  std::ofstream f(path);
-  if (!(f << j.dump(2) << "\n")) throw Error("cannot write stats file " + path);
+  write_file_atomically(path, j.dump(2) + "\n");
 }
 
 }  // namespace candela

@@ -10,6 +10,7 @@
 #include "app/render_devices.hpp"
 #include "compile/compiled_scene.hpp"
 #include "render/renderer.hpp"
+#include "scene/scene.hpp"
 
 namespace candela {
 
@@ -24,8 +25,13 @@ struct RenderReport {
   std::string strategy, filter, sampler;
   bool energy_compensation = true;
   uint64_t dropped_samples = 0;
+  bool partial_pass = false;   // stopped inside a range of samples
+  uint64_t sample_end = 0;     // no pixel holds a sample index at or past this one
   // In the metadata only
   std::string scene;  // the scene file
+  // Fingerprints (FNV-1a of the device camera record; of the background and environment
+  // map): renders that `candela merge` combines must agree on them
+  std::string camera, lighting;
   // In the stats only
   int width = 0, height = 0;
   double samples_per_second = 0.0;
@@ -43,6 +49,10 @@ struct RenderReport {
   std::vector<GridMemory> grids;
   std::vector<DeviceShare> devices;
 };
+
+// The fingerprints of the camera and the lighting of a scene about to be compiled
+std::string camera_fingerprint(const Scene& scene, int width, int height);
+std::string lighting_fingerprint(const Scene& scene);
 
 RenderReport make_render_report(const RenderArgs& args, const RenderSettings& settings, const Renderer& renderer,
                                 const RenderResult& result, const std::vector<DeviceEntry>& devices);

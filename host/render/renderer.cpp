@@ -177,8 +177,9 @@ namespace {
 // samples that every pixel has received
 class SampleScheduler {
  public:
-  SampleScheduler(uint32_t spp, double time_limit, size_t workers)
-      : limit_(spp > 0 ? spp : kMaxSamplesPerPixel),
+  // `indices_left`: sample indices left before the 32-bit index would wrap
+  SampleScheduler(uint32_t spp, double time_limit, size_t workers, uint64_t indices_left)
+      : limit_(spp > 0 ? spp : uint32_t(std::min<uint64_t>(kMaxSamplesPerPixel, indices_left))),
         time_limit_(spp > 0 ? 0.0 : time_limit),
         partial_(workers, 0.0),
         done_by_(workers, 0),
@@ -229,6 +230,7 @@ class SampleScheduler {
 
   double seconds() const { return seconds_since(start_); }
   uint32_t done() const { return done_; }
+  uint32_t taken() const { return next_; }
   bool interrupted() const { return interrupted_; }
   bool partial_pass() const { return partial_pass_; }
 
@@ -250,7 +252,9 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
                             const std::function<bool()>& stop) {
   if (workers.empty()) throw Error("render_samples needs a device");
   if (spp == 0 && !(time_limit > 0.0)) throw Error("render needs a sample count or a time limit");
-  SampleScheduler sched(spp, time_limit, workers.size());
+  uint64_t indices_left = (uint64_t(1) << 32) - sample_begin;
+  if (spp > indices_left) throw Error("the sample indices would pass 2^32: lower --sample-offset or --spp");
+  SampleScheduler sched(spp, time_limit, workers.size(), indices_left);
   std::vector<std::exception_ptr> errors(workers.size());
   auto work = [&](size_t i) {
     try {
@@ -285,6 +289,7 @@ RenderResult render_samples(const std::vector<DeviceRenderer*>& workers, uint32_
   result.seconds = sched.seconds();
   result.interrupted = sched.interrupted();
   result.partial_pass = sched.partial_pass();
+  result.samples_taken = sched.taken();
   // Each worker's share: the samples its film holds (partial ranges included)
   for (size_t i = 0; i < workers.size(); ++i) {
     Film f = workers[i]->film();

@@ -69,6 +69,8 @@ struct RenderResult {
   double seconds = 0.0;
   bool interrupted = false;              // stopped by the caller
   bool partial_pass = false;             // stopped inside a range: some pixels hold more samples
+  uint32_t samples_taken = 0;            // ranges handed out, from the first sample: no pixel holds an
+                                         // index at or past sample_begin + samples_taken
   std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
 };
 
