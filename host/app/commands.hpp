@@ -25,6 +25,7 @@ int run_compare_command(CLI::App* cmd, CompareCommand* c);
 // `candela info SCENE`: what the scene holds as candela reads it
 struct InfoArgs {
   std::string scene;
+  bool allow_outside_paths = false;
 };
 CLI::App* add_info_command(CLI::App* app, InfoArgs* args);
 int run_info_command(const InfoArgs& args);

@@ -107,11 +107,15 @@ CLI::App* add_info_command(CLI::App* app, InfoArgs* args) {
                                        "Print what a glTF scene holds as candela reads it: geometry, "
                                        "extensions, cameras, lights, materials and warnings");
   info->add_option("scene", args->scene, "Scene file (.gltf or .glb)")->required();
+  info->add_flag("--allow-outside-paths", args->allow_outside_paths,
+                 "Let the scene read files outside its folder (absolute paths, .., links out)");
   return info;
 }
 
 int run_info_command(const InfoArgs& args) {
-  Scene s = load_gltf(args.scene);
+  LoadOptions options;
+  options.allow_outside_paths = args.allow_outside_paths;
+  Scene s = load_gltf(args.scene, options);
   std::printf("scene: %s\n", args.scene.c_str());
   print_geometry(s);
   print_extensions(s);

@@ -343,6 +343,9 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render->add_option("--filter", a.filter, "Pixel filter: " + enum_names(kPixelFilterNames, true));
   render->add_option("--sampler", a.sampler, "Random numbers: " + enum_names(kSamplerNames, true));
   render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
+  render->add_flag("--allow-outside-paths", a.allow_outside_paths,
+                   "Let the scene read files outside its folder: absolute paths, .., links that lead out "
+                   "(by default a scene's buffers, images, maps and grids must lie inside its folder)");
   add_accuracy_render_options(render, &a);
   add_distributed_render_options(render, &a);
   return render;

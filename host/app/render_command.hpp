@@ -40,6 +40,7 @@ struct RenderArgs {
   bool generic = false;        // --generic: the kernel with every scene feature compiled in
   uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
   bool mpi = false;            // --mpi: spread the samples over the ranks of an MPI job
+  bool allow_outside_paths = false;  // --allow-outside-paths: scene files outside its folder
 };
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args);

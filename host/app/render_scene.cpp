@@ -169,6 +169,7 @@ void warn_unreachable_lights(const RenderArgs& a, const Scene& scene) {
 Scene load_render_scene(RenderArgs* args) {
   RenderArgs& a = *args;
   LoadOptions options;
+  options.allow_outside_paths = a.allow_outside_paths;
   if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
   options.variant = a.variant;
   Scene scene = load_gltf(a.scene, options);

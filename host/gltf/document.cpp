@@ -2,6 +2,8 @@
 // its nesting checked, image views bounds-checked, and what tinygltf 2.7 needs to read
 // files glTF allows written in.
 #include <algorithm>
+#include <cctype>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <string_view>
 
@@ -146,11 +148,45 @@ void check_image_views(const json& j, const std::string& name) {
   }
 }
 
+// Whether `uri` is a data: URI whose payload tinygltf 2.7 could not decode (not base64):
+// tinygltf then fails the whole file, where glTF's images are optional
+bool undecodable_data_uri(const std::string& uri) {
+  if (uri.compare(0, 5, "data:") != 0) return false;
+  size_t comma = uri.find(',');
+  if (comma == std::string::npos || uri.compare(comma - 7, 7, ";base64") != 0) return true;
+  size_t payload = 0;
+  for (size_t i = comma + 1; i < uri.size(); ++i) {
+    char c = uri[i];
+    bool b64 = std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/' || c == '=';
+    if (!b64) return true;
+    payload += c != '=';
+  }
+  return payload < 2;  // under one byte
+}
+
+// Images whose data: URI cannot be decoded get a stand-in that decodes to bytes that are no
+// image: load_checked_image then drops them with a warning; *bad gets their indices
+bool replace_undecodable_images(json& j, std::set<int>* bad) {
+  const json* images = member(j, "images");
+  if (!images || !images->is_array()) return false;
+  bool changed = false;
+  for (size_t i = 0; i < images->size(); ++i) {
+    json& img = j["images"][i];
+    const json* uri = member(img, "uri");
+    if (!uri || !uri->is_string() || !undecodable_data_uri(uri->get<std::string>())) continue;
+    img["uri"] = "data:application/octet-stream;base64,AAAA";
+    img.erase("mimeType");
+    bad->insert(int(i));
+    changed = true;
+  }
+  return changed;
+}
+
 // The document with what tinygltf needs written in (JSON text, or a GLB with its JSON chunk
 // replaced) into *out, and true; false, and no copy, when it needs nothing (or does not
 // parse: tinygltf then reports it)
 bool patch_document(const std::string& data, size_t json_begin, size_t json_size, bool binary, const std::string& name,
-                    std::string* out) {
+                    std::string* out, std::set<int>* bad_images) {
   if (binary && json_begin != 20) return false;  // too short for a GLB: tinygltf reports it
   std::string_view text(data.data() + json_begin, json_size);
   bool lights = text.find("KHR_lights_punctual") != std::string_view::npos;
@@ -165,6 +201,7 @@ bool patch_document(const std::string& data, size_t json_begin, size_t json_size
   if (lights) changed |= add_missing_spot_objects(j);
   if (draco) changed |= drop_draco_indices(j);
   if (meshopt) changed |= fill_meshopt_placeholders(j, binary);
+  if (images) changed |= replace_undecodable_images(j, bad_images);
   if (!changed) return false;
   std::string patched = j.dump();
   if (!binary) {
@@ -187,7 +224,7 @@ bool patch_document(const std::string& data, size_t json_begin, size_t json_size
 }  // namespace
 
 const std::string& prepare_document(const std::string& data, bool binary, const std::string& name,
-                                    std::string* patched) {
+                                    std::string* patched, std::set<int>* bad_images) {
   size_t json_begin = 0, json_size = data.size();  // a GLB's JSON is its first chunk
   if (binary && data.size() >= 20) {
     uint32_t length = 0;  // little-endian, at byte 12
@@ -198,7 +235,7 @@ const std::string& prepare_document(const std::string& data, bool binary, const 
   if (json_depth(data.data() + json_begin, json_size, kMaxJsonDepth) > kMaxJsonDepth)
     throw Error("cannot load glTF scene " + name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
                 " levels");
-  return patch_document(data, json_begin, json_size, binary, name, patched) ? *patched : data;
+  return patch_document(data, json_begin, json_size, binary, name, patched, bad_images) ? *patched : data;
 }
 
 }  // namespace candela::gltf

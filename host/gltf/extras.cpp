@@ -43,7 +43,7 @@ void read_strategy(ReadContext& ctx, const tinygltf::Value& st) {
 
 // The medium filling the scene
 void read_global_medium(ReadContext& ctx, const tinygltf::Value& v) {
-  MediumDesc m = read_medium(v, "scene extras candela.medium", ctx.base_dir);
+  MediumDesc m = read_medium(v, "scene extras candela.medium", ctx.folder);
   // An infinite ray through a global medium gathers emission / sigma_t: finite only where sigma_t > 0
   for (int k = 0; k < 3; ++k)
     if (m.emission[k] > 0.0f && !m.is_grid() && !(m.sigma_a[k] + m.sigma_s[k] > 0.0f))
@@ -88,11 +88,11 @@ void read_scene_extras(ReadContext& ctx, const tinygltf::Value& extras) {
 void load_environment_file(ReadContext& ctx) {
   if (!ctx.scene.environment) return;
   EnvironmentDesc& env = *ctx.scene.environment;
-  if (ctx.base_dir.empty()) {
+  if (ctx.folder.root.empty()) {
     ctx.warn.add("the environment map " + env.source + " is not loaded: the scene was read without a folder");
     ctx.scene.environment.reset();
   } else {
-    std::string path = (std::filesystem::path(ctx.base_dir) / env.source).string();
+    std::string path = ctx.folder.resolve(env.source, "scene extras candela.environment.file");
     ctx.scene.environment = load_environment(path, env.strength, env.rotation);
   }
 }

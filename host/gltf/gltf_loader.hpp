@@ -12,6 +12,7 @@ namespace candela {
 struct LoadOptions {
   std::optional<LightUnits> light_units;  // else the scene extras' candela.light_units, else photometric
   std::string variant;                    // a KHR_materials_variants name; empty: the default materials
+  bool allow_outside_paths = false;       // files outside the scene's folder (SceneFolder)
 };
 
 // Whether the loader implements glTF extension `name` (others are named in a warning)

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "base/error.hpp"
+#include "base/file_access.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "gltf/limits.hpp"
 #include "gltf/reader.hpp"
@@ -57,30 +58,57 @@ bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& p
 }
 bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
 
+// tinygltf file access for a scene with a folder: tinygltf joins the folder and the
+// decoded URI (then tries the working directory, which is never allowed here); the
+// folder's policy (SceneFolder::resolve) and the regular-file check decide, and their
+// reason becomes tinygltf's read error
+struct SceneFiles {
+  const SceneFolder* folder;
+  std::string prefix;  // folder + "/", as tinygltf joins it
+};
+bool scene_file_exists(const std::string& path, void* user) {
+  const auto* files = static_cast<const SceneFiles*>(user);
+  return path.compare(0, files->prefix.size(), files->prefix) == 0;
+}
+bool read_scene_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  const auto* files = static_cast<const SceneFiles*>(user);
+  try {
+    std::string file = files->folder->resolve(path.substr(files->prefix.size()), "the file");
+    std::string data = read_regular_file(file, "the file", kMaxFileBytes);
+    out->assign(data.begin(), data.end());
+    return true;
+  } catch (const Error& e) {
+    if (err) *err += e.what();
+    return false;
+  }
+}
+
 void trim_end(std::string* text, const char* chars) {
   while (!text->empty() && std::string(chars).find(text->back()) != std::string::npos) text->pop_back();
 }
 
 // The document parsed by tinygltf; images that fail their checks are left empty, with
 // the reason in *image_errors. *warn gets tinygltf's warnings.
-tinygltf::Model parse_model(const std::string& data, const std::string& base_dir, const std::string& name,
+tinygltf::Model parse_model(const std::string& data, const SceneFolder& folder, const std::string& name,
                             std::map<int, std::string>* image_errors, std::string* warn) {
+  const std::string& base_dir = folder.root;
   tinygltf::TinyGLTF gltf;
-  if (base_dir.empty()) {
-    tinygltf::FsCallbacks fs = {};
-    fs.FileExists = no_file_exists;
-    fs.ExpandFilePath = no_expand_path;
-    fs.ReadWholeFile = no_read;
-    fs.WriteWholeFile = no_write;
-    gltf.SetFsCallbacks(fs);
-  }
+  SceneFiles files{&folder, base_dir.empty() || base_dir.back() == '/' ? base_dir : base_dir + "/"};
+  tinygltf::FsCallbacks fs = {};
+  fs.FileExists = base_dir.empty() ? no_file_exists : scene_file_exists;
+  fs.ExpandFilePath = no_expand_path;  // never the shell expansion tinygltf does by default
+  fs.ReadWholeFile = base_dir.empty() ? no_read : read_scene_file;
+  fs.WriteWholeFile = no_write;
+  fs.user_data = &files;
+  gltf.SetFsCallbacks(fs);
   gltf.SetImageLoader(load_checked_image, image_errors);
   tinygltf::Model model;
   std::string err;
   // Binary glTF starts with the magic "glTF", whatever the file is called
   bool binary = data.compare(0, 4, "glTF") == 0;
   std::string patched;  // the file with defaults tinygltf needs written in, if any
-  const std::string& bytes = prepare_document(data, binary, name, &patched);
+  std::set<int> bad_images;
+  const std::string& bytes = prepare_document(data, binary, name, &patched, &bad_images);
   bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, warn, reinterpret_cast<const unsigned char*>(bytes.data()),
                                                unsigned(bytes.size()), base_dir)
                    : gltf.LoadASCIIFromString(&model, &err, warn, bytes.data(), unsigned(bytes.size()), base_dir);
@@ -88,6 +116,7 @@ tinygltf::Model parse_model(const std::string& data, const std::string& base_dir
     trim_end(&err, "\n ");
     throw Error("cannot load glTF scene " + name + ": " + (err.empty() ? "malformed file" : err));
   }
+  for (int i : bad_images) (*image_errors)[i] = "has a data: URI that is not base64";
   return model;
 }
 
@@ -95,11 +124,12 @@ tinygltf::Model parse_model(const std::string& data, const std::string& base_dir
 // External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
 Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
                       const LoadOptions& options) {
+  SceneFolder folder{base_dir, options.allow_outside_paths};
   if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
   if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
   std::map<int, std::string> image_errors;  // filled by load_checked_image
   std::string warn;
-  tinygltf::Model model = parse_model(data, base_dir, name, &image_errors, &warn);
+  tinygltf::Model model = parse_model(data, folder, name, &image_errors, &warn);
   Scene scene;
   if (!warn.empty()) {
     trim_end(&warn, "\n");
@@ -111,7 +141,7 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   decode_meshopt_views(&model);
   decode_draco_primitives(&model, &warnings);
   scene.variants = variant_names(model);
-  ReadContext ctx{model, scene, warnings, base_dir, image_errors, options};
+  ReadContext ctx{model, scene, warnings, folder, image_errors, options};
   ctx.variant = chosen_variant(model, options.variant);
   if (options.light_units) scene.light_units = *options.light_units;
   read_materials(ctx);
@@ -127,19 +157,8 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
 bool supported_gltf_extension(const std::string& name) { return gltf::supported_extension(name); }
 
 Scene load_gltf(const std::string& path, const LoadOptions& options) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error("scene file not found: " + path);
-  if (fs::is_directory(path, ec)) throw Error("scene path is a directory, not a glTF file: " + path);
-  std::string data;
-  std::ifstream in(path, std::ios::binary);
-  uintmax_t size = fs::file_size(path, ec);
-  if (in && !ec) {
-    data.resize(size_t(size));
-    in.read(data.data(), std::streamsize(size));
-  }
-  if (!in || ec) throw Error("cannot read scene file " + path);
-  std::string dir = fs::path(path).parent_path().string();
+  std::string data = read_regular_file(path, "scene file", gltf::kMaxFileBytes);
+  std::string dir = std::filesystem::path(path).parent_path().string();
   return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path, options);
 }
 

@@ -83,16 +83,14 @@ void read_coefficients(const tinygltf::Value& v, const std::string& where, Mediu
 
 // {"nanovdb": "file.nvdb"} or {"vdb": "file.vdb"}, relative to the glTF file, and "name": a
 // grid; false when the grid names no file
-bool read_grid_file(const tinygltf::Value& grid, const std::string& gw, const std::string& base_dir, MediumDesc* m) {
+bool read_grid_file(const tinygltf::Value& grid, const std::string& gw, const SceneFolder& folder, MediumDesc* m) {
   for (const char* key : {"nanovdb", "vdb"}) {
     if (!grid.Has(key)) continue;
     const tinygltf::Value& file = grid.Get(key);
     if (!file.IsString() || file.Get<std::string>().empty()) throw Error(gw + "." + key + " must name a file");
-    if (base_dir.empty()) throw Error(gw + "." + key + ": a scene loaded from memory cannot name files");
     if (grid.Has("name") && !grid.Get("name").IsString()) throw Error(gw + ".name must be a string");
     std::string name = grid.Has("name") ? grid.Get("name").Get<std::string>() : "";
-    std::filesystem::path path(file.Get<std::string>());
-    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+    std::filesystem::path path = folder.resolve(file.Get<std::string>(), gw + "." + key);
     if (std::string(key) == "vdb")
       load_openvdb_density(path.string(), name, m);
     else
@@ -109,7 +107,7 @@ bool read_grid_file(const tinygltf::Value& grid, const std::string& gw, const st
 // "max": [x, y, z], "density": [nx ny nz values, x fastest]} or {"nanovdb": "f.nvdb"} or
 // {"vdb": "f.vdb"} with an optional "name"}, "emission_grid": {"size", "min", "max", "values"}
 // (with a dense grid) and "emission_scale": s; every entry optional
-MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir) {
+MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const SceneFolder& folder) {
   if (!v.IsObject()) throw Error(where + " must be an object");
   MediumDesc m;
   read_coefficients(v, where, &m);
@@ -118,7 +116,7 @@ MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const
   if (!v.Has("grid")) return m;
   const tinygltf::Value& grid = v.Get("grid");
   std::string gw = where + ".grid";
-  if (read_grid_file(grid, gw, base_dir, &m)) return m;
+  if (read_grid_file(grid, gw, folder, &m)) return m;
   read_dense_grid(grid, gw, "density", &m.grid_size, &m.grid_min, &m.grid_max, &m.density);
   read_emission_grid(v, where, &m);
   return m;

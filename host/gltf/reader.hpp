@@ -2,6 +2,7 @@
 // and each reader's entry point (one file per glTF concept; loader.cpp runs them).
 #pragma once
 
+
 #include <tiny_gltf.h>
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/file_access.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "scene/scene.hpp"
 
@@ -34,7 +36,7 @@ struct ReadContext {
   const tinygltf::Model& model;
   Scene& scene;
   Warnings& warn;
-  const std::string& base_dir;                        // where files the scene names are found; empty: nowhere
+  const SceneFolder& folder;                          // where files the scene names are found
   const std::map<int, std::string>& image_errors;     // why load_checked_image left each image empty
   const LoadOptions& options;                         // the user's choices over the file's
   std::map<std::pair<int, bool>, int> textures = {};  // (glTF texture, sRGB) -> Scene::textures or NO_TEXTURE
@@ -70,9 +72,10 @@ void decode_draco_primitives(tinygltf::Model* model, Warnings* warn);
 void decode_meshopt_views(tinygltf::Model* model);
 
 // document.cpp: the bytes tinygltf parses (`data` itself or *patched); Error for JSON nested
-// deeper than kMaxJsonDepth
+// deeper than kMaxJsonDepth. *bad_images gets the images whose data: URI does not decode
+// (replaced by a stand-in that load_checked_image drops).
 const std::string& prepare_document(const std::string& data, bool binary, const std::string& name,
-                                    std::string* patched);
+                                    std::string* patched, std::set<int>* bad_images);
 
 // images.cpp: tinygltf's image decoding behind the size checks (a tinygltf::LoadImageDataFunction)
 bool load_checked_image(tinygltf::Image* image, int index, std::string* err, std::string* warn, int req_width,
@@ -99,7 +102,7 @@ TextureSlot texture_info(const tinygltf::Value& ext, const char* key);
 void read_materials(ReadContext& ctx);
 
 // media.cpp: a medium from candela's extras (`where` names it in errors)
-MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const std::string& base_dir);
+MediumDesc read_medium(const tinygltf::Value& v, const std::string& where, const SceneFolder& folder);
 
 // nodes.cpp: the default scene's node trees (meshes, the first camera, lights), its extras
 void read_nodes(ReadContext& ctx);

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "base/error.hpp"
+#include "base/file_access.hpp"
 
 namespace candela {
 namespace {
@@ -24,9 +25,7 @@ double texel_luminance(const TextureDesc& map, size_t i) {
 }  // namespace
 
 TextureDesc load_environment_image(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec) || fs::is_directory(path, ec)) throw Error("environment map not found: " + path);
+  check_regular_file(path, "environment map");  // a FIFO or /dev/zero would never end
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string why = OIIO::geterror();

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "base/error.hpp"
+#include "base/file_access.hpp"
 
 #ifdef CANDELA_HAVE_NANOVDB
 #include <nanovdb/NanoVDB.h>
@@ -121,6 +122,7 @@ void set_nanovdb_grid(const nanovdb::GridHandle<nanovdb::HostBuffer>& handle, co
 bool nanovdb_supported() { return true; }
 
 void load_nanovdb_density(const std::string& path, const std::string& grid_name, MediumDesc* m) {
+  check_regular_file(path, "NanoVDB file");
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   try {
     handle = grid_name.empty() ? nanovdb::io::readGrid(path) : nanovdb::io::readGrid(path, grid_name);
@@ -146,6 +148,7 @@ void load_nanovdb_density(const std::string& path, const std::string&, MediumDes
 bool openvdb_supported() { return true; }
 
 void load_openvdb_density(const std::string& path, const std::string& grid_name, MediumDesc* m) {
+  check_regular_file(path, "OpenVDB file");
   static std::once_flag init;
   std::call_once(init, [] { openvdb::initialize(); });
   openvdb::FloatGrid::Ptr grid;

@@ -415,35 +415,13 @@ expect_error "merge: PNG input" "reads .exr images" -- "$bin" merge "$tmp/s0.exr
 expect_error "merge: missing input" "not found" -- "$bin" merge "$tmp/s0.exr" "$tmp/nope.exr" -o "$tmp/x.exr"
 [ ! -e "$tmp/x.exr" ] && pass "refused merges write nothing" || fail "a refused merge wrote $tmp/x.exr"
 
-# --mpi: without MPI built in, one clear error; with it (CANDELA_MPI_BIN, e.g. a
-# -DCANDELA_MPI=ON build, and mpirun), two ranks give the 16-spp render
+# --mpi: without MPI built in, one clear error; with it, a single rank renders
 if "$bin" render "$scene" -o "$tmp/mpi1.exr" --mpi $shard --spp 16 >/dev/null 2>"$tmp/err"; then
   pass "--mpi as a single rank (an MPI build)"
 else
   expect_error "--mpi without MPI" "built without MPI" -- "$bin" render "$scene" -o "$tmp/x.exr" --mpi $shard --spp 16
 fi
-mpi_bin=${CANDELA_MPI_BIN:-}
-if [ -n "$mpi_bin" ] && command -v mpirun >/dev/null; then
-  mpirun_args="-np 2"
-  [ "$(id -u)" = 0 ] && mpirun_args="$mpirun_args --allow-run-as-root"
-  mpirun --version 2>/dev/null | grep -q "Open MPI" && mpirun_args="$mpirun_args --oversubscribe"
-  if mpirun $mpirun_args "$mpi_bin" render "$scene" -o "$tmp/mpi.exr" --mpi --spp 16 $shard --stats "$tmp/mpi.json" \
-    >"$tmp/out" 2>"$tmp/err" &&
-    python3 -c "import json; s = json.load(open('$tmp/mpi.json')); assert s['spp'] == 16 and s['mpi_ranks'] == 2, s" &&
-    [ "$(grep -c '^wrote' "$tmp/out")" -eq 1 ] &&
-    { [ $have_oiio_py -eq 0 ] || images_close "$tmp/s01.exr" "$tmp/mpi.exr" 0 1e-5; }; then
-    pass "mpirun -np 2 render --mpi gives the 16-spp render"
-  else
-    fail "render --mpi on 2 ranks"; cat "$tmp/out" "$tmp/err"
-  fi
-  # Every rank reports the error (rank-prefixed), and the job exits non-zero
-  if ! mpirun $mpirun_args "$mpi_bin" render "$scene" -o "$tmp/x.exr" --mpi --time 1 --width 8 --device pocl -q \
-    >"$tmp/out" 2>"$tmp/err" && grep -q "^candela: error: rank 0: --mpi needs --spp" "$tmp/err"; then
-    pass "--mpi with --time is refused"
-  else
-    fail "--mpi with --time is refused"; cat "$tmp/err"
-  fi
-fi
+# (tests/app/mpi_test.sh runs two ranks under mpirun: scripts/mpi-test)
 
 # Ctrl-C during a long render writes what was rendered and exits 130
 "$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \

@@ -194,5 +194,93 @@ else
   echo "skip: full-disk test (cannot mount a tmpfs here: not root?)"
 fi
 
+# ---- A scene's files: from its own folder only, regular files only ----
+# scene_with DIR NAME BUFFER_URI [IMAGE_URI]: a one-triangle glTF whose positions are in
+# BUFFER_URI (36 bytes) and, with IMAGE_URI, a base colour texture
+scene_with() {
+  "$py" - "$@" <<'PY'
+import json, sys
+d, name, buf = sys.argv[1:4]
+img = sys.argv[4] if len(sys.argv) > 4 else None
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+     "materials": [{"pbrMetallicRoughness": {}}],
+     "buffers": [{"uri": buf, "byteLength": 36}], "bufferViews": [{"buffer": 0, "byteLength": 36}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                    "min": [0, 0, 0], "max": [1, 1, 0]}]}
+if img:
+    g["images"] = [{"uri": img}]
+    g["textures"] = [{"source": 0}]
+    g["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+json.dump(g, open(f"{d}/{name}", "w"))
+PY
+}
+box=$tmp/box
+mkdir -p "$box/scene" "$box/outside"
+"$py" -c "import struct; open('$box/outside/tri.bin','wb').write(struct.pack('9f',0,0,0,1,0,0,0,1,0))"
+cp "$box/outside/tri.bin" "$box/scene/tri.bin"
+"$py" -c "import OpenImageIO as oiio; oiio.ImageBuf(oiio.ImageSpec(4, 4, 3, 'uint8')).write('$box/outside/private.png')"
+ln -s ../outside/tri.bin "$box/scene/link.bin"
+mkdir -p "$box/scene/folder.bin"
+mkfifo "$box/scene/fifo.bin"
+# escape REFERENCE PATTERN: a scene whose buffer is REFERENCE fails with one line matching PATTERN
+escape() {
+  scene_with "$box/scene" escape.gltf "$1"
+  "$bin" info "$box/scene/escape.gltf" >"$tmp/out" 2>"$tmp/err" &
+  local pid=$! waited=0
+  while [ -d "/proc/$pid" ] && [ $waited -lt 100 ]; do sleep 0.1; waited=$((waited + 1)); done
+  if [ -d "/proc/$pid" ]; then
+    kill -9 $pid
+    fail "buffer '$1': hangs"
+    return
+  fi
+  wait $pid
+  local rc=$?
+  if [ $rc -eq 1 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && grep -q "^candela: error: .*$2" "$tmp/err"; then
+    pass "buffer '$1': $(cut -c1-150 "$tmp/err")"
+  else
+    fail "buffer '$1' (exit $rc)"
+    cat "$tmp/err"
+  fi
+}
+escape "../outside/tri.bin" "leaves the scene's folder"
+escape "%2e%2e/outside/tri.bin" "leaves the scene's folder"
+escape "..%2Foutside%2Ftri.bin" "leaves the scene's folder"
+escape "$box/outside/tri.bin" "absolute path"
+escape "file://$box/outside/tri.bin" "URI with a scheme"
+escape "link.bin" "outside the scene's folder"
+escape "folder.bin" "is a folder, not a regular file"
+escape "fifo.bin" "is a FIFO, not a regular file"
+escape "missing.bin" "not found"
+# The user can allow more
+scene_with "$box/scene" outside.gltf "../outside/tri.bin"
+if "$bin" info "$box/scene/outside.gltf" --allow-outside-paths >/dev/null 2>"$tmp/err"; then
+  pass "--allow-outside-paths reads ../outside/tri.bin"
+else
+  fail "--allow-outside-paths reads ../outside/tri.bin"
+  cat "$tmp/err"
+fi
+# An image outside the folder is dropped with a warning naming the reason; the scene renders
+scene_with "$box/scene" image.gltf "tri.bin" "../outside/private.png"
+if "$bin" render "$box/scene/image.gltf" --device pocl -q -o "$tmp/img.png" --width 16 --spp 1 >/dev/null 2>"$tmp/err" &&
+  grep -q "leaves the scene's folder" "$tmp/err"; then
+  pass "an image outside the folder is dropped with a warning"
+else
+  fail "an image outside the folder is dropped with a warning"
+  cat "$tmp/err"
+fi
+# A data: URI that is not base64 drops its image with a warning
+scene_with "$box/scene" baddata.gltf "tri.bin" "data:image/png;base64,@@@not base64@@@"
+if "$bin" render "$box/scene/baddata.gltf" --device pocl -q -o "$tmp/bad.png" --width 16 --spp 1 >/dev/null 2>"$tmp/err"; then
+  pass "a bad data: URI image is dropped with a warning: $(grep -m1 warning "$tmp/err" | cut -c1-120)"
+else
+  fail "a bad data: URI image is dropped with a warning"
+  cat "$tmp/err"
+fi
+# Non-regular files named on the command line: one line, no hang
+one_error "a FIFO as the scene" -- timeout 20 "$bin" info "$box/scene/fifo.bin"
+one_error "/dev/zero as --env" -- timeout 20 "${render[@]}" -o "$tmp/never.png" --env /dev/zero --width 16
+one_error "a folder as --env" -- timeout 20 "${render[@]}" -o "$tmp/never.png" --env "$box" --width 16
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# MPI: two ranks under mpirun render the image of a single-process 16-spp render (the same
+# sample indices, split into blocks and merged by rank 0), and --mpi with --time is refused
+# on every rank. Needs a -DCANDELA_MPI=ON build and mpirun (scripts/mpi-test does both).
+# Usage: mpi_test.sh path/to/candela repo_root
+set -u
+bin=$1
+root=$2
+scene=$root/scenes/cornell-box/cornell-box.gltf
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passes=0
+fails=0
+pass() { passes=$((passes + 1)); echo "ok: $1"; }
+fail() { fails=$((fails + 1)); echo "FAIL: $1"; }
+command -v mpirun >/dev/null || { echo "mpirun not found (Debian: openmpi-bin)"; exit 1; }
+mpirun_args=(-np 2)
+[ "$(id -u)" = 0 ] && mpirun_args+=(--allow-run-as-root)
+mpirun --version 2>/dev/null | grep -q "Open MPI" && mpirun_args+=(--oversubscribe)
+shard=(--width 32 --height 32 --seed 7 --device pocl -q)
+
+"$bin" render "$scene" -o "$tmp/one.exr" --spp 16 "${shard[@]}" >/dev/null 2>"$tmp/err" || { cat "$tmp/err"; exit 1; }
+if mpirun "${mpirun_args[@]}" "$bin" render "$scene" -o "$tmp/mpi.exr" --mpi --spp 16 "${shard[@]}" \
+  --stats "$tmp/mpi.json" >"$tmp/out" 2>"$tmp/err" &&
+  python3 -c "import json; s = json.load(open('$tmp/mpi.json')); assert s['spp'] == 16 and s['mpi_ranks'] == 2, s" &&
+  [ "$(grep -c '^wrote' "$tmp/out")" -eq 1 ] &&
+  /usr/bin/python3 - "$tmp/one.exr" "$tmp/mpi.exr" <<'PY'
+import sys, numpy as np, OpenImageIO as oiio
+a, b = (oiio.ImageBuf(p).get_pixels(oiio.FLOAT) for p in sys.argv[1:3])
+d = np.abs(a - b).max() / max(np.abs(a).max(), 1e-30)
+print(f"max relative difference {d:.2e}")
+sys.exit(0 if d <= 1e-5 else 1)
+PY
+then
+  pass "mpirun -np 2 render --mpi gives the 16-spp render"
+else
+  fail "render --mpi on 2 ranks"
+  cat "$tmp/out" "$tmp/err"
+fi
+# Every rank reports the error (rank-prefixed), and the job exits non-zero
+if ! mpirun "${mpirun_args[@]}" "$bin" render "$scene" -o "$tmp/x.exr" --mpi --time 1 --width 8 --device pocl -q \
+  >"$tmp/out" 2>"$tmp/err" && grep -q "^candela: error: rank 0: --mpi needs --spp" "$tmp/err"; then
+  pass "--mpi with --time is refused"
+else
+  fail "--mpi with --time is refused"
+  cat "$tmp/err"
+fi
+echo "$passes passed, $fails failed"
+[ $fails -eq 0 ]
