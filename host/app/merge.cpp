@@ -100,8 +100,7 @@ Input read_input(const std::string& path) {
   if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
     throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
   x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
-  if (x.spp == 0)
-    throw Error("cannot merge " + path + ": it holds no complete pass of samples (candela:spp 0)");
+  if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no complete pass of samples (candela:spp 0)");
   x.ranges = ranges_of(x.img, path, x.spp);
   return x;
 }

@@ -1,15 +1,15 @@
 // `candela render`: its options, and the render from the scene file to the written images.
 #include "app/render_command.hpp"
 
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
-#include <cstdlib>
-#include <functional>
-#include <unistd.h>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <memory>
 
 #include "app/mpi_render.hpp"
@@ -83,9 +83,10 @@ void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
 
 // Several devices and machines (README): --sample-offset and --mpi; --device takes a list
 void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
-  render->add_option("--sample-offset", a->sample_offset,
-                     "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
-                     "stored as candela:sample_offset")
+  render
+      ->add_option("--sample-offset", a->sample_offset,
+                   "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
+                   "stored as candela:sample_offset")
       ->check(integer_in(0, 4294967295LL));
   render->add_flag("--mpi", a->mpi,
                    "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank "
@@ -99,12 +100,14 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
                          "Constant background radiance R,G,B (replaces the scene's background and environment map)");
   render->add_option("--env", a.env, "Equirectangular environment map (.hdr, .exr, .png, .jpg), replacing the scene's")
       ->excludes(background_opt);
-  render->add_option("--env-strength", a.env_strength,
-                     "Environment map strength, a radiance scale (default 1, or the scene's)")
+  render
+      ->add_option("--env-strength", a.env_strength,
+                   "Environment map strength, a radiance scale (default 1, or the scene's)")
       ->check(finite_number());
-  render->add_option(
-      "--env-rotation", a.env_rotation,
-      "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)")
+  render
+      ->add_option(
+          "--env-rotation", a.env_rotation,
+          "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)")
       ->check(finite_number());
   render->add_option("--default-light", a.default_light,
                      "The built-in studio environment: " + enum_names(kDefaultLightNames, true));
@@ -120,23 +123,26 @@ void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
 
 // The camera, replacing or changing the scene's
 void add_camera_render_options(CLI::App* render, RenderArgs& a) {
-  render->add_option("--camera", a.camera,
-                     "The scene's camera to render through, by index (candela info lists them; "
-                     "default 0, the first)")
+  render
+      ->add_option("--camera", a.camera,
+                   "The scene's camera to render through, by index (candela info lists them; "
+                   "default 0, the first)")
       ->check(integer_in(0, 1 << 30));
   render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
   render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
   render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
   render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)")
       ->check(finite_number());
-  render->add_option(
-      "--aperture", a.aperture,
-      "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)")
+  render
+      ->add_option(
+          "--aperture", a.aperture,
+          "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)")
       ->check(finite_number());
-  render->add_option("--focus-distance", a.focus_distance,
-                     "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
-                     "camera's extras, else the scene bounds' centre)")
-      ->check(positive_number());
+  render
+      ->add_option("--focus-distance", a.focus_distance,
+                   "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
+                   "camera's extras, else the scene bounds' centre)")
+      ->check(finite_number());
 }
 
 // Samples, size, devices and the path tracer's settings
@@ -229,6 +235,14 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
   settings->seed = a.seed;
   settings->max_depth = a.max_depth;
   settings->energy_compensation = !a.no_energy_compensation;
+  // CANDELA_LAUNCH_SECONDS: the target duration of one launch (default 0.2 s)
+  if (const char* text = std::getenv("CANDELA_LAUNCH_SECONDS")) {
+    char* end = nullptr;
+    double v = std::strtod(text, &end);
+    if (end == text || *end || !(v >= 1e-4 && v <= 60.0))
+      throw Error(std::string("CANDELA_LAUNCH_SECONDS must be seconds from 0.0001 to 60, not '") + text + "'");
+    settings->launch_seconds = v;
+  }
 }
 
 // The renderer of the scene through its camera, on the devices. Host memory: the loaded
@@ -313,7 +327,8 @@ void print_result(const RenderReport& report, bool partial_pass, const Film& fil
   if (partial_pass && report.spp == 0) {
     size_t with = 0;
     for (size_t p = 0; p < film.pixels(); ++p) with += film.samples(p) > 0;
-    std::fprintf(stderr, "note: stopped inside the first pass: %.1f %% of the pixels have samples, the others are black\n",
+    std::fprintf(stderr,
+                 "note: stopped inside the first pass: %.1f %% of the pixels have samples, the others are black\n",
                  100.0 * double(with) / double(std::max<size_t>(film.pixels(), 1)));
   } else if (partial_pass) {
     std::fprintf(stderr, "note: stopped inside a pass; some pixels hold more than %u samples\n", report.spp);

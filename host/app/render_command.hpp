@@ -36,10 +36,10 @@ struct RenderArgs {
   std::string filter = "box";
   std::string sampler = "sobol";
   bool quiet = false;
-  std::string variance;        // --variance: variance-of-the-mean image (render/image_stats.hpp)
-  bool generic = false;        // --generic: the kernel with every scene feature compiled in
-  uint32_t sample_offset = 0;  // --sample-offset: first sample index (shards, candela merge)
-  bool mpi = false;            // --mpi: spread the samples over the ranks of an MPI job
+  std::string variance;              // --variance: variance-of-the-mean image (render/image_stats.hpp)
+  bool generic = false;              // --generic: the kernel with every scene feature compiled in
+  uint32_t sample_offset = 0;        // --sample-offset: first sample index (shards, candela merge)
+  bool mpi = false;                  // --mpi: spread the samples over the ranks of an MPI job
   bool allow_outside_paths = false;  // --allow-outside-paths: scene files outside its folder
 };
 

@@ -13,9 +13,7 @@
 #include "scene/environment.hpp"
 
 namespace candela {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 void check_camera_options(const RenderArgs& a) {
   if (a.fov && !(*a.fov > 0 && *a.fov < 180)) throw Error("--fov must be between 0 and 180 degrees (exclusive)");
@@ -46,7 +44,8 @@ void check_camera_against_scene(const CameraDesc& cam, const Scene& scene) {
   Bounds b = scene.bounds();
   float extent = glm::length(b.hi - b.lo);
   if (cam.aperture_radius > 1000.0f * std::max(extent, cam.focus_distance.value_or(0.0f)))
-    throw Error("--aperture " + format_number(cam.aperture_radius) + " is more than 1000 times the scene's size: every point would be a blur");
+    throw Error("--aperture " + format_number(cam.aperture_radius) +
+                " is more than 1000 times the scene's size: every point would be a blur");
 }
 
 // --look-from, --look-at, --up; returns the look-at point's distance when it is given

@@ -12,8 +12,8 @@
 #include "base/atomic_file.hpp"
 #include "base/error.hpp"
 #include "base/hash.hpp"
-#include "compile/camera.hpp"
 #include "compile/bvh_builder.hpp"
+#include "compile/camera.hpp"
 
 namespace candela {
 namespace {
@@ -135,17 +135,17 @@ std::string lighting_fingerprint(const Scene& scene) {
 
 std::map<std::string, std::string> image_metadata(const RenderReport& r) {
   std::map<std::string, std::string> meta = {{"spp", std::to_string(r.spp)},
-          {"seconds", std::to_string(r.seconds)},
-          {"device", r.device},
-          {"seed", std::to_string(r.seed)},
-          {"strategy", r.strategy},
-          {"max_depth", std::to_string(r.max_depth)},
-          {"dropped_samples", std::to_string(r.dropped_samples)},
-          {"scene", r.scene},
-          {"energy_compensation", r.energy_compensation ? "on" : "off"},
-          {"filter", r.filter},
-          {"sampler", r.sampler},
-          {"sample_offset", std::to_string(r.sample_offset)}};
+                                             {"seconds", std::to_string(r.seconds)},
+                                             {"device", r.device},
+                                             {"seed", std::to_string(r.seed)},
+                                             {"strategy", r.strategy},
+                                             {"max_depth", std::to_string(r.max_depth)},
+                                             {"dropped_samples", std::to_string(r.dropped_samples)},
+                                             {"scene", r.scene},
+                                             {"energy_compensation", r.energy_compensation ? "on" : "off"},
+                                             {"filter", r.filter},
+                                             {"sampler", r.sampler},
+                                             {"sample_offset", std::to_string(r.sample_offset)}};
   if (!r.camera.empty()) meta["camera"] = r.camera;
   if (!r.lighting.empty()) meta["lighting"] = r.lighting;
   // Stopped inside a range: its pixels hold up to sample_end (merge refuses overlaps)

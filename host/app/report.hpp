@@ -25,8 +25,8 @@ struct RenderReport {
   std::string strategy, filter, sampler;
   bool energy_compensation = true;
   uint64_t dropped_samples = 0;
-  bool partial_pass = false;   // stopped inside a range of samples
-  uint64_t sample_end = 0;     // no pixel holds a sample index at or past this one
+  bool partial_pass = false;  // stopped inside a range of samples
+  uint64_t sample_end = 0;    // no pixel holds a sample index at or past this one
   // In the metadata only
   std::string scene;  // the scene file
   // Fingerprints (FNV-1a of the device camera record; of the background and environment

@@ -53,8 +53,7 @@ bool inside(const fs::path& inner, const fs::path& outer) {
 void check_regular_file(const std::string& path, const std::string& what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) throw Error(what + " not found: " + path);
-  if (!S_ISREG(st.st_mode))
-    throw Error(what + " " + path + " is " + kind_of(st.st_mode) + ", not a regular file");
+  if (!S_ISREG(st.st_mode)) throw Error(what + " " + path + " is " + kind_of(st.st_mode) + ", not a regular file");
 }
 
 std::string read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes) {
@@ -62,8 +61,7 @@ std::string read_regular_file(const std::string& path, const std::string& what, 
   std::error_code ec;
   uintmax_t size = fs::file_size(path, ec);
   if (ec) throw Error("cannot read " + what + " " + path + ": " + ec.message());
-  if (size > max_bytes)
-    throw Error(what + " " + path + " is larger than " + std::to_string(max_bytes >> 20) + " MiB");
+  if (size > max_bytes) throw Error(what + " " + path + " is larger than " + std::to_string(max_bytes >> 20) + " MiB");
   std::string data(size_t(size), '\0');
   std::ifstream in(path, std::ios::binary);
   if (!in || !in.read(data.data(), std::streamsize(size)) || in.gcount() != std::streamsize(size))
@@ -85,8 +83,7 @@ std::string SceneFolder::resolve(const std::string& reference, const std::string
   if (ec) throw Error("cannot resolve the scene's folder " + root + ": " + ec.message());
   fs::path joined = fs::absolute(fs::path(root) / reference).lexically_normal();
   fs::path lexical_base = fs::absolute(root).lexically_normal();
-  if (!inside(joined, lexical_base))
-    throw Error(what + " '" + reference + "' leaves the scene's folder" + hint);
+  if (!inside(joined, lexical_base)) throw Error(what + " '" + reference + "' leaves the scene's folder" + hint);
   fs::path real = fs::weakly_canonical(joined, ec);  // symbolic links resolved
   if (ec) real = joined;
   if (!inside(real, base))

@@ -3,8 +3,8 @@
 // files glTF allows written in.
 #include <algorithm>
 #include <cctype>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string_view>
 
 #include "base/error.hpp"
@@ -223,8 +223,8 @@ bool patch_document(const std::string& data, size_t json_begin, size_t json_size
 
 }  // namespace
 
-const std::string& prepare_document(const std::string& data, bool binary, const std::string& name,
-                                    std::string* patched, std::set<int>* bad_images) {
+const std::string& prepare_document(const std::string& data, bool binary, const std::string& name, std::string* patched,
+                                    std::set<int>* bad_images) {
   size_t json_begin = 0, json_size = data.size();  // a GLB's JSON is its first chunk
   if (binary && data.size() >= 20) {
     uint32_t length = 0;  // little-endian, at byte 12

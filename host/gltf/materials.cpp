@@ -153,8 +153,7 @@ void add_volume_absorption(const tinygltf::Material& gm, const std::string& name
 void read_interior(ReadContext& ctx, const tinygltf::Material& gm, const std::string& name, MaterialDesc* m) {
   bool has_extra = gm.extras.Has("candela") && gm.extras.Get("candela").Has("medium");
   MediumDesc md;
-  if (has_extra)
-    md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", ctx.folder);
+  if (has_extra) md = read_medium(gm.extras.Get("candela").Get("medium"), name + " extras.candela.medium", ctx.folder);
   bool solid = m->transmission > 0.0f && !m->thin_walled;
   if (solid) {
     add_volume_absorption(gm, name, &md);

@@ -2,7 +2,6 @@
 // and each reader's entry point (one file per glTF concept; loader.cpp runs them).
 #pragma once
 
-
 #include <tiny_gltf.h>
 
 #include <cstdint>
@@ -74,8 +73,8 @@ void decode_meshopt_views(tinygltf::Model* model);
 // document.cpp: the bytes tinygltf parses (`data` itself or *patched); Error for JSON nested
 // deeper than kMaxJsonDepth. *bad_images gets the images whose data: URI does not decode
 // (replaced by a stand-in that load_checked_image drops).
-const std::string& prepare_document(const std::string& data, bool binary, const std::string& name,
-                                    std::string* patched, std::set<int>* bad_images);
+const std::string& prepare_document(const std::string& data, bool binary, const std::string& name, std::string* patched,
+                                    std::set<int>* bad_images);
 
 // images.cpp: tinygltf's image decoding behind the size checks (a tinygltf::LoadImageDataFunction)
 bool load_checked_image(tinygltf::Image* image, int index, std::string* err, std::string* warn, int req_width,

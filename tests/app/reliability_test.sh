@@ -79,7 +79,8 @@ check_signal() {
   local code=130
   [ "$sig" = TERM ] && code=143
   rm -f "$tmp"/sig.*
-  CANDELA_RAISE_AT=$phase:$sig "${render[@]}" -o "$tmp/sig.exr" -o "$tmp/sig.png" --stats "$tmp/sig.json" \
+  # launches of a millisecond: every pass takes several, so each phase is reached
+  CANDELA_LAUNCH_SECONDS=0.001 CANDELA_RAISE_AT=$phase:$sig "${render[@]}" -o "$tmp/sig.exr" -o "$tmp/sig.png" --stats "$tmp/sig.json" \
     --width "$width" --spp 8 >"$tmp/out" 2>"$tmp/err"
   local rc=$? got=none
   if [ -s "$tmp/sig.exr" ] && [ -s "$tmp/sig.png" ] && [ -s "$tmp/sig.json" ]; then
@@ -108,7 +109,7 @@ check_signal() {
 for sig in INT TERM; do
   check_signal loading $sig none 64
   check_signal kernel-build $sig none 64
-  check_signal first-pass $sig partial 160  # 160x120: the first pass takes several launches
+  check_signal first-pass $sig partial 160
   check_signal later-pass $sig some 64
   check_signal writing $sig all 64
 done
@@ -135,9 +136,10 @@ else
 fi
 
 # ---- Shards: merge refuses overlaps, interrupted ones included, and differing settings ----
-# Stopped inside its second range (320 px wide: later ranges take several launches), the
+# Stopped inside its second range (launches of a millisecond: a range takes several), the
 # shard holds sample indices past its whole passes: a shard that starts there overlaps it
-CANDELA_RAISE_AT=mid-pass:INT "${render[@]}" -o "$tmp/cut.exr" --width 320 --spp 8 >/dev/null 2>&1
+CANDELA_LAUNCH_SECONDS=0.001 CANDELA_RAISE_AT=mid-pass:INT "${render[@]}" -o "$tmp/cut.exr" --width 320 --spp 8 \
+  >/dev/null 2>&1
 cut_spp=$(meta "$tmp/cut.exr" spp)
 cut_ranges=$(meta "$tmp/cut.exr" sample_ranges)
 cut_end=${cut_ranges#*:}
