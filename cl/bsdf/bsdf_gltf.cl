@@ -245,7 +245,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   }
   if (t > 0.0f) {
     float glass_p;
-    under += (1.0f - m) * t * bsdf_dielectric_eval(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
+    under += (1.0f - m) * t * energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi,
+                                                       &glass_p);
     *pdf += w[GLTF_GLASS] * glass_p;
   }
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
@@ -323,7 +324,7 @@ int gltf_ms_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2
 // A delta transmission crosses the coat once, at the angle of the direction outside
 int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  if (!bsdf_dielectric_sample(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
+  if (!energy_dielectric_sample(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
     return GLTF_SAMPLE_FAILED;
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
   float att =
