@@ -195,7 +195,7 @@ float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
-  float base_norm;  // gltf_coat_base_norm
+  float base_norm;                // gltf_coat_base_norm
   float w[GLTF_COMPONENT_COUNT];  // selection probabilities by GLTF_* id, summing to 1 (or all 0)
 } GltfAtWo;
 
@@ -272,8 +272,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   }
   if (t > 0.0f) {
     float glass_p;
-    under += (1.0f - m) * t * energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi,
-                                                       &glass_p);
+    under += (1.0f - m) * t *
+             energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
     *pdf += w[GLTF_GLASS] * glass_p;
   }
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the

@@ -179,12 +179,12 @@ typedef struct {
   bool on;
   bool thin;
   float eta;
-  GgxEnergy ggx;           // thin sheets: the GGX table
-  DielectricEnergy diel;   // volumetric interfaces: the dielectric table
-  float e_o;               // single-scattering albedo at wo
-  float refl, trans;       // a_s and c
-  float q;                 // probability of sampling the compensation lobe: 1 - e_o
-  float p_refl;            // within it, the share of reflection: a_s A_s
+  GgxEnergy ggx;          // thin sheets: the GGX table
+  DielectricEnergy diel;  // volumetric interfaces: the dielectric table
+  float e_o;              // single-scattering albedo at wo
+  float refl, trans;      // a_s and c
+  float q;                // probability of sampling the compensation lobe: 1 - e_o
+  float p_refl;           // within it, the share of reflection: a_s A_s
 } DielectricMs;
 
 DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta, bool thin, float mu_o) {
@@ -268,8 +268,7 @@ bool energy_dielectric_sample(__global const float* table, Ggx g, float eta, boo
     float v = uc / m.q;
     bs->wi = sample_cosine_hemisphere(u.x, u.y);
     if (v >= m.p_refl) bs->wi.z = -bs->wi.z;
-  } else if (!bsdf_dielectric_sample(g, eta, thin, tint, wo, fmin((uc - m.q) / (1.0f - m.q), 0x1.fffffep-1f), u,
-                                     bs)) {
+  } else if (!bsdf_dielectric_sample(g, eta, thin, tint, wo, fmin((uc - m.q) / (1.0f - m.q), 0x1.fffffep-1f), u, bs)) {
     return false;
   }
   bool transmits = bs->wi.z < 0.0f;

@@ -167,9 +167,10 @@ TEST(EnergyDielectric, TableMatchesConvergedQuadrature) {
     EXPECT_GE(looked[k].s[1], 0.0f);
     EXPECT_LE(looked[k].s[1], 1.0f);
   }
-  std::printf("worst lookup error %.2e over %zu queries; e.g. eta 1.5 roughness 1: E(1) %.4f, E_avg %.4f; "
-              "inside: E(1) %.4f, E_avg %.4f\n",
-              worst, q.size(), looked[39].s[0], looked[39].s[1], looked[99].s[0], looked[99].s[1]);
+  std::printf(
+      "worst lookup error %.2e over %zu queries; e.g. eta 1.5 roughness 1: E(1) %.4f, E_avg %.4f; "
+      "inside: E(1) %.4f, E_avg %.4f\n",
+      worst, q.size(), looked[39].s[0], looked[39].s[1], looked[99].s[0], looked[99].s[1]);
 }
 
 // White glass returns every photon: X-albedo 1 from outside, from inside (total internal
@@ -189,15 +190,19 @@ TEST(EnergyDielectric, WhiteGlassAlbedoIsOneFromBothSides) {
           Albedo without = albedo(r, white, false, front, at_angle(theta), seed++);
           Albedo tint = albedo(r, tinted, true, front, at_angle(theta), seed++);
           std::printf("  %s roughness %.1f theta %2.0f: X-albedo %.5f +- %.5f compensated, %.5f not; tinted %.4f\n",
-                      thin ? "thin sheet" : front ? "outside   " : "inside    ", roughness, theta,
-                      with.channel[1].mean, with.channel[1].standard_error, without.channel[1].mean,
+                      thin    ? "thin sheet"
+                      : front ? "outside   "
+                              : "inside    ",
+                      roughness, theta, with.channel[1].mean, with.channel[1].standard_error, without.channel[1].mean,
                       tint.channel[0].mean);
           EXPECT_EQ(with.disagree, 0u);
           EXPECT_EQ(tint.disagree, 0u);
           for (int c = 0; c < 3; ++c) {
             const Estimate& e = with.channel[c];
-            EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01)
-                << (thin ? "thin " : front ? "outside " : "inside ") << roughness << " theta " << theta;
+            EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01) << (thin    ? "thin "
+                                                                        : front ? "outside "
+                                                                                : "inside ")
+                                                                    << roughness << " theta " << theta;
             EXPECT_LE(tint.channel[c].mean, 1.0 + 4.0 * tint.channel[c].standard_error + 0.01);
             EXPECT_LE(without.channel[c].mean, 1.0 + 4.0 * without.channel[c].standard_error);
           }
@@ -238,7 +243,10 @@ TEST(EnergyDielectric, EvalIsReciprocalAndConservesEnergy) {
           }
           Estimate e = sample_mean(w, 1);
           std::printf("  eval-based X-albedo, %s roughness %.1f theta %2.0f: %.4f +- %.4f\n",
-                      thin ? "thin   " : front ? "outside" : "inside ", roughness, theta, e.mean, e.standard_error);
+                      thin    ? "thin   "
+                      : front ? "outside"
+                              : "inside ",
+                      roughness, theta, e.mean, e.standard_error);
           EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01);
         }
       // Reciprocity: random pairs, wo from the front or the back; the swapped pair is seen
@@ -295,10 +303,11 @@ TEST(EnergyClearcoat, WhiteLambertUnderClearCoatReflectsAll) {
       Albedo with = albedo(r, lambert, true, true, at_angle(theta), seed++);
       Albedo without = albedo(r, lambert, false, true, at_angle(theta), seed++);
       Albedo over_plastic = albedo(r, plastic, true, true, at_angle(theta), seed++);
-      std::printf("  clear coat roughness %.1f theta %2.0f: Lambert base %.5f +- %.5f compensated, %.5f not; "
-                  "plastic base %.5f\n",
-                  coat_roughness, theta, with.channel[1].mean, with.channel[1].standard_error, without.channel[1].mean,
-                  over_plastic.channel[1].mean);
+      std::printf(
+          "  clear coat roughness %.1f theta %2.0f: Lambert base %.5f +- %.5f compensated, %.5f not; "
+          "plastic base %.5f\n",
+          coat_roughness, theta, with.channel[1].mean, with.channel[1].standard_error, without.channel[1].mean,
+          over_plastic.channel[1].mean);
       EXPECT_EQ(with.disagree, 0u);
       EXPECT_EQ(over_plastic.disagree, 0u);
       worst_without = std::min(worst_without, without.channel[1].mean);
@@ -326,11 +335,10 @@ TEST_P(EnergyGlassFurnace, WhiteRoughGlassSpheresVanish) {
       GltfBuilder g;
       json ext = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}};
       if (!thin) ext["KHR_materials_volume"] = {{"thicknessFactor", 1.0}};
-      int mat = g.add("materials", {{"pbrMetallicRoughness",
-                                     {{"baseColorFactor", {1, 1, 1, 1}},
-                                      {"metallicFactor", 0.0},
-                                      {"roughnessFactor", roughness}}},
-                                    {"extensions", ext}});
+      int mat = g.add("materials",
+                      {{"pbrMetallicRoughness",
+                        {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", roughness}}},
+                       {"extensions", ext}});
       g.add_node({{"mesh", g.add_mesh({sphere_primitive(glm::vec3(0.0f), 1.0f, 3, mat)})}});
       g.add_camera({0, 0, 3.2f}, {0, 0, 0}, 0.75f);
       g.set_background({1, 1, 1});
