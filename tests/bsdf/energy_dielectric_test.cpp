@@ -15,6 +15,7 @@
 #include "device/energy.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
+#include "support/kernels.hpp"
 #include "support/test_support.hpp"
 
 namespace candela::test {
@@ -51,7 +52,7 @@ dev::Material glass(double roughness, bool thin, glm::dvec3 tint = glm::dvec3(1.
 }
 
 struct DielectricRig {
-  KernelRig rig{pocl_device()};
+  const KernelRig& rig = kernel_rig("pocl");
   // From the kernel cache (TableMatchesConvergedQuadrature computes its own afresh)
   GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file);
 
