@@ -22,6 +22,7 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/bsdf_diffuse.cl
   cl/bsdf/bsdf_conductor.cl
   cl/bsdf/bsdf_dielectric.cl
+  cl/bsdf/energy_dielectric.cl
   cl/bsdf/bsdf_gltf.cl
   cl/bsdf/bsdf.cl
   cl/lights/environment.cl

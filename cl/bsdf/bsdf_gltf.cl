@@ -10,7 +10,8 @@
 //            thin-walled or refracting (bsdf_dielectric.cl, exact Fresnel)
 //   ms:      with the GGX albedo table, the multiple scattering of the metal and plastic
 //            GGX lobes (energy.cl, Kulla & Conty 2017), each coloured by its Schlick
-//            term's average. Neither the coat nor the glass has one.
+//            term's average. The glass has its own (energy_dielectric.cl); the coat has
+//            none (F_avg ~ 0.09: under 1 %).
 // Layering (albedo scaling, Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017): what lies
 // below a layer gets the light the layer does not reflect. With A(mu) the layer's
 // directional albedo (the largest channel), the diffuse base is weighted by
@@ -19,9 +20,10 @@
 // reflects 1 at every angle. A comes from the GGX albedo table (E, E5 and the multiple-
 // scattering term); without the table (no compensation) A = Schlick's F(mu), exact only for
 // smooth layers, and the division is left out so that no rough layer can create energy.
-// The coat's attenuation has no division either: a base that is not Lambertian (plastic's
-// own specular peak) would gain energy from it; a white Lambert base under a clear coat
-// reflects about 93 % instead of 1 (its light trapped under the coat is not returned).
+// The coat's attenuation of specular lobes has no division: one that is not Lambertian would
+// gain energy from it. The diffuse base under the coat is normalized by the coat's and the
+// specular layer's joint transmittance (gltf_coat_base_norm), so a white Lambert base under a
+// clear coat returns the light trapped under the coat.
 // Sampling picks a component with a probability from its estimated weight at wo (the
 // lecture's combined BSDF); eval and pdf sum every non-delta component, so sampling and
 // evaluation describe the same mixture.
@@ -151,6 +153,29 @@ float gltf_below(const GltfLayer* l, float cos_i) {
   return fmax(l->normalized ? w / (1.0f - l->a_avg) : w, 0.0f);
 }
 
+// The diffuse base under the coat and the specular layer gets their transmittance
+// T = (1 - A_c)(1 - A_s) at both directions, normalized by T_avg = 2 integral of T mu dmu
+// (as gltf_below does for one layer): a white base returns exactly T(mu_o), and the light
+// trapped under the coat is not lost. Returns the factor (1 - A_s,avg) / T_avg that turns the
+// specular layer's own normalization into this one; 1 without the table or the coat.
+// T_avg by 8-point Gauss-Legendre quadrature on [0, 1/4] and [1/4, 1] (A is steep at grazing).
+float gltf_coat_base_norm(const Bsdf* b, const GltfLayer* coat, const GltfLayer* spec) {
+  if (b->lobe.gltf.coat <= 0.0f || !spec->normalized || !b->ggx_albedo) return 1.0f;
+  const float x[4] = {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f};
+  const float w[4] = {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f};
+  float sum = 0.0f;
+  for (int part = 0; part < 2; ++part) {
+    float c = part ? 0.625f : 0.125f, h = part ? 0.375f : 0.125f;
+    for (int k = 0; k < 4; ++k)
+      for (int sign = -1; sign <= 1; sign += 2) {
+        float mu = c + (float)sign * h * x[k];
+        float t = (1.0f - gltf_layer_albedo(coat, mu)) * (1.0f - gltf_layer_albedo(spec, mu));
+        sum += 2.0f * h * w[k] * mu * t;
+      }
+  }
+  return sum > 0.0f ? (1.0f - spec->a_avg) / sum : 1.0f;
+}
+
 // Colour of the multiple-scattering lobe: each lobe's weight times its F_ms
 float3 gltf_ms_fresnel(const Bsdf* b, const GgxEnergy* e) {
   const GltfBsdf* lobe = &b->lobe.gltf;
@@ -170,6 +195,7 @@ float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
+  float base_norm;                // gltf_coat_base_norm
   float w[GLTF_COMPONENT_COUNT];  // selection probabilities by GLTF_* id, summing to 1 (or all 0)
 } GltfAtWo;
 
@@ -206,6 +232,7 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
   g.e = gltf_energy(b, cos_o);
   g.spec = gltf_spec_layer(b, &g.e, cos_o);
   g.coat = gltf_coat_layer(b, cos_o);
+  g.base_norm = gltf_coat_base_norm(b, &g.coat, &g.spec);
 #define GLTF_WEIGHT(id, name, kind) g.w[id] = gltf_##name##_weight(b, &g, cos_o);
   GLTF_COMPONENTS(GLTF_WEIGHT)
 #undef GLTF_WEIGHT
@@ -232,7 +259,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
     bool glossy = m > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
     if (glossy) d = ggx_reflection_eval(lobe->ggx, wo, wi, &p, &cos_h);
     float3 fd = glossy ? fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_h) : (float3)(0.0f);
-    under = (1.0f - m) * (1.0f - t) * gltf_below(&spec, wi.z) * b->base_color * INV_PI_F;
+    under = (1.0f - m) * (1.0f - t) * gltf_below(&spec, wi.z) * g->base_norm * b->base_color * INV_PI_F;
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
@@ -245,7 +272,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   }
   if (t > 0.0f) {
     float glass_p;
-    under += (1.0f - m) * t * bsdf_dielectric_eval(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
+    under += (1.0f - m) * t *
+             energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
     *pdf += w[GLTF_GLASS] * glass_p;
   }
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
@@ -323,7 +351,7 @@ int gltf_ms_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2
 // A delta transmission crosses the coat once, at the angle of the direction outside
 int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  if (!bsdf_dielectric_sample(lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
+  if (!energy_dielectric_sample(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
     return GLTF_SAMPLE_FAILED;
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
   float att =

@@ -123,8 +123,18 @@
 // for mu), then its hemispherical average at GGX_ALBEDO_N roughnesses
 #define GGX_ALBEDO_N 32
 #define GGX_ALBEDO_HALF (GGX_ALBEDO_N * (GGX_ALBEDO_N + 1))
-#define GGX_ALBEDO_SIZE (2 * GGX_ALBEDO_HALF)
 #define GGX_ALBEDO_QUADRATURE 64  // quadrature points per side of each entry
+// Then the rough dielectric's albedo (cl/bsdf/energy_dielectric.cl): reflection plus
+// transmission E(y, roughness, eta) for each side (0: eta >= 1, 1: eta < 1), y fastest, then
+// its hemispherical averages by (roughness, eta, side)
+#define DIEL_ALBEDO_OFFSET (2 * GGX_ALBEDO_HALF)
+#define DIEL_ALBEDO_N 32           // nodes in y
+#define DIEL_ALBEDO_R 16           // nodes in glTF roughness
+#define DIEL_ALBEDO_F 16           // nodes in 2 (eta - 1) / (eta + 1), eta in [1, 3]
+#define DIEL_ALBEDO_QUADRATURE 48  // quadrature points per side of each entry
+#define DIEL_ALBEDO_ROWS (2 * DIEL_ALBEDO_F * DIEL_ALBEDO_R)
+#define DIEL_ALBEDO_SIZE (DIEL_ALBEDO_ROWS * (DIEL_ALBEDO_N + 1))
+#define GGX_ALBEDO_SIZE (DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_SIZE)  // the whole buffer
 
 #define NO_TEXTURE (-1)
 #define NO_LIGHT (-1)

@@ -164,9 +164,9 @@ void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
       ->check(integer_in(0, 100000));
   render->add_option("--strategy", a.strategy,
                      enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else nee");
-  render->add_flag(
-      "--no-energy-compensation", a.no_energy_compensation,
-      "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");
+  render->add_flag("--no-energy-compensation", a.no_energy_compensation,
+                   "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
+                   "default: rough metal and glass keep their albedo)");
 }
 
 void check_variance_path(const RenderArgs& a) {

@@ -13,6 +13,13 @@ namespace {
 
 constexpr size_t kBytes = GGX_ALBEDO_SIZE * sizeof(float);
 
+// Every entry an albedo in [0, 1] (NaN fails)
+bool valid(const std::vector<float>& table) {
+  for (float e : table)
+    if (!(e >= 0.0f && e <= 1.0f)) return false;
+  return true;
+}
+
 std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                  cl::Buffer* buffer) {
   *buffer = cl::Buffer(context, CL_MEM_READ_WRITE, kBytes);
@@ -22,10 +29,15 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   average.setArg(0, *buffer);
   queue.enqueueNDRangeKernel(albedo, cl::NullRange, cl::NDRange(GGX_ALBEDO_N, GGX_ALBEDO_N));
   queue.enqueueNDRangeKernel(average, cl::NullRange, cl::NDRange(GGX_ALBEDO_N, 2));
+  cl::Kernel diel(program, "energy_dielectric_albedo_table"), diel_average(program, "energy_dielectric_average_table");
+  diel.setArg(0, *buffer);
+  diel.setArg(1, cl_uint(DIEL_ALBEDO_QUADRATURE));
+  diel_average.setArg(0, *buffer);
+  queue.enqueueNDRangeKernel(diel, cl::NullRange, cl::NDRange(DIEL_ALBEDO_N, DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
+  queue.enqueueNDRangeKernel(diel_average, cl::NullRange, cl::NDRange(DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
   std::vector<float> table(GGX_ALBEDO_SIZE);
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
-  for (float e : table)
-    if (!(e >= 0.0f && e <= 1.0f)) throw Error("the device computed GGX albedos outside [0, 1]");
+  if (!valid(table)) throw Error("the device computed GGX albedos outside [0, 1]");
   return table;
 }
 
@@ -38,8 +50,10 @@ GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQue
   std::string path = program_cache_file.empty() ? "" : program_cache_file + ".ggx_albedo";
   try {
     std::vector<unsigned char> cached = path.empty() ? std::vector<unsigned char>() : read_cache_entry(path);
-    if (cached.size() == kBytes) {
-      t.buffer = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kBytes, cached.data());
+    std::vector<float> loaded(cached.size() == kBytes ? GGX_ALBEDO_SIZE : 0);
+    if (!loaded.empty()) std::memcpy(loaded.data(), cached.data(), kBytes);
+    if (!loaded.empty() && valid(loaded)) {  // the cache entry's checksum is read_cache_entry's
+      t.buffer = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kBytes, loaded.data());
       t.from_cache = true;
     } else {
       std::vector<float> table = compute_table(context, queue, program, &t.buffer);

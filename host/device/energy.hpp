@@ -9,7 +9,7 @@
 namespace candela {
 
 struct GgxAlbedoTable {
-  cl::Buffer buffer;  // GGX_ALBEDO_SIZE floats
+  cl::Buffer buffer;  // GGX_ALBEDO_SIZE floats: the GGX and the dielectric tables
   double seconds = 0.0;
   bool from_cache = false;
 };

@@ -87,10 +87,11 @@ dev::Material conductor(glm::dvec3 eta, glm::dvec3 k, double roughness) {
   return m;
 }
 
-// The PoCL test program and its GGX albedo table, computed afresh (no cache)
+// The PoCL test program and its albedo tables, from the kernel cache (computed by the first
+// test process; EnergyDielectric.TableMatchesConvergedQuadrature checks a fresh computation)
 struct EnergyRig {
   const KernelRig& rig = kernel_rig("pocl");
-  GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, "");
+  GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file);
 
   // (E(mu), E_avg, E5(mu), E5_avg) as the lobes look them up, for (mu, roughness) queries
   std::vector<cl_float4> lookup(const std::vector<cl_float2>& q) {
