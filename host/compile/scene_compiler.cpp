@@ -83,6 +83,8 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   g.clearcoat_roughness = m.clearcoat_roughness;
   g.anisotropy_strength = m.anisotropy_strength;
   g.anisotropy_rotation = m.anisotropy_rotation;
+  for (int c = 0; c < 3; ++c) g.sheen[c] = m.sheen_color[c];
+  g.sheen[3] = m.sheen_roughness;
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {
