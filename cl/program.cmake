@@ -25,6 +25,7 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/bsdf_dielectric.cl
   cl/bsdf/bsdf_gltf.cl
   cl/bsdf/bsdf.cl
+  cl/bsdf/unlit.cl
   cl/lights/environment.cl
   cl/lights/lights.cl
   cl/media/phase.cl

@@ -27,6 +27,7 @@
   X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material shaded as MATERIAL_GLTF (kernel_type)") \
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
   X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
+  X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
 // clang-format on
@@ -58,6 +59,7 @@
 #define MATERIAL_ALPHA_MASK 4u      // alphaMode MASK: cut out below alpha_cutoff
 #define MATERIAL_ALPHA_BLEND 8u     // alphaMode BLEND: stochastic opacity
 #define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
+#define MATERIAL_UNLIT 32u          // KHR_materials_unlit: shows its base colour, ends paths
 
 // Texture slots of a material (Material.textures)
 #define TEX_BASE_COLOR 0

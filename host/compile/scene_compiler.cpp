@@ -107,6 +107,7 @@ void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
     d.flags |= m.null_boundary ? MATERIAL_NULL_BOUNDARY : 0u;
+    d.flags |= m.unlit ? MATERIAL_UNLIT : 0u;
     d.medium = NO_MEDIUM;  // compile_media sets the insides of closed surfaces
     d.alpha_cutoff = m.alpha_cutoff;
     d.normal_scale = m.normal_scale;

@@ -120,6 +120,11 @@ void read_sheen(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m)
   set_texture_slot(ctx, m, TEX_SHEEN_ROUGHNESS, sh, "sheenRoughnessTexture", false);
 }
 
+// KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
+void read_unlit(const tinygltf::Material& gm, MaterialDesc* m) {
+  m->unlit = gm.extensions.count("KHR_materials_unlit") > 0;
+}
+
 // extras.candela.conductor: a preset name or {"eta": [r, g, b], "k": [r, g, b]}
 void read_conductor(const tinygltf::Value& extras, const std::string& name, MaterialDesc* m) {
   if (!extras.Has("candela") || !extras.Get("candela").Has("conductor")) return;
@@ -233,6 +238,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_clearcoat(ctx, gm, &m);
   read_anisotropy(ctx, gm, &m);
   read_sheen(ctx, gm, &m);
+  read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);
   check_ranges(name, &m);

@@ -10,7 +10,7 @@ namespace candela {
 uint32_t MaterialDesc::kernel_type() const {
   bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f &&
                     sheen_color == glm::vec3(0.0f);
-  return type == MATERIAL_GLTF && lambertian ? MATERIAL_DIFFUSE : type;
+  return unlit || (type == MATERIAL_GLTF && lambertian) ? MATERIAL_DIFFUSE : type;
 }
 
 bool MaterialDesc::has_sheen() const {
@@ -80,6 +80,7 @@ SceneFeatures Scene::features() const {
     f.alpha |= materials.at(m.material).alpha_tested();
     f.media |= materials.at(m.material).medium >= 0;
     f.sheen |= materials.at(m.material).has_sheen();
+    f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)
     if (bool SceneFeatures::*flag = material_feature(materials.at(m.material).kernel_type())) f.*flag = true;
