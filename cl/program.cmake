@@ -18,6 +18,7 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/fresnel.cl
   cl/bsdf/microfacet.cl
   cl/bsdf/energy.cl
+  cl/bsdf/sheen.cl
   cl/bsdf/bsdf_common.cl
   cl/bsdf/bsdf_diffuse.cl
   cl/bsdf/bsdf_conductor.cl
@@ -25,6 +26,7 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/energy_dielectric.cl
   cl/bsdf/bsdf_gltf.cl
   cl/bsdf/bsdf.cl
+  cl/bsdf/unlit.cl
   cl/lights/environment.cl
   cl/lights/lights.cl
   cl/media/phase.cl

@@ -27,6 +27,11 @@ typedef struct {
   bool thin;   // a thin-walled sheet: transmission does not bend
   float coat;  // clearcoat weight
   Ggx coat_ggx;
+#if CD_FEATURE_SHEEN
+  float3 sheen;                        // KHR_materials_sheen colour (0: no sheen layer)
+  float sheen_roughness;               // its roughness r (alpha = r^2)
+  __global const float* sheen_albedo;  // its albedo table (sheen.cl); 0: no albedo scaling
+#endif
 } GltfBsdf;
 
 // Parameters of a MATERIAL_CONDUCTOR BSDF at a shading point (bsdf_conductor.cl)

@@ -3,6 +3,11 @@
 //   coat:    clearcoat * F_c * GGX(coat roughness), F_c = Schlick(0.04, 1); it attenuates
 //            reflections below by (1 - A_c(mu_o)) (1 - A_c(mu_i)) and transmissions by
 //            1 - A_c at the outside direction's angle, A_c = the coat's albedo
+//   sheen:   (CD_FEATURE_SHEEN) sheen colour * Charlie sheen (sheen.cl) / max(1, E(mu_o),
+//            E(mu_i)), below the coat; it scales reflections below by min(1 - c E(mu_o),
+//            1 - c E(mu_i)) (the extension's albedo scaling, c = max3(sheen colour), E its
+//            albedo table, taken at most 1) and transmissions by 1 - c E at the outside
+//            direction's angle
 //   metal:   metallic * Schlick(base color, 1) * GGX
 //   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + W(mu_o, mu_i) * base / pi],
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
@@ -35,16 +40,20 @@
 // and a term of f and pdf in gltf_eval_at, which adds the components in its own order: the
 // metal and plastic specular lobes share one microfacet evaluation, and the coat is a layer
 // over the others rather than a term beside them.
+// A component compiled out by its feature has weight 0; the last component (glass) is
+// always compiled in, so a zero-width one is never chosen.
 #define GLTF_COAT 0u
-#define GLTF_METAL 1u
-#define GLTF_SPEC 2u
-#define GLTF_DIFFUSE 3u
-#define GLTF_MS 4u
-#define GLTF_GLASS 5u
+#define GLTF_SHEEN 1u
+#define GLTF_METAL 2u
+#define GLTF_SPEC 3u
+#define GLTF_DIFFUSE 4u
+#define GLTF_MS 5u
+#define GLTF_GLASS 6u
 // One entry per line, columns aligned:
 // clang-format off
 #define GLTF_COMPONENTS(X)               \
   X(GLTF_COAT, coat, BSDF_GLOSSY)        \
+  X(GLTF_SHEEN, sheen, BSDF_GLOSSY)      \
   X(GLTF_METAL, metal, BSDF_GLOSSY)      \
   X(GLTF_SPEC, spec, BSDF_GLOSSY)        \
   X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE) \
@@ -80,7 +89,15 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   lobe->coat = g->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
   float coat_rough = g->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
   lobe->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);
-  if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f)
+  bool layered = false;  // an extension's layer or lobe at this point
+#if CD_FEATURE_SHEEN
+  lobe->sheen = load3(g->sheen) * bsdf_texture(sc, m, TEX_SHEEN_COLOR, s).xyz;
+  lobe->sheen_roughness = g->sheen[3] * bsdf_texture(sc, m, TEX_SHEEN_ROUGHNESS, s).w;
+  lobe->sheen_albedo = sc->sheen_albedo;
+  layered = layered || max_component(lobe->sheen) > 0.0f;
+#endif
+  if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f &&
+      !layered)
     b->type = MATERIAL_DIFFUSE;
 }
 
@@ -190,41 +207,78 @@ float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
   return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i));
 }
 
+#if CD_FEATURE_SHEEN
+// The sheen's albedo E(mu) with colour 1 (0 without the table)
+float gltf_sheen_e(const Bsdf* b, float mu) {
+  return sheen_albedo(b->lobe.gltf.sheen_albedo, mu, b->lobe.gltf.sheen_roughness);
+}
+
+// What the sheen leaves to the layers below it where its albedo is e: 1 - max3(colour) min(e, 1)
+float gltf_sheen_below(const Bsdf* b, float e) {
+  float c = max_component(b->lobe.gltf.sheen);
+  return c > 0.0f ? fmax(1.0f - c * fmin(e, 1.0f), 0.0f) : 1.0f;
+}
+
+// The sheen lobe; where the Charlie lobe's albedo exceeds 1 (grazing angles at low sheen
+// roughness) it is divided by max(1, E(mu_o), E(mu_i)), which keeps it reciprocal and its
+// albedo at most 1
+float3 gltf_sheen_f(const Bsdf* b, float e_o, float3 wo, float3 wi) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float norm = fmax(1.0f, fmax(e_o, gltf_sheen_e(b, wi.z)));
+  return lobe->sheen * (sheen_eval(sheen_alpha(lobe->sheen_roughness), wo, wi) / norm);
+}
+#endif
+
 // What depends on wo alone: the albedo-table lookups, the layers and the mixture weights
 // (computed once per sample: bsdf_gltf_sample evaluates with the ones it sampled with)
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
   float base_norm;                // gltf_coat_base_norm
+  float outer;  // what the layers over the base (coat, sheen) leave it at wo
+#if CD_FEATURE_SHEEN
+  float sheen_e_o, sheen_o;  // gltf_sheen_e and gltf_sheen_below at wo
+#endif
   float w[GLTF_COMPONENT_COUNT];  // selection probabilities by GLTF_* id, summing to 1 (or all 0)
 } GltfAtWo;
 
-// Each component's weight at wo before normalization: its albedo estimate, below the coat
+// Each component's weight at wo before normalization: its albedo estimate, below the layers
+// over it
 float gltf_coat_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) { return g->coat.a_o; }
 
+float gltf_sheen_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+#if CD_FEATURE_SHEEN
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  float e = lobe->sheen_albedo ? fmin(g->sheen_e_o, 1.0f) : 1.0f;
+  return (1.0f - g->coat.a_o) * luminance(lobe->sheen) * fmax(e, 0.01f);
+#else
+  return 0.0f;
+#endif
+}
+
 float gltf_metal_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
-  return (1.0f - g->coat.a_o) * b->lobe.gltf.metallic * g->e.e_o;
+  return g->outer * b->lobe.gltf.metallic * g->e.e_o;
 }
 
 float gltf_spec_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   float fs = luminance(fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_o));
-  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fs * g->e.e_o;
+  return g->outer * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fs * g->e.e_o;
 }
 
 float gltf_diffuse_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * (1.0f - g->spec.a_o) *
+  return g->outer * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * (1.0f - g->spec.a_o) *
          luminance(b->base_color);
 }
 
 float gltf_ms_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
-  return g->e.table ? (1.0f - g->coat.a_o) * energy_ms_albedo(&g->e) * luminance(gltf_ms_fresnel(b, &g->e)) : 0.0f;
+  return g->e.table ? g->outer * energy_ms_albedo(&g->e) * luminance(gltf_ms_fresnel(b, &g->e)) : 0.0f;
 }
 
 float gltf_glass_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  return (1.0f - g->coat.a_o) * (1.0f - lobe->metallic) * lobe->transmission;
+  return g->outer * (1.0f - lobe->metallic) * lobe->transmission;
 }
 
 GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
@@ -233,6 +287,12 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
   g.spec = gltf_spec_layer(b, &g.e, cos_o);
   g.coat = gltf_coat_layer(b, cos_o);
   g.base_norm = gltf_coat_base_norm(b, &g.coat, &g.spec);
+  g.outer = 1.0f - g.coat.a_o;
+#if CD_FEATURE_SHEEN
+  g.sheen_e_o = gltf_sheen_e(b, cos_o);
+  g.sheen_o = gltf_sheen_below(b, g.sheen_e_o);
+  g.outer *= g.sheen_o;
+#endif
 #define GLTF_WEIGHT(id, name, kind) g.w[id] = gltf_##name##_weight(b, &g, cos_o);
   GLTF_COMPONENTS(GLTF_WEIGHT)
 #undef GLTF_WEIGHT
@@ -276,6 +336,18 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
              energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
     *pdf += w[GLTF_GLASS] * glass_p;
   }
+#if CD_FEATURE_SHEEN
+  // The sheen over them: albedo scaling, then its own lobe
+  if (max_component(lobe->sheen) > 0.0f) {
+    if (wi.z > 0.0f) {
+      under = under * fmin(g->sheen_o, gltf_sheen_below(b, gltf_sheen_e(b, wi.z))) +
+              gltf_sheen_f(b, g->sheen_e_o, wo, wi);
+      *pdf += w[GLTF_SHEEN] * sheen_sample_pdf(wi);
+    } else {
+      under *= b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -wi.z));
+    }
+  }
+#endif
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
   // direction outside
   float3 f =
@@ -319,10 +391,23 @@ int gltf_coat_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, floa
   return gltf_ggx_direction(lobe->coat_ggx, wo, u, bs);
 }
 
+int gltf_sheen_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  bs->wi = sheen_sample(u);
+  return GLTF_SAMPLE_DIRECTION;
+}
+
+// The layers between the coat and a mirror reflection of the base (the sheen, at mu_i = mu_o)
+float3 gltf_mirror_below_sheen(const GltfAtWo* g, float3 weight) {
+#if CD_FEATURE_SHEEN
+  weight *= g->sheen_o;
+#endif
+  return weight;
+}
+
 int gltf_metal_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) {
-    float3 weight = lobe->metallic * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z);
+    float3 weight = gltf_mirror_below_sheen(g, lobe->metallic * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z));
     return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_METAL], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);
@@ -332,7 +417,7 @@ int gltf_spec_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, floa
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) {
     float3 fd = fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), wo.z);
-    float3 weight = (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fd;
+    float3 weight = gltf_mirror_below_sheen(g, (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fd);
     return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_SPEC], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);
@@ -356,6 +441,10 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
   float att =
       bs->wi.z > 0.0f ? gltf_below(&g->coat, wo.z) : 1.0f - gltf_layer_albedo(&g->coat, b->entering ? wo.z : -bs->wi.z);
+#if CD_FEATURE_SHEEN
+  if (max_component(lobe->sheen) > 0.0f)
+    att *= bs->wi.z > 0.0f || b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -bs->wi.z));
+#endif
   bs->f *= att * (1.0f - lobe->metallic) * lobe->transmission;
   bs->pdf *= g->w[GLTF_GLASS];
   return bs->pdf > 0.0f ? GLTF_SAMPLE_DONE : GLTF_SAMPLE_FAILED;
@@ -402,13 +491,20 @@ uint bsdf_gltf_flags(const Bsdf* b) {
     flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (lobe->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
   if (lobe->transmission > 0.0f && lobe->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
+#if CD_FEATURE_SHEEN
+  if (max_component(lobe->sheen) > 0.0f) flags |= BSDF_GLOSSY;
+#endif
   return flags;
 }
 
-// Alpha of the widest microfacet lobe: the specular one's, or the coat's where wider
+// Alpha of the widest microfacet lobe: the specular one's, or the coat's where wider; a sheen
+// spreads over the whole hemisphere whatever its roughness (1)
 float bsdf_gltf_alpha(const Bsdf* b) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   float a = sqrt(lobe->ggx.ax * lobe->ggx.ay);
   if (lobe->coat > 0.0f) a = fmax(a, sqrt(lobe->coat_ggx.ax * lobe->coat_ggx.ay));
+#if CD_FEATURE_SHEEN
+  if (max_component(lobe->sheen) > 0.0f) a = 1.0f;
+#endif
   return a;
 }

@@ -57,12 +57,14 @@ float3 ggx_sample_visible(Ggx g, float3 w, float2 u) {
 
 // glTF roughness r to alpha = r^2, and KHR_materials_anisotropy's stretch of the tangent
 // direction: ax = mix(alpha, 1, strength^2), ay = alpha (the frame's tangent is turned
-// to the anisotropy direction beforehand)
+// to the anisotropy direction beforehand). A lobe that is no mirror (ax >= GGX_DELTA_ALPHA)
+// keeps ay >= GGX_DELTA_ALPHA: at roughness 0 with anisotropy, ay = 0 would make D and
+// Lambda divide by zero; the floor makes it the narrowest line-shaped lobe that is not a mirror
 Ggx ggx_from_roughness(float roughness, float anisotropy) {
   float alpha = roughness * roughness;
   Ggx g;
   g.ax = mix(alpha, 1.0f, anisotropy * anisotropy);
-  g.ay = alpha;
+  g.ay = g.ax < GGX_DELTA_ALPHA ? alpha : fmax(alpha, GGX_DELTA_ALPHA);
   return g;
 }
 

@@ -189,6 +189,13 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       continue;
     }
 #endif
+#if CD_FEATURE_UNLIT
+    // An unlit surface shows its colour to every ray and ends the path (no light sampling finds it)
+    if (sc->materials[s.material].flags & MATERIAL_UNLIT) {
+      ps.radiance += ps.beta * bsdf_unlit_radiance(sc, &s);
+      break;
+    }
+#endif
     if (counts_emission) ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
     if (ps.depth >= params->max_depth) break;
 

@@ -26,6 +26,8 @@
   X(nanovdb, CD_FEATURE_NANOVDB, CD_PNANOVDB_AVAILABLE, "a medium with a NanoVDB grid")            \
   X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material shaded as MATERIAL_GLTF (kernel_type)") \
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
+  X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
+  X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
 // clang-format on
@@ -57,6 +59,7 @@
 #define MATERIAL_ALPHA_MASK 4u      // alphaMode MASK: cut out below alpha_cutoff
 #define MATERIAL_ALPHA_BLEND 8u     // alphaMode BLEND: stochastic opacity
 #define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
+#define MATERIAL_UNLIT 32u          // KHR_materials_unlit: shows its base colour, ends paths
 
 // Texture slots of a material (Material.textures)
 #define TEX_BASE_COLOR 0
@@ -69,7 +72,9 @@
 #define TEX_CLEARCOAT 7            // R
 #define TEX_CLEARCOAT_ROUGHNESS 8  // G
 #define TEX_ANISOTROPY 9           // RG direction in tangent space, B strength
-#define TEX_SLOTS 10
+#define TEX_SHEEN_COLOR 10         // RGB (sRGB)
+#define TEX_SHEEN_ROUGHNESS 11     // A
+#define TEX_SLOTS 12
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
 // on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
@@ -136,6 +141,13 @@
 #define DIEL_ALBEDO_SIZE (DIEL_ALBEDO_ROWS * (DIEL_ALBEDO_N + 1))
 #define GGX_ALBEDO_SIZE (DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_SIZE)  // the whole buffer
 
+// Sheen albedo table (cl/bsdf/sheen.cl): the directional albedo E(mu) of the Charlie sheen
+// lobe with colour 1 at SHEEN_ALBEDO_N x SHEEN_ALBEDO_N nodes (mu, sheen roughness), mu fastest,
+// mu = (i / (SHEEN_ALBEDO_N - 1))^2, roughness = j / (SHEEN_ALBEDO_N - 1)
+#define SHEEN_ALBEDO_N 32
+#define SHEEN_ALBEDO_SIZE (SHEEN_ALBEDO_N * SHEEN_ALBEDO_N)
+#define SHEEN_ALBEDO_QUADRATURE 64  // quadrature points per side of each entry
+
 #define NO_TEXTURE (-1)
 #define NO_LIGHT (-1)
 #define NO_MEDIUM (-1)
@@ -195,12 +207,13 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Parameters of a MATERIAL_GLTF material, 48 bytes; factors multiply their texture slots
+// Parameters of a MATERIAL_GLTF material, 64 bytes; factors multiply their texture slots
 typedef struct {
   float ior;  // KHR_materials_ior (1.5)
   float metallic, roughness, transmission;
   float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
   float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
+  float sheen[4];  // KHR_materials_sheen: rgb colour factor, w = sheen roughness factor
 } GltfMaterial;
 
 // Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
@@ -212,13 +225,13 @@ typedef struct {
   unsigned int pad;
 } ConductorMaterial;
 
-// A material type's own parameters (Material.type selects the member), 48 bytes
+// A material type's own parameters (Material.type selects the member), 64 bytes
 typedef union {
   GltfMaterial gltf;
   ConductorMaterial conductor;
 } MaterialParams;
 
-// Material, 416 bytes: what every type has, then its type's parameters. Colours are linear
+// Material, 496 bytes: what every type has, then its type's parameters. Colours are linear
 // RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;   // MATERIAL_*
@@ -359,8 +372,9 @@ typedef struct {
 // Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
 // vertex; an array the scene does not need holds one dummy element. nanovdb holds the NanoVDB
 // grids of MEDIUM_NANOVDB media, each a NanoVDB buffer starting on a 32-byte boundary. env_distribution holds
-// the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. ggx_albedo is no part
-// of the scene: each renderer computes it on its device (GGX_ALBEDO_SIZE floats, energy.cl).
+// the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. ggx_albedo and
+// sheen_albedo are no part of the scene: each renderer computes them on its device (GGX_ALBEDO_SIZE floats,
+// energy.cl; SHEEN_ALBEDO_SIZE floats, sheen.cl, only for a kernel with CD_FEATURE_SHEEN).
 // One entry per line, columns aligned:
 // clang-format off
 #define CD_SCENE_BUFFERS(X)  \
@@ -384,7 +398,8 @@ typedef struct {
   X(Medium, media)           \
   X(float, densities)        \
   X(unsigned int, nanovdb)   \
-  X(float, ggx_albedo)
+  X(float, ggx_albedo)       \
+  X(float, sheen_albedo)
 // clang-format on
 
 // Every shared struct's size and the offsets that pin its layout: SIZE(type, bytes) and
@@ -399,14 +414,15 @@ typedef struct {
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)                                 \
-  SIZE(GltfMaterial, 48) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
+  SIZE(GltfMaterial, 64) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
     FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
+    FIELD(GltfMaterial, sheen, 48)                                                                            \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
-  SIZE(MaterialParams, 48)                                                                                    \
-  SIZE(Material, 416) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
+  SIZE(MaterialParams, 64)                                                                                    \
+  SIZE(Material, 496) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
     FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
-    FIELD(Material, textures, 96)                                                                             \
+    FIELD(Material, textures, 112)                                                                            \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
   SIZE(TexelF, 16)                                                                                            \

@@ -83,6 +83,8 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   g.clearcoat_roughness = m.clearcoat_roughness;
   g.anisotropy_strength = m.anisotropy_strength;
   g.anisotropy_rotation = m.anisotropy_rotation;
+  for (int c = 0; c < 3; ++c) g.sheen[c] = m.sheen_color[c];
+  g.sheen[3] = m.sheen_roughness;
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {
@@ -105,6 +107,7 @@ void compile_materials(const Scene& scene, dev::SceneBuffers* b) {
               (m.alpha_mode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
               (m.alpha_mode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u);
     d.flags |= m.null_boundary ? MATERIAL_NULL_BOUNDARY : 0u;
+    d.flags |= m.unlit ? MATERIAL_UNLIT : 0u;
     d.medium = NO_MEDIUM;  // compile_media sets the insides of closed surfaces
     d.alpha_cutoff = m.alpha_cutoff;
     d.normal_scale = m.normal_scale;

@@ -111,6 +111,20 @@ void read_anisotropy(ReadContext& ctx, const tinygltf::Material& gm, MaterialDes
   set_texture_slot(ctx, m, TEX_ANISOTROPY, an, "anisotropyTexture", false);
 }
 
+// KHR_materials_sheen: colour (sRGB texture RGB) and roughness (texture A)
+void read_sheen(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
+  const tinygltf::Value& sh = extension(gm, "KHR_materials_sheen");
+  for (int c = 0; c < 3; ++c) m->sheen_color[c] = float(number_or(sh, "sheenColorFactor", c, 0.0));
+  m->sheen_roughness = float(number_or(sh, "sheenRoughnessFactor", -1, 0.0));
+  set_texture_slot(ctx, m, TEX_SHEEN_COLOR, sh, "sheenColorTexture", true);
+  set_texture_slot(ctx, m, TEX_SHEEN_ROUGHNESS, sh, "sheenRoughnessTexture", false);
+}
+
+// KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
+void read_unlit(const tinygltf::Material& gm, MaterialDesc* m) {
+  m->unlit = gm.extensions.count("KHR_materials_unlit") > 0;
+}
+
 // extras.candela.conductor: a preset name or {"eta": [r, g, b], "k": [r, g, b]}
 void read_conductor(const tinygltf::Value& extras, const std::string& name, MaterialDesc* m) {
   if (!extras.Has("candela") || !extras.Get("candela").Has("conductor")) return;
@@ -183,9 +197,11 @@ void check_ranges(const std::string& name, MaterialDesc* m) {
   in(m->clearcoat, 0.0f, 1.0f, "clearcoatFactor");
   in(m->clearcoat_roughness, 0.0f, 1.0f, "clearcoatRoughnessFactor");
   in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
+  in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
   in(m->ior, 0.0f, 10.0f, "ior");
   for (int c = 0; c < 3; ++c) {
     in(m->specular_color[c], 0.0f, 1e6f, "specularColorFactor");
+    in(m->sheen_color[c], 0.0f, 1.0f, "sheenColorFactor");
     if (m->type == MATERIAL_CONDUCTOR) {
       in(m->conductor_eta[c], 0.0f, 100.0f, "conductor eta");
       in(m->conductor_k[c], 0.0f, 100.0f, "conductor k");
@@ -220,6 +236,8 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_volume(ctx, gm, &m);
   read_clearcoat(ctx, gm, &m);
   read_anisotropy(ctx, gm, &m);
+  read_sheen(ctx, gm, &m);
+  read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);
   check_ranges(name, &m);

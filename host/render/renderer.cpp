@@ -12,6 +12,7 @@
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
+#include "device/sheen_albedo.hpp"
 
 namespace candela {
 namespace {
@@ -83,6 +84,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   if (settings.energy_compensation)
     scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
         ggx_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
+  if (scene.features.sheen)
+    scene_buffers_[unsigned(dev::SceneBuffer::sheen_albedo)] =
+        sheen_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
 
   params_host_.camera = camera;
   params_host_.width = uint32_t(settings.width);

@@ -78,7 +78,8 @@ struct RenderResult {
 class DeviceRenderer {
  public:
   // Builds the kernel program for the scene's features, uploads the scene buffers and,
-  // with energy compensation, the GGX albedo table (host/device/energy.hpp). `camera`:
+  // with energy compensation, the GGX albedo table (host/device/energy.hpp), and with a sheen
+  // the sheen albedo table (host/device/sheen_albedo.hpp). `camera`:
   // the device record for settings.width x settings.height (compile/camera.hpp).
   // `release`: the same scene, whose host arrays are freed one by one once uploaded (for
   // the last device that uploads them; CompiledScene::release_host_arrays)

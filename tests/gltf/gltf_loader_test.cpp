@@ -258,8 +258,8 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf().document();
-  j["extensionsUsed"] = {"KHR_materials_sheen"};
-  j["materials"][0]["extensions"] = {{"KHR_materials_sheen", {{"sheenRoughnessFactor", 1}}}};
+  j["extensionsUsed"] = {"KHR_materials_iridescence"};
+  j["materials"][0]["extensions"] = {{"KHR_materials_iridescence", {{"iridescenceFactor", 1}}}};
   j["materials"].push_back(j["materials"][0]);
   j["materials"][0]["occlusionTexture"] = {{"index", 0}};
   j["materials"][1]["occlusionTexture"] = {{"index", 0}};
@@ -270,12 +270,12 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
         "png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg="
         "="}}};
   Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
-  int sheen = 0, occlusion = 0;
+  int iridescence = 0, occlusion = 0;
   for (const auto& w : s.warnings) {
-    sheen += w.find("KHR_materials_sheen") != std::string::npos;
+    iridescence += w.find("KHR_materials_iridescence") != std::string::npos;
     occlusion += w.find("occlusionTexture") != std::string::npos;
   }
-  EXPECT_EQ(sheen, 1);
+  EXPECT_EQ(iridescence, 1);
   EXPECT_EQ(occlusion, 1);
 }
 

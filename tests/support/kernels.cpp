@@ -7,6 +7,7 @@
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
+#include "device/sheen_albedo.hpp"
 
 namespace candela::test {
 
@@ -72,6 +73,8 @@ SceneOnDevice::SceneOnDevice(const KernelRig& rig, const CompiledScene& scene) {
 #undef CD_TEST_UPLOAD
   buffers[unsigned(dev::SceneBuffer::ggx_albedo)] =
       ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file).buffer;
+  buffers[unsigned(dev::SceneBuffer::sheen_albedo)] =
+      sheen_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file).buffer;
   params_host.num_lights = cl_uint(scene.buffers.lights.size());
   params_host.environment_light = scene.environment_light;
   params_host.energy_compensation = 1u;  // as renderers have it by default, with the table above

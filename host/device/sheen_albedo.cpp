@@ -1,0 +1,58 @@
+#include "device/sheen_albedo.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "base/device_types.hpp"
+#include "base/error.hpp"
+#include "device/program_cache.hpp"
+
+namespace candela {
+namespace {
+
+constexpr size_t kBytes = SHEEN_ALBEDO_SIZE * sizeof(float);
+
+std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
+                                 cl::Buffer* buffer) {
+  *buffer = cl::Buffer(context, CL_MEM_READ_WRITE, kBytes);
+  cl::Kernel albedo(program, "sheen_albedo_table");
+  albedo.setArg(0, *buffer);
+  albedo.setArg(1, cl_uint(SHEEN_ALBEDO_QUADRATURE));
+  queue.enqueueNDRangeKernel(albedo, cl::NullRange, cl::NDRange(SHEEN_ALBEDO_N, SHEEN_ALBEDO_N));
+  std::vector<float> table(SHEEN_ALBEDO_SIZE);
+  queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
+  for (float e : table)
+    if (!(e >= 0.0f && e <= 100.0f)) throw Error("the device computed sheen albedos outside [0, 100]");
+  return table;
+}
+
+}  // namespace
+
+SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue,
+                                    const cl::Program& program, const std::string& program_cache_file) {
+  auto start = std::chrono::steady_clock::now();
+  SheenAlbedoTable t;
+  std::string path = program_cache_file.empty() ? "" : program_cache_file + ".sheen_albedo";
+  try {
+    std::vector<unsigned char> cached = path.empty() ? std::vector<unsigned char>() : read_cache_entry(path);
+    if (cached.size() == kBytes) {
+      t.buffer = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kBytes, cached.data());
+      t.from_cache = true;
+    } else {
+      std::vector<float> table = compute_table(context, queue, program, &t.buffer);
+      if (!path.empty()) {
+        std::vector<unsigned char> bytes(kBytes);
+        std::memcpy(bytes.data(), table.data(), kBytes);
+        write_cache_entry(path, bytes);
+      }
+    }
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("computing the sheen albedo table", e.err()));
+  }
+  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return t;
+}
+
+}  // namespace candela
