@@ -108,7 +108,7 @@ void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")
       ->check(CLI::Range(0u, 100000u));
   render->add_option("--strategy", a.strategy,
-                     enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else nee");
+                     enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto");
   render->add_flag(
       "--no-energy-compensation", a.no_energy_compensation,
       "Leave out the multiple scattering of rough GGX lobes (on by default: rough metal keeps its albedo)");

@@ -56,4 +56,18 @@ std::vector<float> environment_distribution(const TextureDesc& map) {
   return out;
 }
 
+double environment_solid_angle(const TextureDesc& map) {
+  int w = map.width, h = map.height;
+  double sum = 0.0, sum2 = 0.0;
+  for (int r = 0; r < h; ++r) {
+    double solid_angle = 2.0 * kPi / w * (std::cos(kPi * r / h) - std::cos(kPi * (r + 1) / h));
+    for (int c = 0; c < w; ++c) {
+      double l = std::max(texel_luminance(map, size_t(r) * w + c), 0.0);
+      sum += l * solid_angle;
+      sum2 += l * l * solid_angle;
+    }
+  }
+  return sum2 > 0.0 ? std::min(sum * sum / sum2, 4.0 * kPi) : 4.0 * kPi;
+}
+
 }  // namespace candela

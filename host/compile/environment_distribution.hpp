@@ -13,4 +13,9 @@ namespace candela {
 // float CDF step > 0, so its pdf is > 0.
 std::vector<float> environment_distribution(const TextureDesc& map);
 
+// The map's effective solid angle (integral L)^2 / integral L^2 over the sphere, L its
+// luminance: 4 pi for a constant, the solid angle of the lit part for a map lit uniformly
+// over part of the sphere. The strategy choice reads it (cl/integrator/integrator_path.cl).
+double environment_solid_angle(const TextureDesc& map);
+
 }  // namespace candela
