@@ -95,32 +95,44 @@ float path_lobe_pdf(float omega, float d) {
 // STRATEGY_AUTO's choice for light `index` at a vertex at p with lobes `lobes`: true when
 // light sampling takes it. The second moments of the two estimators of the light's
 // contribution, for a BSDF whose f cos is proportional to its sampling pdf sum_c w_c p_c
-// and a light of solid angle W_L picked with probability pmf (docs/integrator.md, "The
-// choice"):
-//   M_nee = W_L / pmf * integral over the light of (sum_c w_c p_c)^2,
-//   M_bsdf = integral over the light of sum_c w_c p_c.
-// Per lobe, p_c over the light is bounded by its value q_c at the point of the light's
-// bounding cone nearest to the lobe's centre and its mass there is P_c = min(1, W_L q_c), so
-//   M_nee ~ W_L / pmf * waste * sum_c w_c^2 q_c P_c,   M_bsdf ~ sum_c w_c P_c
-// (waste = 2 for an environment map seen from a reflect-only surface: half its samples
-// land below it). Light sampling takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf.
-// Evaluated twice per light path, at the light sample and where the sampled ray finds the
-// light, on the same inputs: no contraction, so both give the same answer.
+// and a light of solid angle W_L and radiance L picked with probability pmf
+// (docs/integrator.md, "The choice"):
+//   M_nee = W_L / pmf * integral over the light of (sum_c w_c p_c)^2 L^2,
+//   M_bsdf = integral over the light of sum_c w_c p_c L^2.
+// Per lobe (cross terms dropped), p_c over the light is bounded by its value q_c at the
+// point of the light's bounding cone nearest to the lobe's centre, and its mass there is
+// P_c = min(1, W_L q_c), so for an emitter of constant L
+//   M_nee ~ W_L / pmf * sum_c w_c^2 q_c P_c,   M_bsdf ~ sum_c w_c P_c.
+// An environment is sampled in proportion to L (its integral E over the sphere): its bright
+// part, a cone of its effective solid angle W_E = E^2 / integral L^2 and radiance E / W_E,
+// enters as a light does, and the radiance L_c it shows at each lobe's centre adds
+// M_nee += E / pmf * w_c^2 L_c / W_c and M_bsdf += w_c L_c^2; light sampling of a map from
+// a reflect-only surface wastes half its samples below it (M_nee x 2). Light sampling
+// takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
+// path, at the light sample and where the sampled ray finds the light, on the same inputs:
+// no contraction, so both give the same answer.
 bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, float3 p, uint index) {
 #pragma OPENCL FP_CONTRACT OFF
   LightExtent e = lights_extent(sc, index, p);
   if (!(e.omega > 0.0f)) return true;  // a delta light
+  float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
   float m_nee = 0.0f, m_bsdf = 0.0f;
   for (uint k = 0u; k < lobes->count; ++k) {
-    float w = lobes->weight[k];
-    float d = e.everywhere ? 0.0f : fmax(acos(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
-    float q = path_lobe_pdf(lobes->omega[k], d);
+    float w = lobes->weight[k], omega = lobes->omega[k];
+    float d = e.radius >= PI_F ? 0.0f : fmax(acos(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
+    float q = path_lobe_pdf(omega, d);
     float mass = fmin(e.omega * q, 1.0f);
-    m_nee += w * w * q * mass;
-    m_bsdf += w * mass;
+    m_nee += w * w * q * mass * l_bright;
+    m_bsdf += w * mass * l_bright * l_bright;
+    if (e.everywhere) {
+      float l = luminance(lights_environment_radiance(sc, lobes->dir[k]));
+      m_nee += w * w * l / omega;
+      m_bsdf += w * l * l;
+    }
   }
+  float scale = e.everywhere ? e.integral / e.pmf : e.omega / e.pmf;
   float waste = e.map && lobes->reflect_only ? 2.0f : 1.0f;
-  return AUTO_SHADOW_COST * (e.omega / e.pmf) * waste * m_nee <= m_bsdf;
+  return AUTO_SHADOW_COST * scale * waste * m_nee <= m_bsdf;
 }
 
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with

@@ -27,10 +27,11 @@ typedef struct {
 // point (integrator_path.cl): its solid angle, the direction to its centre, and the
 // probability with which light selection picks it
 typedef struct {
-  float3 dir;       // unit direction to the light's centre; unused where `everywhere`
+  float3 dir;       // unit direction to the light's centre (an environment: its bright part's)
   float omega;      // solid angle (0: a delta light)
   float radius;     // angle from dir that holds the whole light
   float pmf;        // selection probability
+  float integral;   // an environment: integral of its luminance over the sphere
   bool everywhere;  // an environment: it surrounds the point, overlapping every lobe
   bool map;         // an environment map: sampled over the whole sphere, even at reflect-only surfaces
 } LightExtent;
@@ -100,12 +101,17 @@ bool lights_environment_sample(const SceneData* sc, __global const Light* light,
 
 uint lights_environment_prim(__global const Light* light) { return UINT_MAX; }
 
-// An environment's effective solid angle (integral L)^2 / integral L^2 over the sphere,
-// luminance, computed on the host (Light.params[3]; 4 pi for a constant)
+// An environment seen from anywhere: its bright part as a cone of its effective solid angle
+// (integral L)^2 / integral L^2 about the direction its L^2 is centred on (the whole
+// sphere for a constant), and integral L, L its luminance (computed on the host:
+// Light.params[3..7])
 void lights_environment_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {
   e->omega = light->params[3];
   e->everywhere = true;
   e->map = environment_map(light) != NO_TEXTURE;
+  e->dir = (float3)(light->params[4], light->params[5], light->params[6]);
+  e->radius = dot(e->dir, e->dir) > 0.0f ? acos(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
+  e->integral = light->params[7] * (e->map ? light->params[1] : luminance(load3(light->radiance)));
 }
 
 // Triangle lights are sampled uniformly in the solid angle they subtend at ctx.p (Arvo
@@ -423,6 +429,7 @@ LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
   e.dir = (float3)(0.0f);
   e.omega = 0.0f;
   e.radius = PI_F;
+  e.integral = 0.0f;
   e.pmf = light->pmf;
   e.everywhere = false;
   e.map = false;

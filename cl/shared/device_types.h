@@ -261,8 +261,10 @@ typedef struct {
 //                      TextureInfo index (an integer stored as float), params[1] = strength
 //                      (radiance = strength x texel), params[2] = rotation about +Y in
 //                      radians; its sampling distribution is the env_distribution buffer.
-//                      Both: params[3] = effective solid angle (integral L)^2 / integral L^2
-//                      (4 pi for a constant), for STRATEGY_AUTO's choice.
+//                      Both, for STRATEGY_AUTO's choice, L the luminance before strength:
+//                      params[3] = effective solid angle (integral L)^2 / integral L^2 (4 pi
+//                      for a constant), params[4..6] = unit direction L^2 is centred on
+//                      (zero: none), params[7] = integral of L over the sphere.
 //   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
 //                      radiance[3] = range (0: infinite), params[0..2] = position.
 //   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,

@@ -65,13 +65,13 @@ Scene glass_furnace(bool solid) {
 
 }  // namespace
 
-TEST(FailureCases, AutoIsTheDefault) { EXPECT_EQ(RenderSettings{}.strategy, Strategy::Auto); }
+TEST(DefaultStrategy, IsAuto) { EXPECT_EQ(RenderSettings{}.strategy, Strategy::Auto); }
 
 // Near-specular glass in a white furnace: the sphere fills the centre of the view, where
 // every pixel is 1 less what single scattering misses (under 1 % at roughness 0.1)
-class GlassFurnace : public ::testing::TestWithParam<bool> {};
+class NearSpecularGlassFurnace : public ::testing::TestWithParam<bool> {};
 
-TEST_P(GlassFurnace, AutoRendersItLikeBsdfSampling) {
+TEST_P(NearSpecularGlassFurnace, AutoRendersItLikeBsdfSampling) {
   Scene scene = glass_furnace(GetParam());
   constexpr int kSize = 24;
   Film automatic = render_film(scene, Strategy::Auto, kSize, kSize, 256, 1000, 1);
@@ -92,7 +92,7 @@ TEST_P(GlassFurnace, AutoRendersItLikeBsdfSampling) {
   EXPECT_LT(median_n, 0.5) << "light sampling no longer fails here: the case tests nothing";
 }
 
-INSTANTIATE_TEST_SUITE_P(FailureCases, GlassFurnace, ::testing::Values(false, true),
+INSTANTIATE_TEST_SUITE_P(FailureCases, NearSpecularGlassFurnace, ::testing::Values(false, true),
                          [](const auto& info) { return std::string(info.param ? "solid" : "thin"); });
 
 // Metal of roughness 0.02-0.3 and glass of roughness 0.1 on a floor, under a large area
