@@ -82,10 +82,11 @@ TEST_P(NearSpecularGlassFurnace, AutoRendersItLikeBsdfSampling) {
   Estimate a = region_mean(automatic, 1, lo, hi, lo, hi), b = region_mean(bsdf, 1, lo, hi, lo, hi),
            n = region_mean(nee, 1, lo, hi, lo, hi);
   double median_a = region_median(automatic, lo, hi, lo, hi), median_n = region_median(nee, lo, hi, lo, hi);
-  std::printf("%s glass r0.1 furnace, centre: auto %.4f +- %.4f (median %.4f), bsdf %.4f +- %.4f, nee %.4f +- %.4f "
-              "(median %.4f)\n",
-              GetParam() ? "solid" : "thin", a.mean, a.standard_error, median_a, b.mean, b.standard_error, n.mean,
-              n.standard_error, median_n);
+  std::printf(
+      "%s glass r0.1 furnace, centre: auto %.4f +- %.4f (median %.4f), bsdf %.4f +- %.4f, nee %.4f +- %.4f "
+      "(median %.4f)\n",
+      GetParam() ? "solid" : "thin", a.mean, a.standard_error, median_a, b.mean, b.standard_error, n.mean,
+      n.standard_error, median_n);
   EXPECT_NEAR(a.mean, b.mean, 4.0 * std::hypot(a.standard_error, b.standard_error) + 1e-4);
   EXPECT_NEAR(a.mean, 1.0, 4.0 * a.standard_error + 0.01);
   EXPECT_NEAR(median_a, 1.0, 0.02) << "the median pixel, not only the mean";
