@@ -16,6 +16,8 @@ Outputs (deterministic, byte-identical on every run):
   scenes/lights/small-light.gltf        a small bright light over a diffuse floor
   scenes/lights/large-light-glossy.gltf a large light over smooth-ish metal
   scenes/lights/many-lights.gltf        4096 small emissive quads over a floor
+  scenes/lights/near-specular.gltf      metal and glass of roughness 0.02-0.3 under a
+                                        large area light (near-specular-sky: sky.hdr)
   scenes/volumes/god-rays.gltf          a dusty room lit through a window
   scenes/volumes/liquid-glass.gltf      a glass of absorbing liquid
   scenes/volumes/cloud.gltf             a procedural noise cloud (density grid)
@@ -838,6 +840,53 @@ def make_large_light_glossy(path):
     g.write(path)
 
 
+def make_near_specular(path, environment):
+    """The near-specular failure cases: metal of glTF roughness 0.02, 0.1 and 0.3 and
+    glass of roughness 0.1 (thin-walled, then solid) on a diffuse floor, under a large
+    area light (3 x 1.5, radiance 4) behind the camera's view and above, or lit by
+    sky.hdr. Light sampling alone speckles the sharp lobes and the caustics under the
+    glass; BSDF sampling alone the floor (small sun)."""
+    g = GltfWriter(GENERATOR)
+
+    def pbr(base, metallic, roughness):
+        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
+                "roughnessFactor": roughness}
+    glass = {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
+    materials = [
+        metal_pbr(g, "metal-r0.02", 0.02, (0.9, 0.9, 0.9)),
+        metal_pbr(g, "metal-r0.1", 0.1, (0.9, 0.9, 0.9)),
+        metal_pbr(g, "metal-r0.3", 0.3, (0.9, 0.9, 0.9)),
+        g.pbr_material("thin-glass-r0.1", pbr((1, 1, 1), 0.0, 0.1), dict(glass)),
+        g.pbr_material("glass-r0.1", pbr((1, 1, 1), 0.0, 0.1),
+                       dict(glass, KHR_materials_volume={"thicknessFactor": 1.0})),
+    ]
+    radius = 0.4
+    pos, nrm, uv, idx = uv_sphere(radius)
+    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
+              "TEXCOORD_0": g.vec_accessor(uv, 2)}
+    sphere_indices = g.index_accessor(idx)
+    for k, mat in enumerate(materials):
+        name = g.doc["materials"][mat]["name"]
+        mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
+        g.node(name, mesh=mesh, translation=[0.95 * k - 1.9, radius, 0.0])
+    floor = g.material("floor", (0.5, 0.5, 0.5, 1.0))
+    s = 4.0
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
+        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    if environment:
+        g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
+                                                                    "rotation": 0.0}}}
+    else:
+        light = g.material("panel", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), strength=4.0,
+                           double_sided=False)
+        p = [(-1.5, 2.5, -1.0), (1.5, 2.5, -1.0), (1.5, 2.5, 0.5), (-1.5, 2.5, 0.5)]
+        g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
+            [f32v(q) for q in p], (0.0, -1.0, 0.0)))), light))
+        g.set_background([0, 0, 0])  # lit by its own light alone: no default light
+    look_camera(g, (0.0, 1.4, 4.0), (0.0, 0.35, 0.0), 0.55, 2.0)
+    g.write(path)
+
+
 def make_many_lights(path):
     """4096 small emissive quads (8192 triangles, 8 colours) floating in a 64 x 64 grid
     over a diffuse floor with a few spheres: light selection by power through the alias
@@ -1178,6 +1227,8 @@ SCENES = [
     ("scenes/lights/small-light.gltf", make_small_light),
     ("scenes/lights/large-light-glossy.gltf", make_large_light_glossy),
     ("scenes/lights/many-lights.gltf", make_many_lights),
+    ("scenes/lights/near-specular.gltf", lambda path: make_near_specular(path, False)),
+    ("scenes/lights/near-specular-sky.gltf", lambda path: make_near_specular(path, True)),
     ("scenes/volumes/god-rays.gltf", make_god_rays),
     ("scenes/volumes/liquid-glass.gltf", make_liquid_glass),
     ("scenes/volumes/cloud.gltf", make_cloud),

@@ -1,5 +1,5 @@
 // BSDF interface: bsdf_at evaluates the material at a shading point into a Bsdf record;
-// flags / eval / pdf / sample / widest alpha go to the material type's lobe (bsdf_NAME.cl).
+// flags / eval / pdf / sample / lobes go to the material type's lobe (bsdf_NAME.cl).
 // Every dispatch on the type is generated from CD_MATERIALS (cl/shared/device_types.h): a
 // type whose feature is off (SceneFeatures) has its `if (0 && ...)` folded away, so its lobe
 // is compiled out; an unknown type shades as MATERIAL_DIFFUSE. Lobes work in the local frame
@@ -63,14 +63,26 @@ uint bsdf_flags(const Bsdf* b) {
   return bsdf_diffuse_flags(b);
 }
 
-// Alpha (sqrt(ax ay)) of the widest microfacet lobe a non-diffuse BSDF has: how sharp its
-// sharpest-but-not-delta reflection is, for the auto strategy (integrator_path.cl)
-float bsdf_widest_alpha(const Bsdf* b) {
-#define BSDF_ALPHA(id, name, feature) \
-  if (feature && b->type == id) return bsdf_##name##_alpha(b);
-  CD_MATERIALS(BSDF_ALPHA)
-#undef BSDF_ALPHA
-  return bsdf_diffuse_alpha(b);
+// STRATEGY_AUTO's lobe summary of this BSDF at wo (BsdfLobes, bsdf_common.cl): the type's
+// lobes, turned to world space
+void bsdf_lobes_local(const Bsdf* b, float3 wo, BsdfLobes* l) {
+#define BSDF_LOBES(id, name, feature) \
+  if (feature && b->type == id) {     \
+    bsdf_##name##_lobes(b, wo, l);    \
+    return;                           \
+  }
+  CD_MATERIALS(BSDF_LOBES)
+#undef BSDF_LOBES
+  bsdf_diffuse_lobes(b, wo, l);
+}
+
+BsdfLobes bsdf_lobes(const Bsdf* b, float3 wo) {
+  BsdfLobes l;
+  l.count = 0u;
+  l.reflect_only = (bsdf_flags(b) & BSDF_TRANSMISSION) == 0u;
+  bsdf_lobes_local(b, frame_to_local(&b->frame, wo), &l);
+  for (uint k = 0u; k < l.count; ++k) l.dir[k] = frame_from_local(&b->frame, l.dir[k]);
+  return l;
 }
 
 // Shading normals (interpolated, normal-mapped) can tilt so far from the geometric normal

@@ -56,6 +56,52 @@ typedef struct {
   } lobe;  // by type
 } Bsdf;
 
+// The lobes of a BSDF at wo, for the strategy choice (bsdf_lobes in bsdf.cl; the integrator's
+// STRATEGY_AUTO): each non-delta lobe's centre direction, its solid angle (1 / its peak
+// pdf: pi for a cosine lobe, 4 pi ax ay for a GGX reflection) and its selection weight at
+// wo. Each material type declares its lobes in bsdf_NAME_lobes (in the local frame); lobes
+// of the same centre and solid angle merge, and past BSDF_MAX_LOBES a lobe joins the one
+// nearest in solid angle.
+#define BSDF_MAX_LOBES 4
+typedef struct {
+  float3 dir[BSDF_MAX_LOBES];    // centre (local while the type fills it, then world)
+  float omega[BSDF_MAX_LOBES];   // solid angle, > 0
+  float weight[BSDF_MAX_LOBES];  // selection probability at wo
+  uint count;
+  bool reflect_only;  // no transmission: light samples below the surface are wasted
+} BsdfLobes;
+
+void bsdf_lobes_add(BsdfLobes* l, float3 dir, float omega, float weight) {
+  if (!(weight > 0.0f) || !(omega > 0.0f)) return;  // absent, or a delta lobe
+  uint nearest = 0u;
+  for (uint k = 0u; k < l->count; ++k) {
+    if (l->omega[k] == omega && all(l->dir[k] == dir)) {
+      l->weight[k] += weight;
+      return;
+    }
+    if (fabs(log(l->omega[k] / omega)) < fabs(log(l->omega[nearest] / omega))) nearest = k;
+  }
+  if (l->count == BSDF_MAX_LOBES) {
+    l->weight[nearest] += weight;
+    return;
+  }
+  l->dir[l->count] = dir;
+  l->omega[l->count] = omega;
+  l->weight[l->count] = weight;
+  ++l->count;
+}
+
+// Solid angles of the lobe shapes: a cosine lobe (1 / its peak pdf 1 / pi), a GGX
+// reflection (peak D / 4 = 1 / (4 pi ax ay) at normal incidence), a GGX refraction from wo
+// across relative index eta (a facet tilt d turns the refracted ray by d (1 - 1/eta): the
+// half-vector solid angle pi ax ay times (1 - 1/eta)^2); each at most 2 pi
+float bsdf_lobe_omega_cosine(void) { return PI_F; }
+float bsdf_lobe_omega_ggx(Ggx g) { return fmin(4.0f * PI_F * g.ax * g.ay, 2.0f * PI_F); }
+float bsdf_lobe_omega_ggx_refraction(Ggx g, float eta) {
+  float s = 1.0f - 1.0f / eta;
+  return fmin(fmax(PI_F * g.ax * g.ay * s * s, 1e-9f), 2.0f * PI_F);
+}
+
 // A texture slot of the material at the hit
 float4 bsdf_texture(const SceneData* sc, __global const Material* m, int slot, const SurfaceHit* s) {
   return textures_lookup(sc, &m->textures[slot], s->uvs);

@@ -17,8 +17,6 @@ uint bsdf_conductor_flags(const Bsdf* b) {
   return BSDF_REFLECTION | (ggx_is_delta(b->lobe.conductor.ggx) ? BSDF_DELTA : BSDF_GLOSSY);
 }
 
-float bsdf_conductor_alpha(const Bsdf* b) { return sqrt(b->lobe.conductor.ggx.ax * b->lobe.conductor.ggx.ay); }
-
 // Probability of sampling the multiple-scattering lobe: its share of the albedo at wo
 float bsdf_conductor_ms_share(const ConductorBsdf* p, const GgxEnergy* e, float3 f_ms) {
   float ms = energy_ms_albedo(e) * luminance(f_ms);
@@ -62,4 +60,14 @@ bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSam
   bs->f = bsdf_conductor_eval(b, wo, bs->wi, &bs->pdf);
   bs->flags = BSDF_REFLECTION | BSDF_GLOSSY;
   return bs->pdf > 0.0f;
+}
+
+// The GGX reflection about the mirror direction, and the multiple-scattering cosine lobe
+void bsdf_conductor_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
+  const ConductorBsdf* p = &b->lobe.conductor;
+  if (ggx_is_delta(p->ggx) || wo.z <= 0.0f) return;
+  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, wo.z);
+  float q = e.table ? bsdf_conductor_ms_share(p, &e, energy_ms_fresnel(&e, p->f_avg)) : 0.0f;
+  bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(p->ggx), 1.0f - q);
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), q);
 }

@@ -18,5 +18,7 @@ bool bsdf_diffuse_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSampl
   return bs->pdf > 0.0f;
 }
 
-// No microfacet lobe: as rough as it gets (the auto strategy light-samples diffuse lobes)
-float bsdf_diffuse_alpha(const Bsdf* b) { return 1.0f; }
+// One cosine lobe about the normal
+void bsdf_diffuse_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), 1.0f);
+}

@@ -37,6 +37,8 @@
 // flag of a direction the component samples. Each has
 //   float gltf_NAME_weight(const Bsdf*, const GltfAtWo*, float cos_o): its weight at wo
 //   int gltf_NAME_sample(const Bsdf*, const GltfAtWo*, float3 wo, float uc, float2 u, BsdfSample*)
+//   void gltf_NAME_lobes(const Bsdf*, const GltfAtWo*, float3 wo, float w, BsdfLobes*): the
+//        lobe(s) it samples, of total weight w (none if delta), for the strategy choice
 // and a term of f and pdf in gltf_eval_at, which adds the components in its own order: the
 // metal and plastic specular lobes share one microfacet evaluation, and the coat is a layer
 // over the others rather than a term beside them.
@@ -497,14 +499,58 @@ uint bsdf_gltf_flags(const Bsdf* b) {
   return flags;
 }
 
-// Alpha of the widest microfacet lobe: the specular one's, or the coat's where wider; a sheen
-// spreads over the whole hemisphere whatever its roughness (1)
-float bsdf_gltf_alpha(const Bsdf* b) {
+// Each component's lobes (a GGX reflection about the mirror direction, cosine lobes about
+// the normal; the glass splits its weight by the Fresnel reflectance at wo between its
+// reflection and its transmission, about the refracted direction, or straight through a
+// thin sheet)
+void gltf_ggx_lobe(Ggx g, float3 wo, float w, BsdfLobes* l) {
+  if (!ggx_is_delta(g)) bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(g), w);
+}
+
+void gltf_coat_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  gltf_ggx_lobe(b->lobe.gltf.coat_ggx, wo, w, l);
+}
+
+// The sheen spreads over the hemisphere whatever its roughness: a cosine lobe's support
+void gltf_sheen_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), w);
+}
+
+void gltf_metal_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  gltf_ggx_lobe(b->lobe.gltf.ggx, wo, w, l);
+}
+
+void gltf_spec_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  gltf_ggx_lobe(b->lobe.gltf.ggx, wo, w, l);
+}
+
+void gltf_diffuse_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), w);
+}
+
+void gltf_ms_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), w);
+}
+
+void gltf_glass_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  float a = sqrt(lobe->ggx.ax * lobe->ggx.ay);
-  if (lobe->coat > 0.0f) a = fmax(a, sqrt(lobe->coat_ggx.ax * lobe->coat_ggx.ay));
-#if CD_FEATURE_SHEEN
-  if (max_component(lobe->sheen) > 0.0f) a = 1.0f;
-#endif
-  return a;
+  if (ggx_is_delta(lobe->ggx)) return;
+  float r = fresnel_dielectric(wo.z, lobe->eta);
+  float3 t = -wo;
+  if (lobe->thin) {
+    r = dielectric_sheet_reflectance(r);
+  } else if (!fresnel_refract(wo, (float3)(0.0f, 0.0f, 1.0f), lobe->eta, &t)) {
+    r = 1.0f;  // total internal reflection
+  }
+  gltf_ggx_lobe(lobe->ggx, wo, w * r, l);
+  float omega = lobe->thin ? bsdf_lobe_omega_ggx(lobe->ggx) : bsdf_lobe_omega_ggx_refraction(lobe->ggx, lobe->eta);
+  bsdf_lobes_add(l, t, omega, w * (1.0f - r));
+}
+
+void bsdf_gltf_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
+  if (wo.z <= 0.0f) return;
+  GltfAtWo g = gltf_at_wo(b, wo.z);
+#define GLTF_LOBES(id, name, kind) gltf_##name##_lobes(b, &g, wo, g.w[id], l);
+  GLTF_COMPONENTS(GLTF_LOBES)
+#undef GLTF_LOBES
 }

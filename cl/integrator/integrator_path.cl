@@ -6,24 +6,25 @@
 //                  arrives through shadow rays to sampled lights (skipped at delta lobes)
 //   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
 //                  punctual lights, which no ray can hit, contribute nothing)
-//   STRATEGY_AUTO: per vertex. A BSDF without a diffuse lobe whose every microfacet lobe
-//                  has alpha <= AUTO_BSDF_ALPHA gathers direct light by its sampled ray
-//                  (emission counted at the next hit, like bsdf); every other vertex by
-//                  a light sample (like nee). Delta lights, which no sampled ray can
-//                  find, are light-sampled at every vertex under nee and auto.
-// A vertex's choice decides, for the ray it samples, whether the emission that ray finds
-// counts: it counts exactly when the vertex did not take that light by a light sample.
+//   STRATEGY_AUTO: per vertex and per light, decided before sampling from the BSDF's lobes
+//                  at wo (bsdf_lobes) and the light's extent seen from the vertex
+//                  (lights_extent): path_nee_takes. A light sample counts only for a light
+//                  the vertex takes by light sampling; a BSDF-sampled ray that finds an
+//                  emitter or the environment counts it only for a light the vertex it left
+//                  did not take (the path state keeps that vertex's position and lobes).
+//                  Delta lights, which no sampled ray can find, are light-sampled at every
+//                  vertex under nee and auto.
+// Emission found by a delta lobe's ray always counts (no light sample can find it there).
 // Participating media (CD_FEATURE_MEDIA, cl/media/media.cl): a medium step after each closest
 // hit adds the medium's emission along the segment (under both strategies: media are not
 // lights) and may scatter the path there, a vertex like a surface one with the phase
 // function as its BSDF; null boundaries are passed without a bounce; shadow rays carry the
 // transmittance of the media they cross.
 
-// Near-specular threshold of STRATEGY_AUTO (alpha = glTF roughness^2): below it BSDF
-// sampling has the lower error on area and environment lights (measured on
-// scenes/lights/veach.gltf, see README "Strategies")
-#ifndef AUTO_BSDF_ALPHA
-#define AUTO_BSDF_ALPHA 0.01f
+// STRATEGY_AUTO's cost of a shadow ray, as a factor on light sampling's second moment
+// (docs/integrator.md, "The choice")
+#ifndef AUTO_SHADOW_COST
+#define AUTO_SHADOW_COST 1.0f
 #endif
 
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
@@ -34,9 +35,12 @@ typedef struct {
   uint depth;            // scattering events so far
   bool specular_bounce;  // emission the ray finds counts: the camera ray, a delta lobe's
                          // ray, or one from a vertex that took no light sample
-  float eta_scale;       // product of eta^2 over transmissions, so roulette sees radiance scale
-  int medium;            // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
-  MediumStack media;     // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+  bool decide;           // STRATEGY_AUTO: emission counts for lights the vertex it left
+  float3 prev_p;         // (at prev_p, with lobes `lobes`) did not take by light sampling
+  BsdfLobes lobes;
+  float eta_scale;    // product of eta^2 over transmissions, so roulette sees radiance scale
+  int medium;         // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
+  MediumStack media;  // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
 } PathState;
 
 PathState path_start(const SceneData* sc, Ray ray) {
@@ -46,6 +50,7 @@ PathState path_start(const SceneData* sc, Ray ray) {
   ps.radiance = (float3)(0.0f);
   ps.depth = 0u;
   ps.specular_bounce = true;  // the camera sees emitters directly
+  ps.decide = false;
   ps.eta_scale = 1.0f;
   ps.medium = NO_MEDIUM;
 #if CD_FEATURE_MEDIA
@@ -77,18 +82,71 @@ float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const
 #endif
 }
 
+// The pdf lobe c of solid angle W puts at angle d from its centre (normalized on the
+// plane of small angles): a cosine lobe's cos d / pi for W >= pi, else the GGX-shaped
+// (1 / W) / (1 + pi d^2 / W)^2 (D of the half vector at small angles, whose tail falls as
+// d^-4: a light beside a sharp lobe still gets much of its reflection)
+float path_lobe_pdf(float omega, float d) {
+  if (omega >= PI_F) return fmax(cos(d), 0.0f) * INV_PI_F;
+  float x = 1.0f + PI_F * d * d / omega;
+  return 1.0f / (omega * x * x);
+}
+
+// STRATEGY_AUTO's choice for light `index` at a vertex at p with lobes `lobes`: true when
+// light sampling takes it. The second moments of the two estimators of the light's
+// contribution, for a BSDF whose f cos is proportional to its sampling pdf sum_c w_c p_c
+// and a light of solid angle W_L and radiance L picked with probability pmf
+// (docs/integrator.md, "The choice"):
+//   M_nee = W_L / pmf * integral over the light of (sum_c w_c p_c)^2 L^2,
+//   M_bsdf = integral over the light of sum_c w_c p_c L^2.
+// Per lobe (cross terms dropped), p_c over the light is bounded by its value q_c at the
+// point of the light's bounding cone nearest to the lobe's centre, and its mass there is
+// P_c = min(1, W_L q_c), so for an emitter of constant L
+//   M_nee ~ W_L / pmf * sum_c w_c^2 q_c P_c,   M_bsdf ~ sum_c w_c P_c.
+// An environment is sampled in proportion to L (its integral E over the sphere): its bright
+// part, a cone of its effective solid angle W_E = E^2 / integral L^2 and radiance E / W_E,
+// enters as a light does, and the radiance L_c it shows at each lobe's centre adds
+// M_nee += E / pmf * w_c^2 L_c / W_c and M_bsdf += w_c L_c^2; light sampling of a map from
+// a reflect-only surface wastes half its samples below it (M_nee x 2). Light sampling
+// takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
+// path, at the light sample and where the sampled ray finds the light, on the same inputs:
+// no contraction, so both give the same answer.
+bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, float3 p, uint index) {
+#pragma OPENCL FP_CONTRACT OFF
+  LightExtent e = lights_extent(sc, index, p);
+  if (!(e.omega > 0.0f)) return true;  // a delta light
+  float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
+  float m_nee = 0.0f, m_bsdf = 0.0f;
+  for (uint k = 0u; k < lobes->count; ++k) {
+    float w = lobes->weight[k], omega = lobes->omega[k];
+    float d = e.radius >= PI_F ? 0.0f : fmax(acos(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
+    float q = path_lobe_pdf(omega, d);
+    float mass = fmin(e.omega * q, 1.0f);
+    m_nee += w * w * q * mass * l_bright;
+    m_bsdf += w * mass * l_bright * l_bright;
+    if (e.everywhere) {
+      float l = luminance(lights_environment_radiance(sc, lobes->dir[k]));
+      m_nee += w * w * l / omega;
+      m_bsdf += w * l * l;
+    }
+  }
+  float scale = e.everywhere ? e.integral / e.pmf : e.omega / e.pmf;
+  float waste = e.map && lobes->reflect_only ? 2.0f : 1.0f;
+  return AUTO_SHADOW_COST * scale * waste * m_nee <= m_bsdf;
+}
+
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
-// `delta_only`, of the delta lights alone (the others then count when a sampled ray finds
-// them: a sample of another light contributes nothing here). `media`: the media on wo's
-// side; a shadow ray through the surface enters (or leaves) `interior`, the medium inside
-// the surface.
+// `lobes` (STRATEGY_AUTO), only of a light the vertex takes by light sampling (the others
+// count when a sampled ray finds them: a sample of one contributes nothing here).
+// `media`: the media on wo's side; a shadow ray through the surface enters (or leaves)
+// `interior`, the medium inside the surface.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
-                         bool delta_only, const MediumStack* media, int interior, Rng* rng) {
+                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
   uint x_select = rng_next_uint(rng);
   float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
-  if (delta_only && !ls.is_delta) return (float3)(0.0f);
+  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx->p, ls.light)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
   float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
@@ -147,6 +205,7 @@ int path_medium_step(const SceneData* sc, PathState* ps, float tmax, bool nee, R
   float pdf;
   float3 wi = phase_sample(g, wo, u, &pdf);  // exact sampling: the weight f / pdf is 1
   ps->specular_bounce = !nee;                // emission found next counts unless light sampling took it
+  ps->decide = false;
   if (!path_survives_roulette(ps, sc->params->rr_depth, rng)) return MEDIUM_ABSORBED;
   ps->ray.org = p;
   ps->ray.dir = wi;
@@ -176,7 +235,12 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 #endif
     bool counts_emission = ps.specular_bounce;
     if (hit.prim < 0) {
-      if (counts_emission) ps.radiance += ps.beta * lights_environment_radiance(sc, ps.ray.dir);
+      if (counts_emission || ps.decide) {
+        float3 le = lights_environment_radiance(sc, ps.ray.dir);
+        if (!counts_emission && max_component(le) > 0.0f)
+          counts_emission = !path_nee_takes(sc, &ps.lobes, ps.prev_p, (uint)params->environment_light);
+        if (counts_emission) ps.radiance += ps.beta * le;
+      }
       break;
     }
     SurfaceHit s = surface_at(sc, (uint)hit.prim, hit.b1, hit.b2, ps.ray.dir);
@@ -196,21 +260,29 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       break;
     }
 #endif
-    if (counts_emission) ps.radiance += ps.beta * surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
+    if (counts_emission || ps.decide) {
+      float3 le = surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
+      if (!counts_emission && max_component(le) > 0.0f) {
+        int light = lights_of_prim(sc, (uint)hit.prim);
+        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, ps.prev_p, (uint)light);
+      }
+      if (counts_emission) ps.radiance += ps.beta * le;
+    }
     if (ps.depth >= params->max_depth) break;
 
     float3 wo = -ps.ray.dir;
     Bsdf bsdf = bsdf_at(sc, &s);
     bsdf_face_wo(&bsdf, wo);  // no black fringes where shading normals tilt away from wo
     uint flags = bsdf_flags(&bsdf);
-    // Light sampling, except at lobes that are all delta (no light sample can find them)
-    // and where the strategy leaves area and environment lights to the sampled ray
+    // Light sampling, except at lobes that are all delta (no light sample can find them);
+    // under auto, of the lights the vertex takes by light sampling (path_nee_takes)
     bool samples_lights = strategy != STRATEGY_BSDF && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u;
-    bool near_specular =
-        strategy == STRATEGY_AUTO && (flags & BSDF_DIFFUSE) == 0u && bsdf_widest_alpha(&bsdf) <= AUTO_BSDF_ALPHA;
+    bool chooses = samples_lights && strategy == STRATEGY_AUTO;
+    BsdfLobes lobes;
+    if (chooses) lobes = bsdf_lobes(&bsdf, wo);
     if (samples_lights) {
       LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
-      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, near_specular, &ps.media,
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
                                                  sc->materials[s.material].medium, rng);
     }
 
@@ -220,7 +292,13 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     BsdfSample bs;
     if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
     ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
-    ps.specular_bounce = (bs.flags & BSDF_DELTA) != 0u || !samples_lights || near_specular;
+    bool delta = (bs.flags & BSDF_DELTA) != 0u;
+    ps.specular_bounce = delta || !samples_lights;
+    ps.decide = chooses && !delta;
+    if (ps.decide) {
+      ps.prev_p = s.p;
+      ps.lobes = lobes;
+    }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
     ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);

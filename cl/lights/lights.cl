@@ -20,7 +20,21 @@ typedef struct {
   bool is_delta;     // a punctual or directional light: no BSDF-sampled ray can hit it
   bool at_infinity;  // shadow ray along wi without end
   float3 target;     // finite lights: the sampled point, moved off the light toward ctx.p
+  uint light;        // index of the light picked
 } LightSample;
+
+// What STRATEGY_AUTO's choice between light and BSDF sampling needs of a light seen from a
+// point (integrator_path.cl): its solid angle, the direction to its centre, and the
+// probability with which light selection picks it
+typedef struct {
+  float3 dir;       // unit direction to the light's centre (an environment: its bright part's)
+  float omega;      // solid angle (0: a delta light)
+  float radius;     // angle from dir that holds the whole light
+  float pmf;        // selection probability
+  float integral;   // an environment: integral of its luminance over the sphere
+  bool everywhere;  // an environment: it surrounds the point, overlapping every lobe
+  bool map;         // an environment map: sampled over the whole sphere, even at reflect-only surfaces
+} LightExtent;
 
 LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) {
   LightSampleContext ctx;
@@ -83,6 +97,21 @@ bool lights_environment_sample(const SceneData* sc, __global const Light* light,
   ls->radiance = lights_environment_radiance(sc, ls->wi);
   ls->at_infinity = true;
   return ls->pdf > 0.0f;
+}
+
+uint lights_environment_prim(__global const Light* light) { return UINT_MAX; }
+
+// An environment seen from anywhere: its bright part as a cone of its effective solid angle
+// (integral L)^2 / integral L^2 about the direction its L^2 is centred on (the whole
+// sphere for a constant), and integral L, L its luminance (computed on the host:
+// Light.params[3..7])
+void lights_environment_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {
+  e->omega = light->params[3];
+  e->everywhere = true;
+  e->map = environment_map(light) != NO_TEXTURE;
+  e->dir = (float3)(light->params[4], light->params[5], light->params[6]);
+  e->radius = dot(e->dir, e->dir) > 0.0f ? acos(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
+  e->integral = light->params[7] * (e->map ? light->params[1] : luminance(load3(light->radiance)));
 }
 
 // Triangle lights are sampled uniformly in the solid angle they subtend at ctx.p (Arvo
@@ -232,6 +261,30 @@ float lights_triangle_pdf(const SceneData* sc, __global const Light* light, cons
   return lights_triangle_solid_angle_pdf(ctx->p, ctx->p + t * wi, n, light->params[0]);
 }
 
+uint lights_triangle_prim(__global const Light* light) { return light->index; }
+
+// A triangle seen from p: its solid angle (Van Oosterom & Strackee 1983, The Solid Angle
+// of a Plane Triangle) and the cone about the direction to its centroid that holds its
+// three corners
+void lights_triangle_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {
+#pragma OPENCL FP_CONTRACT OFF
+  float3 v0, v1, v2;
+  scene_prim_positions(sc, light->index, &v0, &v1, &v2);
+  float3 a = v0 - p, b = v1 - p, c = v2 - p;
+  float3 d = a + b + c;
+  float la = length(a), lb = length(b), lc = length(c), ld = length(d);
+  if (!(la > 0.0f && lb > 0.0f && lc > 0.0f && ld > 0.0f)) {
+    e->omega = 2.0f * PI_F;
+    e->radius = PI_F;
+    return;
+  }
+  float den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  e->omega = clamp(2.0f * atan2(fabs(dot(a, cross(b, c))), den), 1e-12f, 2.0f * PI_F);
+  e->dir = d / ld;
+  float cos_min = fmin(fmin(dot(e->dir, a) / la, dot(e->dir, b) / lb), dot(e->dir, c) / lc);
+  e->radius = acos(clamp(cos_min, -1.0f, 1.0f));
+}
+
 // Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries
 // the irradiance arriving normal to wi as `radiance` with pdf 1 (times the selection
 // pmf), so path_direct_light's f * radiance * cos / pdf is the reflected radiance, and no
@@ -293,6 +346,14 @@ bool lights_directional_sample(const SceneData* sc, __global const Light* light,
   return true;
 }
 
+// Delta lights: no extent (only light sampling finds them), no primitive
+void lights_point_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
+void lights_spot_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
+void lights_directional_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
+uint lights_point_prim(__global const Light* light) { return UINT_MAX; }
+uint lights_spot_prim(__global const Light* light) { return UINT_MAX; }
+uint lights_directional_prim(__global const Light* light) { return UINT_MAX; }
+
 // A delta in direction: no sampled direction finds a punctual light
 float lights_point_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float3 wi) {
   return 0.0f;
@@ -319,7 +380,8 @@ bool lights_sample_light(const SceneData* sc, __global const Light* light, const
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u, LightSample* ls) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
-  __global const Light* light = &sc->lights[sample_discrete_alias(sc->light_alias, n, x_select)];
+  ls->light = sample_discrete_alias(sc->light_alias, n, x_select);
+  __global const Light* light = &sc->lights[ls->light];
   ls->is_delta = false;
   bool ok = lights_sample_light(sc, light, ctx, u, ls);
   ls->pdf *= light->pmf;
@@ -334,4 +396,46 @@ float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index,
   CD_LIGHTS(LIGHTS_PDF)
 #undef LIGHTS_PDF
   return 0.0f;
+}
+
+// The emissive primitive a light is (UINT_MAX for the others), and the light of emissive
+// primitive `prim`, or NO_LIGHT (an emitter black throughout). The compile step lists
+// triangle lights first, in increasing primitive order (host/compile), so a binary search
+// over lights_prim finds it.
+uint lights_prim(__global const Light* light) {
+#define LIGHTS_PRIM(id, name, feature) \
+  if (feature && light->type == id) return lights_##name##_prim(light);
+  CD_LIGHTS(LIGHTS_PRIM)
+#undef LIGHTS_PRIM
+  return UINT_MAX;
+}
+
+int lights_of_prim(const SceneData* sc, uint prim) {
+  uint lo = 0u, hi = sc->params->num_lights;
+  while (lo < hi) {
+    uint mid = (lo + hi) / 2u;
+    if (lights_prim(&sc->lights[mid]) < prim)
+      lo = mid + 1u;
+    else
+      hi = mid;
+  }
+  return lo < sc->params->num_lights && lights_prim(&sc->lights[lo]) == prim ? (int)lo : NO_LIGHT;
+}
+
+// Light `index` as STRATEGY_AUTO's choice sees it from p
+LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
+  __global const Light* light = &sc->lights[index];
+  LightExtent e;
+  e.dir = (float3)(0.0f);
+  e.omega = 0.0f;
+  e.radius = PI_F;
+  e.integral = 0.0f;
+  e.pmf = light->pmf;
+  e.everywhere = false;
+  e.map = false;
+#define LIGHTS_EXTENT(id, name, feature) \
+  if (feature && light->type == id) lights_##name##_extent(sc, light, p, &e);
+  CD_LIGHTS(LIGHTS_EXTENT)
+#undef LIGHTS_EXTENT
+  return e;
 }

@@ -39,7 +39,7 @@
 //   uint bsdf_NAME_flags(const Bsdf*)
 //   float3 bsdf_NAME_eval(const Bsdf*, float3 wo, float3 wi, float* pdf)
 //   bool bsdf_NAME_sample(const Bsdf*, float3 wo, float uc, float2 u, BsdfSample*)
-//   float bsdf_NAME_alpha(const Bsdf*)
+//   void bsdf_NAME_lobes(const Bsdf*, float3 wo, BsdfLobes*): its lobes at wo (bsdf_common.cl)
 // and on the host compile_material_NAME (host/compile/scene_compiler.cpp). `feature` is the
 // CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
 #define MATERIAL_DIFFUSE 0u    // Lambertian, albedo = base color
@@ -81,6 +81,8 @@
 //   bool lights_NAME_sample(const SceneData*, __global const Light*, const LightSampleContext*,
 //                           float2 u, LightSample*)
 //   float lights_NAME_pdf(const SceneData*, __global const Light*, const LightSampleContext*, float3 wi)
+//   void lights_NAME_extent(const SceneData*, __global const Light*, float3 p, LightExtent*)
+//   uint lights_NAME_prim(__global const Light*): the emissive primitive it is, or UINT_MAX
 // in cl/lights/ and light_power_NAME on the host (host/compile/scene_compiler.cpp). `feature`
 // is the CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
 #define LIGHT_TRIANGLE 0u     // an emissive triangle (area light)
@@ -101,7 +103,7 @@
 // Integration strategies (no MIS: each light path is counted by exactly one of them)
 #define STRATEGY_NEE 0u
 #define STRATEGY_BSDF 1u
-#define STRATEGY_AUTO 2u  // per vertex: nee at rough or diffuse BSDFs, bsdf at near-specular ones
+#define STRATEGY_AUTO 2u  // per vertex and per light: whichever of the two has the lower second moment
 
 // Camera projections (camera.cl)
 #define CAMERA_PERSPECTIVE 0u   // pinhole, or a thin lens when lens_radius > 0
@@ -282,6 +284,10 @@ typedef struct {
 //                      TextureInfo index (an integer stored as float), params[1] = strength
 //                      (radiance = strength x texel), params[2] = rotation about +Y in
 //                      radians; its sampling distribution is the env_distribution buffer.
+//                      Both, for STRATEGY_AUTO's choice, L the luminance before strength:
+//                      params[3] = effective solid angle (integral L)^2 / integral L^2 (4 pi
+//                      for a constant), params[4..6] = unit direction L^2 is centred on
+//                      (zero: none), params[7] = integral of L over the sphere.
 //   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
 //                      radiance[3] = range (0: infinite), params[0..2] = position.
 //   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,

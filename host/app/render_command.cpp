@@ -163,7 +163,7 @@ void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
   render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")
       ->check(integer_in(0, 100000));
   render->add_option("--strategy", a.strategy,
-                     enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else nee");
+                     enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto");
   render->add_flag("--no-energy-compensation", a.no_energy_compensation,
                    "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
                    "default: rough metal and glass keep their albedo)");

@@ -172,7 +172,7 @@ Scene load_render_scene(RenderArgs* args) {
   if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
   options.variant = a.variant;
   Scene scene = load_gltf(a.scene, options);
-  if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "nee" : scene.strategy;
+  if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "auto" : scene.strategy;
   apply_background_options(a, &scene);
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());

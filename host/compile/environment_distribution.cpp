@@ -56,4 +56,28 @@ std::vector<float> environment_distribution(const TextureDesc& map) {
   return out;
 }
 
+EnvironmentExtent environment_extent(const TextureDesc& map, double rotation) {
+  int w = map.width, h = map.height;
+  double sum = 0.0, sum2 = 0.0, centre[3] = {0.0, 0.0, 0.0};
+  for (int r = 0; r < h; ++r) {
+    double theta = kPi * (r + 0.5) / h;
+    double solid_angle = 2.0 * kPi / w * (std::cos(kPi * r / h) - std::cos(kPi * (r + 1) / h));
+    for (int c = 0; c < w; ++c) {
+      double l = std::max(texel_luminance(map, size_t(r) * w + c), 0.0);
+      double phi = 2.0 * kPi * (c + 0.5) / w - rotation;
+      double d[3] = {-std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi)};
+      sum += l * solid_angle;
+      sum2 += l * l * solid_angle;
+      for (int k = 0; k < 3; ++k) centre[k] += d[k] * l * l * solid_angle;
+    }
+  }
+  EnvironmentExtent e;
+  e.integral = sum;
+  e.solid_angle = sum2 > 0.0 ? std::min(sum * sum / sum2, 4.0 * kPi) : 4.0 * kPi;
+  double length = std::sqrt(centre[0] * centre[0] + centre[1] * centre[1] + centre[2] * centre[2]);
+  if (sum2 > 0.0 && length > 1e-3 * sum2)
+    for (int k = 0; k < 3; ++k) e.direction[k] = centre[k] / length;
+  return e;
+}
+
 }  // namespace candela

@@ -376,13 +376,19 @@ dev::Light compile_environment_map(const EnvironmentDesc& env, dev::SceneBuffers
   l.params[0] = float(b->textures.size());  // exact: fewer than 2^24 textures
   l.params[1] = env.strength;
   l.params[2] = float(double(env.rotation) * kPi / 180.0);
+  EnvironmentExtent extent = environment_extent(t, double(l.params[2]));
+  l.params[3] = float(extent.solid_angle);
+  for (int k = 0; k < 3; ++k) l.params[4 + k] = float(extent.direction[k]);
+  l.params[7] = float(extent.integral);
   b->textures.push_back(info);
   b->env_distribution = environment_distribution(t);
   *power_scale = environment_mean_luminance(t) * env.strength;
   return l;
 }
 
-// Every emissive triangle, punctual light and the environment, with the selection table
+// Every emissive triangle, punctual light and the environment, with the selection table.
+// Triangle lights come first, in increasing primitive order: the kernel finds the light of
+// an emitter it hits by a binary search (lights_of_prim, cl/lights/lights.cl).
 int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   std::vector<double> texture_mean(scene.textures.size(), -1.0);  // computed on first use
   std::vector<double> power;
@@ -429,6 +435,8 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     dev::Light l{};
     l.type = LIGHT_ENVIRONMENT;
     l.params[0] = float(NO_TEXTURE);  // constant radiance
+    l.params[3] = float(4.0 * kPi);   // its solid angle: the sphere, no direction
+    l.params[7] = float(4.0 * kPi);   // integral of a unit radiance over it
     for (int c = 0; c < 3; ++c) l.radiance[c] = scene.background[c];
     environment = int(b->lights.size());
     b->lights.push_back(l);

@@ -32,7 +32,7 @@ enum class Sampler : uint32_t { Sobol, Independent };
 inline constexpr EnumName<Strategy> kStrategyNames[] = {
     {Strategy::Nee, "nee", "next-event estimation"},
     {Strategy::Bsdf, "bsdf", "BSDF sampling only"},
-    {Strategy::Auto, "auto", "per vertex: bsdf at near-specular surfaces, nee elsewhere"}};
+    {Strategy::Auto, "auto", "per vertex and light: whichever of the two has the lower variance; default"}};
 inline constexpr EnumName<PixelFilter> kPixelFilterNames[] = {{PixelFilter::Box, "box", "default"},
                                                               {PixelFilter::Tent, "tent", "radius 1 pixel"},
                                                               {PixelFilter::Gaussian, "gaussian", "sigma 0.5 pixel"}};
@@ -47,7 +47,7 @@ struct RenderSettings {
   uint32_t seed = 0;
   uint32_t max_depth = 16;  // scattering events
   uint32_t rr_depth = 3;    // Russian roulette after this many bounces
-  Strategy strategy = Strategy::Nee;
+  Strategy strategy = Strategy::Auto;
   bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/bsdf/energy.cl)
   PixelFilter filter = PixelFilter::Box;
   Sampler sampler = Sampler::Sobol;

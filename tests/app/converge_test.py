@@ -75,7 +75,7 @@ class Converge(unittest.TestCase):
         self.assertEqual([int(r["spp"]) for r in rows], ladder)
         for r in rows:
             self.assertEqual(r["renderer"], "candela")
-            self.assertEqual(r["strategy"], "nee")
+            self.assertEqual(r["strategy"], "auto")
             self.assertIn("Portable Computing Language", r["device"])
             rel, mse, mae, sec = float(r["rel_mse"]), float(r["mse"]), float(r["mae"]), float(r["seconds"])
             self.assertGreater(sec, 0)

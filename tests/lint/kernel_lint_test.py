@@ -144,16 +144,19 @@ LOBE = {
     'flags': ('uint', ['const Bsdf*']),
     'eval': ('float3', ['const Bsdf*', 'float3', 'float3', 'float*']),
     'sample': ('bool', ['const Bsdf*', 'float3', 'float', 'float2', 'BsdfSample*']),
-    'alpha': ('float', ['const Bsdf*']),
+    'lobes': ('void', ['const Bsdf*', 'float3', 'BsdfLobes*']),
 }
 COMPONENT = {
     'weight': ('float', ['const Bsdf*', 'const GltfAtWo*', 'float']),
     'sample': ('int', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float', 'float2', 'BsdfSample*']),
+    'lobes': ('void', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float', 'BsdfLobes*']),
 }
 LIGHT = {
     'sample': ('bool', ['const SceneData*', '__global const Light*', 'const LightSampleContext*', 'float2',
                         'LightSample*']),
     'pdf': ('float', ['const SceneData*', '__global const Light*', 'const LightSampleContext*', 'float3']),
+    'extent': ('void', ['const SceneData*', '__global const Light*', 'float3', 'LightExtent*']),
+    'prim': ('uint', ['__global const Light*']),
 }
 
 
