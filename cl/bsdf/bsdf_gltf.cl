@@ -98,8 +98,7 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   lobe->sheen_albedo = sc->sheen_albedo;
   layered = layered || max_component(lobe->sheen) > 0.0f;
 #endif
-  if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f &&
-      !layered)
+  if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f && !layered)
     b->type = MATERIAL_DIFFUSE;
 }
 
@@ -236,8 +235,8 @@ float3 gltf_sheen_f(const Bsdf* b, float e_o, float3 wo, float3 wi) {
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
-  float base_norm;                // gltf_coat_base_norm
-  float outer;  // what the layers over the base (coat, sheen) leave it at wo
+  float base_norm;  // gltf_coat_base_norm
+  float outer;      // what the layers over the base (coat, sheen) leave it at wo
 #if CD_FEATURE_SHEEN
   float sheen_e_o, sheen_o;  // gltf_sheen_e and gltf_sheen_below at wo
 #endif
@@ -342,8 +341,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   // The sheen over them: albedo scaling, then its own lobe
   if (max_component(lobe->sheen) > 0.0f) {
     if (wi.z > 0.0f) {
-      under = under * fmin(g->sheen_o, gltf_sheen_below(b, gltf_sheen_e(b, wi.z))) +
-              gltf_sheen_f(b, g->sheen_e_o, wo, wi);
+      under =
+          under * fmin(g->sheen_o, gltf_sheen_below(b, gltf_sheen_e(b, wi.z))) + gltf_sheen_f(b, g->sheen_e_o, wo, wi);
       *pdf += w[GLTF_SHEEN] * sheen_sample_pdf(wi);
     } else {
       under *= b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -wi.z));

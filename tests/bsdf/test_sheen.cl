@@ -41,8 +41,7 @@ __kernel void test_sheen_albedo_lookup(__global const float* table, __global con
 // (wi, pdf), (f, 1 for a delta sample, else 0), (bsdf_eval, bsdf_pdf) at wi; all zero where
 // sampling fails
 __kernel void test_sheen_sample(__global const Material* materials, __global const float* ggx,
-                                __global const float* sheen, uint tables, float4 wo, uint seed,
-                                __global float4* out) {
+                                __global const float* sheen, uint tables, float4 wo, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   Bsdf b = test_sheen_bsdf(materials, ggx, sheen, tables, wo.xyz);
   BsdfSample bs;

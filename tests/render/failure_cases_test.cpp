@@ -38,16 +38,6 @@ double region_median(const Film& f, int x0, int x1, int y0, int y1) {
   return v[v.size() / 2];
 }
 
-double rel_mse(const Film& f, const Film& ref) {
-  double sum = 0.0;
-  for (size_t i = 0; i < f.pixels(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      double r = ref.pixel(i)[c], d = f.pixel(i)[c] - r;
-      sum += d * d / (r * r + 0.01);
-    }
-  return sum / double(3 * f.pixels());
-}
-
 Scene glass_furnace(bool solid) {
   GltfBuilder g;
   json ext = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}};
