@@ -752,7 +752,7 @@ def make_environment(path):
 
 
 # ---------------------------------------------------------------------------
-# Light vs BSDF sampling: where each fails (the lecture's comparison pair, Veach's layout)
+# Light vs BSDF sampling: where each fails (Veach 1997, ch. 9: his plates' layout)
 
 def metal_pbr(g, name, roughness, base=(0.8, 0.8, 0.8)):
     return g.pbr_material(name, {"baseColorFactor": list(base) + [1.0], "metallicFactor": 1.0,

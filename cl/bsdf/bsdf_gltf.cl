@@ -29,8 +29,8 @@
 // gain energy from it. The diffuse base under the coat is normalized by the coat's and the
 // specular layer's joint transmittance (gltf_coat_base_norm), so a white Lambert base under a
 // clear coat returns the light trapped under the coat.
-// Sampling picks a component with a probability from its estimated weight at wo (the
-// lecture's combined BSDF); eval and pdf sum every non-delta component, so sampling and
+// Sampling picks a component with a probability from its estimated weight at wo (a
+// mixture of BSDFs, PBRT 4th ed. sec. 9.1); eval and pdf sum every non-delta component, so sampling and
 // evaluation describe the same mixture.
 //
 // GLTF_COMPONENTS: X(id, name, kind), the components in sampling order, kind the BSDF_*

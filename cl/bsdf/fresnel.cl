@@ -1,4 +1,5 @@
-// Fresnel reflectance for unpolarized light (the lecture's Fresnel equations).
+// Fresnel reflectance for unpolarized light (the Fresnel equations as in Pharr, Jakob and
+// Humphreys, Physically Based Rendering, 4th ed., 2023, sec. 9.3).
 
 // Dielectric interface: cos_i = cosine of the incident direction to the normal on its
 // side, eta = eta_t / eta_i (the far side over the near side). Total internal reflection
@@ -16,8 +17,8 @@ float fresnel_dielectric(float cos_i, float eta) {
 }
 
 // Refracts w (pointing away from the surface, on the side of n) through a surface of
-// relative index eta = eta_t / eta_i; false on total internal reflection. The lecture's
-// w_t = -w / eta + (cos_i / eta - cos_t) n.
+// relative index eta = eta_t / eta_i; false on total internal reflection. Snell's law in
+// vector form (PBRT 4th ed. sec. 9.3): w_t = -w / eta + (cos_i / eta - cos_t) n.
 bool fresnel_refract(float3 w, float3 n, float eta, float3* wt) {
   float cos_i = dot(w, n);
   float sin2_t = fmax(0.0f, 1.0f - cos_i * cos_i) / (eta * eta);
@@ -35,7 +36,8 @@ float3 fresnel_reflect(float3 w, float3 n) { return 2.0f * dot(w, n) * n - w; }
 //   r_s^2 = (a^2 + b^2 - 2 a cos + cos^2) / (a^2 + b^2 + 2 a cos + cos^2),
 //   r_p^2 = r_s^2 (cos^2 (a^2 + b^2) - 2 a cos sin^2 + sin^4) /
 //                 (cos^2 (a^2 + b^2) + 2 a cos sin^2 + sin^4).
-// (The lecture's simpler form approximates this where eta^2 + k^2 >> 1.)
+// (Pharr and Humphreys' simpler form, PBRT 2nd ed. 2010, approximates this where
+// eta^2 + k^2 >> 1.)
 float3 fresnel_conductor(float cos_i, float3 eta, float3 k) {
   cos_i = clamp(cos_i, 0.0f, 1.0f);
   float cos2 = cos_i * cos_i, sin2 = 1.0f - cos2;

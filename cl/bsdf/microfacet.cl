@@ -1,5 +1,6 @@
 // Anisotropic Trowbridge-Reitz (GGX) microfacet distribution in the local shading frame
-// (z = normal): the lecture's D, Smith Lambda, G1 and height-correlated G, and sampling
+// (z = normal): D, Smith Lambda and G1 (Walter et al. 2007), the height-correlated G (Heitz
+// 2014, Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs), and sampling
 // of visible normals (Heitz 2018, Sampling the GGX Distribution of Visible Normals).
 
 // Below this roughness a lobe is treated as a perfect mirror or window (a delta lobe)

@@ -1,4 +1,5 @@
-// Sampling routines of the lecture, each with its pdf.
+// Sampling routines, each with its pdf (Pharr, Jakob and Humphreys, Physically Based
+// Rendering, 4th ed., 2023, appendix A.5).
 
 #define PI_F 3.14159265358979323846f
 #define INV_PI_F 0.31830988618379067154f
@@ -31,7 +32,7 @@ float3 sample_uniform_sphere(float u, float v) {
 
 float sample_uniform_sphere_pdf(void) { return 0.25f * INV_PI_F; }
 
-// Uniform point on a triangle (v0, v1, v2): the lecture's s = 1 - sqrt(u), t = v sqrt(u),
+// Uniform point on a triangle (v0, v1, v2): s = 1 - sqrt(u), t = v sqrt(u) (Turk 1990),
 // x = s v0 + t v1 + (1-s-t) v2, returned as Hit's barycentric weights (b1, b2) = (t, 1-s-t)
 // of v1 and v2, so that x = (1 - b1 - b2) v0 + b1 v1 + b2 v2. The pdf is 1 / area.
 float2 sample_triangle(float u, float v) {

@@ -1,4 +1,5 @@
-// Equirectangular environment maps: the lecture's L_i(w) = I[theta/pi h, phi/2pi w], and
+// Equirectangular environment maps: L_i(w) = I[theta/pi h, phi/2pi w] (the latitude-longitude
+// mapping), and
 // their importance sampling by a piecewise-constant 2D distribution (pbrt's
 // marginal-over-rows, conditional-within-rows construction).
 //

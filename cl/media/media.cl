@@ -14,7 +14,7 @@
 //
 // Coefficients: sigma_t = sigma_a + sigma_s per RGB channel, times the grid's density for
 // MEDIUM_GRID (dense) and MEDIUM_NANOVDB (nanovdb.cl); `emission` is emitted radiance per
-// unit length (the lecture's L_e(z); for grids times the density, or the value of the
+// unit length (L_e(z) of the radiative transfer equation; for grids times the density, or the value of the
 // emission grid Medium.emission_grid names), so a ray crossing length d of a homogeneous
 // medium gathers emission (1 - exp(-sigma_t d)) / sigma_t.
 

@@ -1,9 +1,9 @@
-// Phase functions: the BSDFs of points in a medium (the lecture's f_p). Directions follow
+// Phase functions: the BSDFs of points in a medium (f_p in the radiative transfer equation). Directions follow
 // the BSDF convention: wo points back along the ray that arrived (toward the camera), wi
 // toward where light comes from, and the path continues along wi. The phase function
 // integrates to 1 over the sphere, and sampling is exact: weight f / pdf = 1.
 //
-// Henyey-Greenstein (the lecture's formula): with cos = dot(wo, wi),
+// Henyey-Greenstein (Henyey and Greenstein 1941): with cos = dot(wo, wi),
 //   f_p(wo, wi) = (1 - g^2) / (4 pi (1 + g^2 + 2 g cos)^(3/2)).
 // g > 0 scatters forward: light keeps going, so wi lies near -wo and the mean of
 // dot(-wo, wi) is g. g = 0 is the isotropic 1 / (4 pi). g lies in (-1, 1).

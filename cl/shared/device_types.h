@@ -308,8 +308,8 @@ typedef struct {
 
 // A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
 // RGB at density 1; MEDIUM_GRID and MEDIUM_NANOVDB multiply them by the density at the point
-// (grid value x density_scale). `emission` is radiance emitted per unit length (the
-// lecture's L_e(z)). MEDIUM_NANOVDB uses the grid fields differently: grid_offset is the
+// (grid value x density_scale). `emission` is radiance emitted per unit length (L_e(z)
+// of the radiative transfer equation). MEDIUM_NANOVDB uses the grid fields differently: grid_offset is the
 // grid's first word in `nanovdb`, grid_size is unused, and grid_min/grid_max are the box in
 // the grid's index space that the majorant cells split (the active voxels and one voxel
 // around them); rays are mapped to index space once per segment (the map is affine, so the

@@ -31,7 +31,7 @@ enum class AlphaMode { Opaque, Mask, Blend };
 // space, or between the voxels of a NanoVDB grid (host/vdb_grid.hpp).
 struct MediumDesc {
   glm::vec3 sigma_a{0.0f}, sigma_s{0.0f};
-  glm::vec3 emission{0.0f};                  // radiance emitted per unit length (the lecture's L_e(z))
+  glm::vec3 emission{0.0f};                  // radiance emitted per unit length (L_e(z), radiative transfer)
   float g = 0.0f;                            // Henyey-Greenstein asymmetry, in (-1, 1)
   glm::ivec3 grid_size{0};                   // nodes along x, y, z (each >= 2) when there is a grid
   std::vector<float> density;                // grid values, x fastest, then y, then z; empty: homogeneous

@@ -1,8 +1,8 @@
 // Fresnel (cl/bsdf/fresnel.cl) and Trowbridge-Reitz / GGX (cl/bsdf/microfacet.cl) kernel routines
 // against host formulas in double (tests/bsdf/test_microfacet.cl runs them):
-//  - Fresnel: the lecture's dielectric r_s, r_p; Snell's law and total internal reflection;
+//  - Fresnel: the dielectric r_s, r_p (PBRT 4th ed. sec. 9.3); Snell's law and total internal reflection;
 //    conductors against the exact complex-index Fresnel equations (std::complex);
-//  - GGX: D and Lambda against the lecture's angular forms, D and the visible-normal
+//  - GGX: D and Lambda against Walter et al. 2007's angular forms, D and the visible-normal
 //    density D_w normalized (quadrature), ggx_sample_visible against D_w (chi-square,
 //    1M samples, cells with expected count < 5 pooled, alpha = 0.01 with the Sidak
 //    correction over this file's chi-square tests) and a wrong-alpha negative control.
@@ -42,7 +42,7 @@ double deg(double d) { return d * kPi / 180.0; }
 
 // --- Host references (double), beside those of support/reference.hpp ---
 
-// The lecture's approximate conductor formula (good where eta^2 + k^2 >> 1)
+// The approximate conductor formula of PBRT 2nd ed. (good where eta^2 + k^2 >> 1)
 double fresnel_conductor_lecture(double c, double eta, double k) {
   double a = eta * eta + k * k;
   double rp2 = (a * c * c - 2.0 * eta * c + 1.0) / (a * c * c + 2.0 * eta * c + 1.0);
@@ -216,7 +216,7 @@ TEST_P(MicrofacetTest, FresnelDielectricTotalInternalReflection) {
   EXPECT_LT(f.back(), 1.0f);
 }
 
-// The lecture's r_s, r_p in double at many angles and relative indices, both sides
+// The dielectric r_s, r_p (PBRT 4th ed. sec. 9.3) in double at many angles and relative indices, both sides
 TEST_P(MicrofacetTest, FresnelDielectricMatchesLecture) {
   std::vector<cl_float2> in;
   for (double eta : {1.5, 1.33, 2.4, 1.0 / 1.5, 1.0 / 1.33, 1.0 / 2.4})
@@ -320,7 +320,8 @@ TEST_P(MicrofacetTest, FresnelConductorMatchesComplexFresnel) {
   }
 }
 
-// Sanity: the lecture's approximation (eta^2 + k^2 >> 1) lies within a few percent for metals
+// Sanity: the approximation for eta^2 + k^2 >> 1 (Pharr and Humphreys, Physically Based
+// Rendering, 2nd ed., 2010) lies within a few percent for metals
 TEST_P(MicrofacetTest, FresnelConductorNearLectureApproximation) {
   std::vector<float> cos_i;
   for (int d = 0; d <= 85; d += 5) cos_i.push_back(float(std::cos(deg(d))));
@@ -335,7 +336,7 @@ TEST_P(MicrofacetTest, FresnelConductorNearLectureApproximation) {
   }
 }
 
-// D, Lambda, G1 = 1 / (1 + Lambda) and the height-correlated G against the lecture's
+// D, Lambda, G1 = 1 / (1 + Lambda) and the height-correlated G against Walter et al. 2007's
 // angular forms at random directions
 TEST_P(MicrofacetTest, GgxMatchesLectureFormulas) {
   std::mt19937_64 gen(5);

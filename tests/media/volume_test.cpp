@@ -1,5 +1,5 @@
 // Participating media on the real kernels (cl/media/phase.cl, cl/media/media.cl, cl/integrator/integrator_path.cl):
-//  - phase functions: chi-square of phase_sample against the lecture's Henyey-Greenstein
+//  - phase functions: chi-square of phase_sample against Henyey and Greenstein's (1941)
 //    pdf (host, double) over (cos, phi) cells, 1M samples, alpha = 0.01 with the Sidak
 //    correction over this file's chi-square tests; the sampled pdf equals phase_pdf; the
 //    pdf integrates to 1; the mean cosine between old and new travel directions is g;
@@ -131,7 +131,7 @@ TEST_P(PhaseTest, SamplesFollowThePdf) {
   EXPECT_NEAR(total, 1.0, 1e-6) << "host pdf does not integrate to 1";
   ChiSquare r = chi_square_test(observed_cells(s), expected);
   EXPECT_GT(r.p_value, kAlpha) << "g " << g_ << ": chi2 " << r.statistic << " dof " << r.dof;
-  // The sample's pdf is phase_pdf at the sampled direction and the lecture's formula
+  // The sample's pdf is phase_pdf at the sampled direction and Henyey and Greenstein's formula
   Frame3 f = frame_around(kWo);
   for (size_t i = 0; i < kPhaseSamples; i += 97) {
     const cl_float4& v = s.wi_pdf[i];

@@ -395,7 +395,7 @@ TEST(VolumeTracking, ComparisonRejectsAWrongReference) {
 
 // --- Henyey-Greenstein sampling near |g| = 1 ---
 
-// The deflection angle of phase_sample's directions follows the lecture's cdf at g = +-0.99
+// The deflection angle of phase_sample's directions follows Henyey and Greenstein's cdf at g = +-0.99
 // and +-0.999, where the peak is (1 - |g|) / sqrt|g| wide (1e-3 rad at 0.999): Kolmogorov-
 // Smirnov over 2^20 samples at alpha = 0.01 (critical D = 1.63 / sqrt(n)), on the angle
 // measured in double precision as atan2(|wi x d|, wi . d) from the float directions (accurate

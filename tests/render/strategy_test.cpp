@@ -1,4 +1,4 @@
-// Where each strategy fails (the lecture's point, without MIS): next-event estimation
+// Where each strategy fails (Veach 1997, ch. 9, without MIS): next-event estimation
 // (nee), BSDF sampling (bsdf) and the per-vertex choice between them (auto) rendered to
 // equal sample counts on scenes/lights/ and compared with a high-sample reference the
 // test renders itself (another seed). relMSE = mean over pixels and channels of

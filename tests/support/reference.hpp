@@ -61,7 +61,7 @@ struct GgxReference {
   std::pair<double, double> reflection(glm::dvec3 wo, glm::dvec3 wi) const;
 };
 
-// The same D and Lambda in spherical coordinates of m and w (the lecture's angular forms:
+// The same D and Lambda in spherical coordinates of m and w (Walter et al. 2007's angular forms:
 // D = 1 / (pi ax ay cos^4 (1 + tan^2 (cos^2 phi / ax^2 + sin^2 phi / ay^2))^2), Lambda with
 // alpha^2 = ax^2 cos^2 phi + ay^2 sin^2 phi); m and w need not be unit
 double ggx_d_angular(double ax, double ay, glm::dvec3 m);
