@@ -62,6 +62,9 @@ int primitive_material(const ReadContext& ctx, const tinygltf::Primitive& prim) 
         }
     }
   }
+  if (material >= count)  // -1: no material, the glTF default
+    ctx.warn.add("a primitive names material " + std::to_string(material) + ", which the file does not have (" +
+                 std::to_string(count) + " materials): it gets the default material");
   return material >= 0 && material < count ? material : count;
 }
 

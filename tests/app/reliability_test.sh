@@ -279,6 +279,23 @@ else
   fail "a bad data: URI image is dropped with a warning"
   cat "$tmp/err"
 fi
+# A primitive naming a material the file does not have: a warning, the default material
+"$py" - "$box/scene/tri.bin" "$box/scene/nomaterial.gltf" <<'PY'
+import json, sys
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 99}]}],
+     "buffers": [{"uri": "tri.bin", "byteLength": 36}], "bufferViews": [{"buffer": 0, "byteLength": 36}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                    "min": [0, 0, 0], "max": [1, 1, 0]}]}
+json.dump(g, open(sys.argv[2], "w"))
+PY
+if "$bin" render "$box/scene/nomaterial.gltf" --device pocl -q -o "$tmp/nm.png" --width 16 --spp 1 >/dev/null \
+  2>"$tmp/err" && grep -q "^warning: .*material 99" "$tmp/err"; then
+  pass "a missing material index is a warning: $(grep -m1 'material 99' "$tmp/err")"
+else
+  fail "a missing material index is a warning"
+  cat "$tmp/err"
+fi
 # Non-regular files named on the command line: one line, no hang
 one_error "a FIFO as the scene" -- timeout 20 "$bin" info "$box/scene/fifo.bin"
 one_error "/dev/zero as --env" -- timeout 20 "${render[@]}" -o "$tmp/never.png" --env /dev/zero --width 16
