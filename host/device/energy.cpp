@@ -13,13 +13,6 @@ namespace {
 
 constexpr size_t kBytes = GGX_ALBEDO_SIZE * sizeof(float);
 
-// Every entry an albedo in [0, 1] (NaN fails)
-bool valid(const std::vector<float>& table) {
-  for (float e : table)
-    if (!(e >= 0.0f && e <= 1.0f)) return false;
-  return true;
-}
-
 std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                  cl::Buffer* buffer) {
   *buffer = cl::Buffer(context, CL_MEM_READ_WRITE, kBytes);
@@ -37,7 +30,6 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   queue.enqueueNDRangeKernel(diel_average, cl::NullRange, cl::NDRange(DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
   std::vector<float> table(GGX_ALBEDO_SIZE);
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
-  if (!valid(table)) throw Error("the device computed GGX albedos outside [0, 1]");
   return table;
 }
 
@@ -49,20 +41,9 @@ GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQue
   GgxAlbedoTable t;
   std::string path = program_cache_file.empty() ? "" : program_cache_file + ".ggx_albedo";
   try {
-    std::vector<unsigned char> cached = path.empty() ? std::vector<unsigned char>() : read_cache_entry(path);
-    std::vector<float> loaded(cached.size() == kBytes ? GGX_ALBEDO_SIZE : 0);
-    if (!loaded.empty()) std::memcpy(loaded.data(), cached.data(), kBytes);
-    if (!loaded.empty() && valid(loaded)) {  // the cache entry's checksum is read_cache_entry's
-      t.buffer = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kBytes, loaded.data());
-      t.from_cache = true;
-    } else {
-      std::vector<float> table = compute_table(context, queue, program, &t.buffer);
-      if (!path.empty()) {
-        std::vector<unsigned char> bytes(kBytes);
-        std::memcpy(bytes.data(), table.data(), kBytes);
-        write_cache_entry(path, bytes);
-      }
-    }
+    t.buffer = cached_device_table(
+        context, path, GGX_ALBEDO_SIZE, 0.0f, 1.0f, "GGX albedos",
+        [&](cl::Buffer* buffer) { return compute_table(context, queue, program, buffer); }, &t.from_cache);
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("computing the GGX albedo table", e.err()));
   }

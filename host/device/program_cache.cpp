@@ -153,4 +153,30 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
   return result;
 }
 
+cl::Buffer cached_device_table(const cl::Context& context, const std::string& path, size_t count, float lo, float hi,
+                               const std::string& what, const std::function<std::vector<float>(cl::Buffer*)>& compute,
+                               bool* from_cache) {
+  const size_t bytes = count * sizeof(float);
+  auto in_range = [&](const std::vector<float>& values) {
+    for (float v : values)
+      if (!(v >= lo && v <= hi)) return false;
+    return true;
+  };
+  std::vector<unsigned char> cached = path.empty() ? std::vector<unsigned char>() : read_cache_entry(path);
+  std::vector<float> values(cached.size() == bytes ? count : 0);
+  if (!values.empty()) std::memcpy(values.data(), cached.data(), bytes);
+  *from_cache = !values.empty() && in_range(values);  // the entry's checksum is read_cache_entry's
+  if (*from_cache) return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, values.data());
+  cl::Buffer buffer;
+  values = compute(&buffer);
+  if (values.size() != count || !in_range(values))
+    throw Error("the device computed " + what + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  if (!path.empty()) {
+    std::vector<unsigned char> data(bytes);
+    std::memcpy(data.data(), values.data(), bytes);
+    write_cache_entry(path, data);
+  }
+  return buffer;
+}
+
 }  // namespace candela

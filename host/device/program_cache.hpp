@@ -5,6 +5,7 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,5 +33,14 @@ std::string kernel_cache_dir();
 // corrupt entry is removed); writing is atomic and an unwritable cache is not an error
 std::vector<unsigned char> read_cache_entry(const std::string& path);
 void write_cache_entry(const std::string& path, const std::vector<unsigned char>& data);
+
+// A table of `count` floats computed on a device and kept in the cache entry `path` (empty:
+// no cache). The entry is used when every value lies in [lo, hi] (NaN fails: a corrupt or
+// crafted entry is recomputed); else `compute` fills the device buffer and returns the
+// values, which must pass the same check (Error naming `what` otherwise) and are cached.
+// *from_cache says which happened.
+cl::Buffer cached_device_table(const cl::Context& context, const std::string& path, size_t count, float lo, float hi,
+                               const std::string& what, const std::function<std::vector<float>(cl::Buffer*)>& compute,
+                               bool* from_cache);
 
 }  // namespace candela

@@ -23,8 +23,6 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   queue.enqueueNDRangeKernel(albedo, cl::NullRange, cl::NDRange(SHEEN_ALBEDO_N, SHEEN_ALBEDO_N));
   std::vector<float> table(SHEEN_ALBEDO_SIZE);
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
-  for (float e : table)
-    if (!(e >= 0.0f && e <= 100.0f)) throw Error("the device computed sheen albedos outside [0, 100]");
   return table;
 }
 
@@ -36,18 +34,9 @@ SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::Comman
   SheenAlbedoTable t;
   std::string path = program_cache_file.empty() ? "" : program_cache_file + ".sheen_albedo";
   try {
-    std::vector<unsigned char> cached = path.empty() ? std::vector<unsigned char>() : read_cache_entry(path);
-    if (cached.size() == kBytes) {
-      t.buffer = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kBytes, cached.data());
-      t.from_cache = true;
-    } else {
-      std::vector<float> table = compute_table(context, queue, program, &t.buffer);
-      if (!path.empty()) {
-        std::vector<unsigned char> bytes(kBytes);
-        std::memcpy(bytes.data(), table.data(), kBytes);
-        write_cache_entry(path, bytes);
-      }
-    }
+    t.buffer = cached_device_table(
+        context, path, SHEEN_ALBEDO_SIZE, 0.0f, 100.0f, "sheen albedos",
+        [&](cl::Buffer* buffer) { return compute_table(context, queue, program, buffer); }, &t.from_cache);
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("computing the sheen albedo table", e.err()));
   }
