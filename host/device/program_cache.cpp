@@ -3,10 +3,13 @@
 #include <unistd.h>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -37,8 +40,25 @@ std::string cache_key(const DeviceEntry& d, const std::string& source, const std
   return hex64(fnv1a64(source, fnv1a64(key)));
 }
 
+// Something other than a regular file where an entry belongs (a directory, a FIFO, a device)
+// is left alone and reported once per path: the cache is skipped for that entry, the build
+// goes on from source, and opening it is never tried (a FIFO would block)
+bool usable_entry_path(const std::string& path) {
+  std::error_code ec;
+  fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st) || fs::is_regular_file(st)) return true;
+  static std::mutex mutex;
+  static std::set<std::string> reported;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (reported.insert(path).second)
+    std::fprintf(stderr, "warning: the kernel cache entry %s is not a regular file: not using the cache for it\n",
+                 path.c_str());
+  return false;
+}
+
 // The cached binary, or empty when missing or corrupt (a corrupt file is removed)
 std::vector<unsigned char> read_entry(const std::string& path) {
+  if (!usable_entry_path(path)) return {};
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};
   std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), {});
@@ -59,6 +79,7 @@ std::vector<unsigned char> read_entry(const std::string& path) {
 }
 
 void write_entry(const std::string& path, const std::vector<unsigned char>& binary) {
+  if (!usable_entry_path(path)) return;
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
   // Unique per process, thread and call: workers of several devices may write at once

@@ -301,5 +301,27 @@ one_error "a FIFO as the scene" -- timeout 20 "$bin" info "$box/scene/fifo.bin"
 one_error "/dev/zero as --env" -- timeout 20 "${render[@]}" -o "$tmp/never.png" --env /dev/zero --width 16
 one_error "a folder as --env" -- timeout 20 "${render[@]}" -o "$tmp/never.png" --env "$box" --width 16
 
+# ---- The kernel cache: a folder or a FIFO where an entry belongs is reported, not fatal ----
+cache=$tmp/kcache
+CANDELA_CACHE_DIR=$cache "${render[@]}" -o "$tmp/c0.png" --width 16 --spp 1 >/dev/null 2>&1
+entries=$(ls "$cache" 2>/dev/null)
+if [ -n "$entries" ]; then
+  first=1
+  for e in $entries; do
+    rm -f "$cache/$e"
+    if [ $first = 1 ]; then mkdir "$cache/$e"; else mkfifo "$cache/$e"; fi
+    first=0
+  done
+  if CANDELA_CACHE_DIR=$cache timeout 60 "${render[@]}" -o "$tmp/c1.png" --width 16 --spp 1 >/dev/null 2>"$tmp/err" &&
+    [ -s "$tmp/c1.png" ] && grep -q '^warning: the kernel cache entry .* is not a regular file' "$tmp/err"; then
+    pass "a folder and a FIFO in the kernel cache: $(head -1 "$tmp/err")"
+  else
+    fail "a folder and a FIFO in the kernel cache"
+    cat "$tmp/err"
+  fi
+else
+  fail "the kernel cache was not written to $cache"
+fi
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]
