@@ -13,9 +13,13 @@ BODY, which reads `cfg` (the decoded CONFIG_JSON), calls candela_warmup(scene) b
   pixel filter BOX of width 1 px (candela's default box filter: one pixel);
   persistent data off (every render syncs the scene and builds its BVH again);
   seed = cfg["seed"] (default 0); the sampling pattern is Blender's default (reported by the caller);
-  the glTF's first camera; resolution cfg["width"] x cfg["height"] at 100 %; Standard view transform;
-  world black, unless the scene's extras.candela set a background colour (a constant world of that colour) or an
-    environment map (an Environment Texture of that file and strength; rotation conventions are not matched).
+  the glTF's first camera, or cfg["camera"] when given (candela's --stats "camera" record, in glTF coordinates:
+    a new camera at that position and orientation with that vertical field of view, or orthographic half-height,
+    and thin lens, replacing the imported ones); resolution cfg["width"] x cfg["height"] at 100 %; Standard view
+    transform;
+  world black, unless cfg["background"] (config(..., background=[R, G, B])) or the scene's extras.candela set a
+    background colour (a constant world of that colour) or an environment map (an Environment Texture of that file
+    and strength; rotation conventions are not matched).
 
 config(...) builds the CONFIG_JSON dictionary on the host side (it reads the glTF's extras.candela), so that the two
 scripts cannot drift apart.
@@ -27,13 +31,42 @@ import subprocess
 import time
 
 BLENDER_SETUP = r'''
-import bpy, json, sys, time
+import bpy, json, math, sys, time
 import numpy
 # Debian's Blender 3.4 glTF importer uses numpy.bool & co., which numpy 1.24 removed
 for _name, _type in (("bool", bool), ("int", int), ("float", float), ("object", object)):
     if _name not in numpy.__dict__:
         setattr(numpy, _name, _type)
 cfg = json.loads(sys.argv[sys.argv.index("--") + 1])
+
+
+def candela_camera(scene, rec):
+    """A camera from candela's --stats "camera" record (glTF's Y-up coordinates; the importer maps glTF (x, y, z)
+    to Blender (x, -z, y)), made the scene's camera in place of any imported one."""
+    import mathutils
+    for o in [o for o in scene.objects if o.type == "CAMERA"]:
+        bpy.data.objects.remove(o, do_unlink=True)
+    to_blender = lambda v: mathutils.Vector((v[0], -v[2], v[1]))
+    right, up, forward = (to_blender(rec[k]).normalized() for k in ("right", "up", "forward"))
+    rotation = mathutils.Matrix((right, up, -forward)).transposed()  # columns: camera X, Y, Z (Z looks back)
+    data = bpy.data.cameras.new("candela-camera")
+    data.sensor_fit = "VERTICAL"
+    if rec["type"] == "orthographic":
+        data.type = "ORTHO"
+        data.ortho_scale = 2.0 * rec["ymag"]
+    else:
+        data.type = "PERSP"
+        data.angle_y = math.radians(rec["yfov_degrees"])
+        if rec.get("lens_radius", 0) > 0:  # Cycles' aperture radius is lens / (2 f-stop), lens in mm
+            data.dof.use_dof = True
+            data.dof.focus_distance = rec["focus_distance"]
+            data.dof.aperture_fstop = data.lens * 1e-3 / (2.0 * rec["lens_radius"])
+    data.clip_start = 1e-4
+    data.clip_end = 1e6
+    cam = bpy.data.objects.new("candela-camera", data)
+    cam.matrix_world = mathutils.Matrix.Translation(to_blender(rec["position"])) @ rotation.to_4x4()
+    scene.collection.objects.link(cam)
+    scene.camera = cam
 
 
 def candela_scene(cfg):
@@ -44,6 +77,8 @@ def candela_scene(cfg):
     cams = [o for o in scene.objects if o.type == "CAMERA"]
     if cams:
         scene.camera = cams[0]
+    if cfg.get("camera"):
+        candela_camera(scene, cfg["camera"])
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
@@ -133,7 +168,8 @@ def scene_extras(path):
 
 def config(scene, max_depth, width, height, threads=None, seed=0, **more):
     """The settings dictionary for candela_scene(cfg): the scene's absolute path, candela's max depth, the size,
-    Cycles' thread count (default: nproc), its seed, and the world from the glTF's extras.candela."""
+    Cycles' thread count (default: nproc), its seed, and the world from the glTF's extras.candela. MORE is added
+    last: background=[R, G, B] (a constant world), camera=candela's --stats "camera" record, or the caller's own."""
     cfg = {"scene": os.path.abspath(scene), "max_depth": int(max_depth), "width": int(width), "height": int(height),
            "threads": int(threads or os.cpu_count() or 1), "seed": int(seed)}
     ex = scene_extras(scene)

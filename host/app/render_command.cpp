@@ -378,6 +378,7 @@ int run_render(RenderArgs a) {
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", joined_descriptions(devices).c_str());
   std::string camera = camera_fingerprint(scene, settings.width, settings.height);
+  dev::Camera view = compile_camera(scene, settings.width, settings.height);
   std::string lighting = lighting_fingerprint(scene);
   raise_if_asked("kernel-build");
   Renderer renderer = make_renderer(a, &scene, settings, devices);
@@ -388,6 +389,8 @@ int run_render(RenderArgs a) {
   if (r.spp == 0 && !any_samples(r.film)) throw Error("interrupted before any sample was rendered; nothing written");
   RenderReport report = make_render_report(a, settings, renderer, r, devices);
   report.camera = camera;
+  report.view = view;
+  report.has_view = true;
   report.lighting = lighting;
   raise_if_asked("writing");
   bool all_written = write_outputs(a, r.film, report);

@@ -3,6 +3,7 @@
 
 #include <sys/resource.h>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string_view>
@@ -45,6 +46,37 @@ nlohmann::json devices_json(const std::vector<DeviceShare>& shares) {
                     {"share", d.share},
                     {"samples_per_second", d.samples_per_second}});
   return list;
+}
+
+// "camera": the compiled camera (dev::Camera) with unit right and up vectors and the view's
+// extent apart: the vertical field of view (perspective; |up| = tan(yfov / 2)) or the
+// half-height ymag and half-width xmag (orthographic; |up| = ymag)
+nlohmann::json camera_json(const dev::Camera& c) {
+  auto vec = [](const float* v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  auto length = [](const float* v) {
+    return std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
+  };
+  auto unit = [&](const float* v) {
+    double n = std::max(length(v), 1e-30);
+    return nlohmann::json::array({v[0] / n, v[1] / n, v[2] / n});
+  };
+  bool ortho = c.type == CAMERA_ORTHOGRAPHIC;
+  nlohmann::json j = {{"type", ortho ? "orthographic" : "perspective"},
+                      {"position", vec(c.origin)},
+                      {"forward", vec(c.forward)},
+                      {"up", unit(c.up)},
+                      {"right", unit(c.right)},
+                      {"lens_radius", c.lens_radius},
+                      {"focus_distance", c.focus_distance}};
+  if (ortho) {
+    j["ymag"] = length(c.up);
+    j["xmag"] = length(c.right);
+  } else {
+    const double degrees = 180.0 / 3.14159265358979323846;
+    j["yfov_degrees"] = 2.0 * std::atan(length(c.up)) * degrees;
+    j["xfov_degrees"] = 2.0 * std::atan(length(c.right)) * degrees;
+  }
+  return j;
 }
 
 double per_triangle(size_t bytes, size_t triangles) { return double(bytes) / double(std::max<size_t>(1, triangles)); }
@@ -191,6 +223,7 @@ void write_stats(const RenderReport& r, const std::string& path) {
                       {"sample_end", r.sample_end},
                       {"dropped_samples", r.dropped_samples},
                       {"generic_kernel", r.generic_kernel}};
+  if (r.has_view) j["camera"] = camera_json(r.view);
   write_file_atomically(path, j.dump(2) + "\n");
 }
 

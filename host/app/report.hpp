@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "app/render_devices.hpp"
+#include "base/device_types.hpp"
 #include "compile/compiled_scene.hpp"
 #include "render/renderer.hpp"
 #include "scene/scene.hpp"
@@ -33,6 +34,8 @@ struct RenderReport {
   // map): renders that `candela merge` combines must agree on them
   std::string camera, lighting;
   // In the stats only
+  dev::Camera view{};  // the compiled camera the render used ("camera" in the stats)
+  bool has_view = false;
   int width = 0, height = 0;
   double samples_per_second = 0.0;
   bool interrupted = false;

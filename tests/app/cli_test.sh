@@ -183,6 +183,16 @@ assert not missing, missing
 assert s["spp"] == 4 and s["triangles"] == 32 and s["samples_per_second"] > 0, s
 assert s["width"] == 64 and s["height"] == 48, s
 assert s["energy_compensation"] is True, s
+cam = s["camera"]  # the compiled camera: unit forward, right and up at right angles, the fov
+assert cam["type"] in ("perspective", "orthographic") and len(cam["position"]) == 3, cam
+dot = lambda a, b: sum(x * y for x, y in zip(a, b))
+for v in ("forward", "right", "up"):
+    assert abs(dot(cam[v], cam[v]) - 1) < 1e-5, cam
+assert abs(dot(cam["forward"], cam["up"])) < 1e-5 and abs(dot(cam["forward"], cam["right"])) < 1e-5, cam
+if cam["type"] == "perspective":
+    import math
+    tx, ty = (math.tan(math.radians(cam[k] / 2)) for k in ("xfov_degrees", "yfov_degrees"))
+    assert 0 < cam["yfov_degrees"] < 180 and abs(tx / ty - 64 / 48) < 1e-4, cam
 PY
 then pass "stats JSON fields"; else fail "stats JSON fields"; fi
 if command -v oiiotool >/dev/null; then
