@@ -22,7 +22,11 @@ numpy; Mitsuba's own glTF support is not used. What is converted, and how:
   primitive's shape. Mitsuba's area emitter emits from the front face only, like a glTF material that is not
   doubleSided; a doubleSided emissive material (candela: both faces emit) is approximated by its front face (a
   note says so). emissiveTexture is ignored (a note).
-- Materials (glTF metallic-roughness with KHR_materials_*; textures are ignored with a note, their factors used):
+- Materials (glTF metallic-roughness with KHR_materials_*). baseColorTexture becomes a `bitmap` (TEXCOORD_0 as
+  the PLY's u, v, glTF's orientation as is; the image decoded from sRGB and multiplied by baseColorFactor into a
+  linear EXR; the sampler's magFilter as nearest or bilinear, wrapS as the wrap mode) on the diffuse and
+  principled BSDFs below; every other texture, KHR_texture_transform and the alpha modes are ignored with a note,
+  their factors used:
   * metallic 0, transmission 0, KHR_materials_specular specularFactor 0, no clearcoat or sheen: `diffuse` of
     reflectance base colour, wrapped in `twosided` (exact: the glTF model is then Lambert, as in candela).
   * transmission 1, metallic 0: with a KHR_materials_volume thickness > 0 (a refracting solid) `roughdielectric`
@@ -31,6 +35,10 @@ numpy; Mitsuba's own glTF support is not used. What is converted, and how:
     ignored (a note). Thin-walled (no volume, or thickness 0): `thindielectric` (int_ior ior, transmittance base
     colour), whose reflectance 2R/(1 + R) is candela's thin sheet's; APPROXIMATED: Mitsuba's thin dielectric is
     smooth, so a rough thin sheet (candela: a GGX straight-through lobe) is rendered as a smooth one.
+  * materials[i].extras.candela.conductor (candela's measured conductors): `roughconductor` (GGX, alpha =
+    roughness^2; `conductor` below alpha 1e-3), twosided, with candela's RGB complex index: the given {"eta",
+    "k"}, or a preset's as host/gltf/materials.cpp defines it (read from there). Exact up to Mitsuba's missing
+    energy compensation.
   * everything else: `principled` (base_color, metallic, roughness; eta = ior; spec_trans = transmission when it
     is between 0 and 1), wrapped in `twosided` when it does not transmit. Exact for metal (metallic 1: Schlick
     with F0 = base colour, GGX with alpha = roughness^2, as glTF); APPROXIMATED for dielectrics: Mitsuba's
@@ -60,11 +68,14 @@ import base64
 import json
 import math
 import os
+import re
 
 import numpy as np
 
 COMPONENT = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 COUNT = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+CONDUCTOR_SOURCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "host", "gltf",
+                                "materials.cpp")
 DELTA_ALPHA = 1e-3  # candela: a lobe with alpha below this is a mirror or a window (docs/materials.md)
 
 
@@ -133,15 +144,17 @@ def walk(doc, scene_index):
     return out
 
 
-def write_ply(path, positions, normals, faces):
+def write_ply(path, positions, normals, faces, uvs=None):
     with open(path, "wb") as f:
         header = ["ply", "format binary_little_endian 1.0", "element vertex %d" % len(positions),
                   "property float x", "property float y", "property float z"]
         if normals is not None:
             header += ["property float nx", "property float ny", "property float nz"]
+        if uvs is not None:
+            header += ["property float u", "property float v"]
         header += ["element face %d" % len(faces), "property list uchar int vertex_indices", "end_header"]
         f.write(("\n".join(header) + "\n").encode("ascii"))
-        verts = positions if normals is None else np.hstack([positions, normals])
+        verts = np.hstack([a for a in (positions, normals, uvs) if a is not None])
         f.write(np.ascontiguousarray(verts, dtype="<f4").tobytes())
         rec = np.zeros(len(faces), dtype=[("n", "u1"), ("i", "<i4", (3,))])
         rec["n"] = 3
@@ -153,7 +166,66 @@ def rgb(value):
     return {"type": "rgb", "value": [float(v) for v in value[:3]]}
 
 
-def material_bsdf(mat, notes):
+def conductor_presets():
+    """candela's named conductors, {name: {"eta": rgb, "k": rgb}}, read from the one table that defines them
+    (kConductors in host/gltf/materials.cpp), so that the two cannot drift apart"""
+    with open(CONDUCTOR_SOURCE) as f:
+        text = f.read()
+    number = r"\s*([-+0-9.eE]+)f?\s*"
+    vec = r"\{" + ",".join([number] * 3) + r"\}"
+    out = {}
+    for m in re.finditer(r'\{"(\w+)",\s*' + vec + r",\s*" + vec + r"\}", text):
+        out[m.group(1)] = {"eta": [float(v) for v in m.group(2, 3, 4)], "k": [float(v) for v in m.group(5, 6, 7)]}
+    return out
+
+
+def base_color_texture(ctx, info, factor, notes, name):
+    """A Mitsuba `bitmap` of glTF texture INFO's image, decoded from sRGB and multiplied by FACTOR (written as a
+    linear EXR into the temp folder, read raw), with the glTF sampler's filter and wrap mode"""
+    import OpenImageIO as oiio
+    doc, buffers, base, tmpdir = ctx
+    tex = doc["textures"][info["index"]]
+    image = doc["images"][tex["source"]]
+    if info.get("texCoord", 0) != 0 or "KHR_texture_transform" in info.get("extensions", {}):
+        notes.append("material %s: baseColorTexture's texCoord/KHR_texture_transform not mapped (TEXCOORD_0)" % name)
+    if "bufferView" in image:
+        view = doc["bufferViews"][image["bufferView"]]
+        start = view.get("byteOffset", 0)
+        data = buffers[view["buffer"]][start:start + view["byteLength"]]
+    elif image["uri"].startswith("data:"):
+        data = base64.b64decode(image["uri"].split(",", 1)[1])
+    else:
+        with open(os.path.join(base, image["uri"]), "rb") as f:
+            data = f.read()
+    src = os.path.join(tmpdir, "image-%d.%s" % (tex["source"], "jpg" if data[:2] == b"\xff\xd8" else "png"))
+    with open(src, "wb") as f:
+        f.write(data)
+    inp = oiio.ImageInput.open(src)
+    if inp is None:
+        raise ValueError("cannot read the image of material %s: %s" % (name, oiio.geterror()))
+    spec = inp.spec()
+    px = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT), dtype=np.float64)
+    inp.close()
+    px = px.reshape(spec.height, spec.width, spec.nchannels)
+    rgb3 = px[:, :, :3] if spec.nchannels >= 3 else np.repeat(px[:, :, :1], 3, axis=2)
+    linear = np.where(rgb3 <= 0.04045, rgb3 / 12.92, ((rgb3 + 0.055) / 1.055) ** 2.4)  # sRGB EOTF
+    linear = linear * np.array(factor[:3])[None, None, :]
+    exr = os.path.join(tmpdir, "texture-%d-%d.exr" % (info["index"], len(os.listdir(tmpdir))))
+    out = oiio.ImageOutput.create(exr)
+    out.open(exr, oiio.ImageSpec(spec.width, spec.height, 3, oiio.FLOAT))
+    out.write_image(np.ascontiguousarray(linear, dtype=np.float32))
+    out.close()
+    sampler = doc.get("samplers", [{}])[tex["sampler"]] if "sampler" in tex else {}
+    wrap = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
+    wraps = {wrap.get(sampler.get("wrapS", 10497)), wrap.get(sampler.get("wrapT", 10497))}
+    if len(wraps) > 1:
+        notes.append("material %s: different wrapS and wrapT: both take wrapS" % name)
+    return {"type": "bitmap", "filename": exr, "raw": True,
+            "filter_type": "nearest" if sampler.get("magFilter") == 9728 else "bilinear",
+            "wrap_mode": wrap.get(sampler.get("wrapS", 10497), "repeat")}
+
+
+def material_bsdf(mat, notes, ctx=None):
     """(BSDF dict, emitted RGB radiance or None, emits from both faces) of a glTF material"""
     name = mat.get("name", "?")
     pbr = mat.get("pbrMetallicRoughness", {})
@@ -168,14 +240,33 @@ def material_bsdf(mat, notes):
     specular = float(ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0))
     clearcoat = float(ext.get("KHR_materials_clearcoat", {}).get("clearcoatFactor", 0.0))
     sheen = max(ext.get("KHR_materials_sheen", {}).get("sheenColorFactor", [0, 0, 0]))
-    textured = [k for k in ("baseColorTexture", "metallicRoughnessTexture") if k in pbr]
+    base_tex = None
+    if "baseColorTexture" in pbr and ctx is not None:
+        base_tex = base_color_texture(ctx, pbr["baseColorTexture"], pbr.get("baseColorFactor", [1, 1, 1, 1]), notes,
+                                      name)
+    textured = [k for k in ("metallicRoughnessTexture",) if k in pbr]
+    textured += ["baseColorTexture"] if "baseColorTexture" in pbr and base_tex is None else []
     textured += [k for k in ("normalTexture", "emissiveTexture", "occlusionTexture") if k in mat]
     if textured:
         notes.append("material %s: %s ignored (factors only)" % (name, ", ".join(textured)))
     alpha = roughness * roughness
 
-    if metallic == 0 and transmission == 0 and specular == 0 and clearcoat == 0 and sheen == 0:
-        bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(base)}}
+    conductor = mat.get("extras", {}).get("candela", {}).get("conductor")
+    if mat.get("alphaMode", "OPAQUE") != "OPAQUE":
+        notes.append("material %s: alphaMode %s ignored (opaque)" % (name, mat["alphaMode"]))
+    if conductor is not None:
+        bsdf = {"type": "conductor"}
+        if isinstance(conductor, str):
+            presets = conductor_presets()
+            if conductor not in presets:
+                raise ValueError("material %s: conductor preset %s is not in %s" % (name, conductor, CONDUCTOR_SOURCE))
+            conductor = presets[conductor]
+        bsdf.update({"eta": rgb(conductor["eta"]), "k": rgb(conductor["k"])})
+        if alpha >= DELTA_ALPHA:
+            bsdf.update({"type": "roughconductor", "distribution": "ggx", "alpha": alpha})
+        bsdf = {"type": "twosided", "bsdf": bsdf}
+    elif metallic == 0 and transmission == 0 and specular == 0 and clearcoat == 0 and sheen == 0:
+        bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": base_tex or rgb(base)}}
     elif metallic == 0 and transmission == 1:
         if volume is not None and ("attenuationColor" in volume or "attenuationDistance" in volume):
             notes.append("material %s: KHR_materials_volume attenuation ignored" % name)
@@ -189,7 +280,7 @@ def material_bsdf(mat, notes):
                 notes.append("material %s: thin-walled glass of roughness %g rendered smooth (Mitsuba's "
                              "thindielectric)" % (name, roughness))
     else:
-        bsdf = {"type": "principled", "base_color": rgb(base), "metallic": metallic, "roughness": roughness,
+        bsdf = {"type": "principled", "base_color": base_tex or rgb(base), "metallic": metallic, "roughness": roughness,
                 "eta": ior}
         if transmission > 0:
             bsdf["spec_trans"] = transmission
@@ -197,7 +288,10 @@ def material_bsdf(mat, notes):
             bsdf = {"type": "twosided", "bsdf": bsdf}
         if metallic < 1:
             notes.append("material %s: glTF dielectric layer approximated by Mitsuba's principled" % name)
-    handled = {"diffuse": ("KHR_materials_specular",),
+    if base_tex is not None and (bsdf["bsdf"] if bsdf["type"] == "twosided" else bsdf)["type"] not in ("diffuse",
+                                                                                                     "principled"):
+        notes.append("material %s: baseColorTexture ignored (factors only)" % name)
+    handled = {"diffuse": ("KHR_materials_specular",), "conductor": (), "roughconductor": (),
                "principled": ("KHR_materials_transmission", "KHR_materials_ior")}
     inner = bsdf["bsdf"]["type"] if bsdf["type"] == "twosided" else bsdf["type"]
     done = handled.get(inner, ("KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"))
@@ -250,9 +344,12 @@ def scene_dict(mi, path, width, height, max_depth, tmpdir, rr_depth=3, sampler="
             if flip:
                 faces = faces[:, ::-1]
             ply = os.path.join(tmpdir, "shape-%d.ply" % shapes)
-            write_ply(ply, pos, normals, faces)
             mat = materials[prim["material"]] if "material" in prim else default_mat
-            bsdf, emission, two_faced = material_bsdf(mat, notes)
+            uvs = None  # only where a texture needs them (UVs change Mitsuba's tangent frame, so its random paths)
+            if "TEXCOORD_0" in prim["attributes"] and "baseColorTexture" in mat.get("pbrMetallicRoughness", {}):
+                uvs = accessor(doc, buffers, prim["attributes"]["TEXCOORD_0"])
+            write_ply(ply, pos, normals, faces, uvs)
+            bsdf, emission, two_faced = material_bsdf(mat, notes, (doc, buffers, base, tmpdir))
             shape = {"type": "ply", "filename": ply, "face_normals": normals is None, "bsdf": bsdf}
             if emission is not None:
                 shape["emitter"] = {"type": "area", "radiance": rgb(emission)}
