@@ -83,9 +83,21 @@ void print_lights(const Scene& s) {
 }
 
 void print_materials(const Scene& s) {
-  const char* kSlots[TEX_SLOTS] = {"base colour",         "metallic-roughness", "normal",          "emission",
-                                   "transmission",        "specular",           "specular colour", "clearcoat",
-                                   "clearcoat roughness", "anisotropy",         "sheen colour",    "sheen roughness"};
+  const char* kSlots[TEX_SLOTS] = {"base colour",
+                                   "metallic-roughness",
+                                   "normal",
+                                   "emission",
+                                   "transmission",
+                                   "specular",
+                                   "specular colour",
+                                   "clearcoat",
+                                   "clearcoat roughness",
+                                   "anisotropy",
+                                   "sheen colour",
+                                   "sheen roughness",
+                                   "clearcoat normal",
+                                   "diffuse transmission",
+                                   "diffuse transmission colour"};
   size_t n = s.materials.size() - 1;  // the last is the glTF default material
   std::printf("materials: %zu\n", n);
   for (size_t i = 0; i < n; ++i) {
