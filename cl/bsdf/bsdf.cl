@@ -9,30 +9,16 @@
 // direction on wo's side of the surface can only be reflected into, one on the other side
 // only transmitted into.
 
-// The shading frame: the interpolated normal and tangent, then the normal map in the
-// glTF tangent space (bitangent = sign * n x t; back faces mirror it). A mapped normal
-// that would face away from wo's side of the geometry is bent back to just above it, so
-// no light leaks through and no black fringe appears (the method is to clamp the
-// mapped normal to the geometric hemisphere, as many renderers do).
+// The shading frame: the interpolated normal and tangent (bsdf_geometry_frame), then the
+// normal map (bsdf_mapped_normal, bent back above the geometric plane on wo's side)
 Frame bsdf_shading_frame(const SceneData* sc, __global const Material* m, const SurfaceHit* s) {
-  Frame f = frame_from_z_x(s->ns, s->tangent);
-  float handed = s->tangent_sign * (s->front ? 1.0f : -1.0f);
-  f.b *= handed;
-#if CD_FEATURE_TEXTURES
-  if (m->textures[TEX_NORMAL].index != NO_TEXTURE) {
-    float3 t = bsdf_texture(sc, m, TEX_NORMAL, s).xyz * 2.0f - 1.0f;
-    t.xy *= m->normal_scale;
-    float3 n = frame_from_local(&f, (float3)(t.x, s->front ? t.y : -t.y, t.z));
-    float len = length(n);
-    if (len > 0.0f && isfinite(len)) {
-      n /= len;
-      float c = dot(n, s->ng);
-      if (c < 0.01f) n = normalize(n + (0.01f - c) * s->ng);
-      f = frame_from_z_x(n, f.t);
-      f.b *= handed;
-    }
+  Frame f = bsdf_geometry_frame(s);
+  float3 n;
+  if (bsdf_mapped_normal(sc, m, s, &f, TEX_NORMAL, m->normal_scale, &n)) {
+    float handed = s->tangent_sign * (s->front ? 1.0f : -1.0f);
+    f = frame_from_z_x(n, f.t);
+    f.b *= handed;
   }
-#endif
   return f;
 }
 

@@ -27,10 +27,16 @@ typedef struct {
   bool thin;   // a thin-walled sheet: transmission does not bend
   float coat;  // clearcoat weight
   Ggx coat_ggx;
+  float3 coat_n;         // the clearcoat layer's normal (world; clearcoatNormalTexture, else the unmapped normal)
+  bool coat_own_normal;  // coat_n may differ from frame.n (either layer is normal-mapped)
 #if CD_FEATURE_SHEEN
   float3 sheen;                        // KHR_materials_sheen colour (0: no sheen layer)
   float sheen_roughness;               // its roughness r (alpha = r^2)
   __global const float* sheen_albedo;  // its albedo table (sheen.cl); 0: no albedo scaling
+#endif
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  float diffuse_transmission;         // KHR_materials_diffuse_transmission: the diffuse part's share transmitted
+  float3 diffuse_transmission_color;  // its colour
 #endif
 } GltfBsdf;
 
@@ -105,6 +111,39 @@ float bsdf_lobe_omega_ggx_refraction(Ggx g, float eta) {
 // A texture slot of the material at the hit
 float4 bsdf_texture(const SceneData* sc, __global const Material* m, int slot, const SurfaceHit* s) {
   return textures_lookup(sc, &m->textures[slot], s->uvs);
+}
+
+// The frame of the interpolated normal and tangent at the hit: the glTF tangent space
+// (bitangent = sign * n x t; back faces mirror it)
+Frame bsdf_geometry_frame(const SurfaceHit* s) {
+  Frame f = frame_from_z_x(s->ns, s->tangent);
+  f.b *= s->tangent_sign * (s->front ? 1.0f : -1.0f);
+  return f;
+}
+
+// The normal of a normal-map slot (normalTexture, clearcoatNormalTexture) in world space:
+// the texel's tangent-space normal, its xy times `scale`, in the geometry frame f. A mapped
+// normal that would face away from wo's side of the geometry is bent back to just above it,
+// so no light leaks through and no black fringe appears (the method is to clamp the mapped
+// normal to the geometric hemisphere, as many renderers do). False without a texture in the
+// slot, or where the texel gives no direction
+bool bsdf_mapped_normal(const SceneData* sc, __global const Material* m, const SurfaceHit* s, const Frame* f, int slot,
+                        float scale, float3* n) {
+#if CD_FEATURE_TEXTURES
+  if (m->textures[slot].index == NO_TEXTURE) return false;
+  float3 t = bsdf_texture(sc, m, slot, s).xyz * 2.0f - 1.0f;
+  t.xy *= scale;
+  float3 v = frame_from_local(f, (float3)(t.x, s->front ? t.y : -t.y, t.z));
+  float len = length(v);
+  if (!(len > 0.0f) || !isfinite(len)) return false;
+  v /= len;
+  float c = dot(v, s->ng);
+  if (c < 0.01f) v = normalize(v + (0.01f - c) * s->ng);
+  *n = v;
+  return true;
+#else
+  return false;
+#endif
 }
 
 // GGX roughness (x metallicRoughnessTexture G) and KHR_materials_anisotropy: the strength,

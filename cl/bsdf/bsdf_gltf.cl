@@ -1,16 +1,27 @@
 // glTF metallic-roughness BSDF (glTF 2.0 Appendix B, KHR_materials_* extensions) in the
 // local frame, as a mixture of components:
-//   coat:    clearcoat * F_c * GGX(coat roughness), F_c = Schlick(0.04, 1); it attenuates
-//            reflections below by (1 - A_c(mu_o)) (1 - A_c(mu_i)) and transmissions by
-//            1 - A_c at the outside direction's angle, A_c = the coat's albedo
+//   coat:    clearcoat * F_c * GGX(coat roughness), F_c = Schlick(0.04, 1), about the coat's
+//            own normal n_c (clearcoatNormalTexture; without it the unmapped normal, even where
+//            the base is normal-mapped); it attenuates reflections below by
+//            (1 - A_c(mu_o)) (1 - A_c(mu_i)) and transmissions by 1 - A_c at the outside
+//            direction's angle, A_c = the coat's albedo, mu the cosines to n_c. Where n_c is
+//            not the shading normal n, its lobe is f_c (wi.n_c) / (wi.n): the integrator weighs
+//            by wi.n, the coat reflects by the projected solid angle about n_c
 //   sheen:   (CD_FEATURE_SHEEN) sheen colour * Charlie sheen (sheen.cl) / max(1, E(mu_o),
 //            E(mu_i)), below the coat; it scales reflections below by min(1 - c E(mu_o),
 //            1 - c E(mu_i)) (the extension's albedo scaling, c = max3(sheen colour), E its
 //            albedo table, taken at most 1) and transmissions by 1 - c E at the outside
 //            direction's angle
 //   metal:   metallic * Schlick(base color, 1) * GGX
-//   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + W(mu_o, mu_i) * base / pi],
+//   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + (1 - d) W(mu_o, mu_i) * base / pi],
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
+//   difftrans: (CD_FEATURE_DIFFUSE_TRANSMISSION) (1 - metallic)(1 - transmission) *
+//            d W(mu_o, |mu_i|) * colour / pi into the other hemisphere
+//            (KHR_materials_diffuse_transmission: the factor d takes that share of the
+//            plastic's diffuse base and transmits it, Lambertian, tinted by its colour). It
+//            passes the specular layer, the sheen and the coat as a reflection does (a sheet
+//            with the layers on both faces), so that a white base with colour 1 returns
+//            exactly the light a white plastic reflects, split (1 - d) : d
 //   glass:   (1 - metallic) * transmission * dielectric(ior), base-tinted transmission,
 //            thin-walled or refracting (bsdf_dielectric.cl, exact Fresnel)
 //   ms:      with the GGX albedo table, the multiple scattering of the metal and plastic
@@ -49,17 +60,19 @@
 #define GLTF_METAL 2u
 #define GLTF_SPEC 3u
 #define GLTF_DIFFUSE 4u
-#define GLTF_MS 5u
-#define GLTF_GLASS 6u
+#define GLTF_DIFFTRANS 5u
+#define GLTF_MS 6u
+#define GLTF_GLASS 7u
 // One entry per line, columns aligned:
 // clang-format off
-#define GLTF_COMPONENTS(X)               \
-  X(GLTF_COAT, coat, BSDF_GLOSSY)        \
-  X(GLTF_SHEEN, sheen, BSDF_GLOSSY)      \
-  X(GLTF_METAL, metal, BSDF_GLOSSY)      \
-  X(GLTF_SPEC, spec, BSDF_GLOSSY)        \
-  X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE) \
-  X(GLTF_MS, ms, BSDF_GLOSSY)            \
+#define GLTF_COMPONENTS(X)                   \
+  X(GLTF_COAT, coat, BSDF_GLOSSY)            \
+  X(GLTF_SHEEN, sheen, BSDF_GLOSSY)          \
+  X(GLTF_METAL, metal, BSDF_GLOSSY)          \
+  X(GLTF_SPEC, spec, BSDF_GLOSSY)            \
+  X(GLTF_DIFFUSE, diffuse, BSDF_DIFFUSE)     \
+  X(GLTF_DIFFTRANS, difftrans, BSDF_DIFFUSE) \
+  X(GLTF_MS, ms, BSDF_GLOSSY)                \
   X(GLTF_GLASS, glass, BSDF_GLOSSY)
 // clang-format on
 #define GLTF_COUNT_COMPONENT(id, name, kind) +1
@@ -91,12 +104,27 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   lobe->coat = g->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
   float coat_rough = g->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
   lobe->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);
+  // The coat's normal: its own normal map, else the interpolated normal
+  Frame geo = bsdf_geometry_frame(s);
+  lobe->coat_n = geo.n;
+  lobe->coat_own_normal = false;
+  if (lobe->coat > 0.0f) {
+    bsdf_mapped_normal(sc, m, s, &geo, TEX_CLEARCOAT_NORMAL, g->clearcoat_normal_scale, &lobe->coat_n);
+    lobe->coat_own_normal =
+        m->textures[TEX_CLEARCOAT_NORMAL].index != NO_TEXTURE || m->textures[TEX_NORMAL].index != NO_TEXTURE;
+  }
   bool layered = false;  // an extension's layer or lobe at this point
 #if CD_FEATURE_SHEEN
   lobe->sheen = load3(g->sheen) * bsdf_texture(sc, m, TEX_SHEEN_COLOR, s).xyz;
   lobe->sheen_roughness = g->sheen[3] * bsdf_texture(sc, m, TEX_SHEEN_ROUGHNESS, s).w;
   lobe->sheen_albedo = sc->sheen_albedo;
   layered = layered || max_component(lobe->sheen) > 0.0f;
+#endif
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  lobe->diffuse_transmission = g->diffuse_transmission[3] * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION, s).w;
+  lobe->diffuse_transmission_color =
+      load3(g->diffuse_transmission) * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION_COLOR, s).xyz;
+  layered = layered || lobe->diffuse_transmission > 0.0f;
 #endif
   if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f && !layered)
     b->type = MATERIAL_DIFFUSE;
@@ -106,6 +134,15 @@ float schlick_weight(float cos_i) {
   float m = clamp(1.0f - cos_i, 0.0f, 1.0f);
   float m2 = m * m;
   return m2 * m2 * m;
+}
+
+// KHR_materials_diffuse_transmission's factor at the hit (0 where compiled out)
+float gltf_diffuse_transmission(const Bsdf* b) {
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  return b->lobe.gltf.diffuse_transmission;
+#else
+  return 0.0f;
+#endif
 }
 
 // The GGX albedo table looked up for the metal and plastic specular lobes, if any
@@ -235,8 +272,11 @@ float3 gltf_sheen_f(const Bsdf* b, float e_o, float3 wo, float3 wi) {
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
-  float base_norm;  // gltf_coat_base_norm
-  float outer;      // what the layers over the base (coat, sheen) leave it at wo
+  float base_norm;   // gltf_coat_base_norm
+  bool coat_tilted;  // the coat has its own normal: its lobe works in coat_frame
+  Frame coat_frame;  // the coat's frame in the local (shading) frame, z = n_c
+  float coat_o;      // wo.n_c (wo.z when not tilted)
+  float outer;       // what the layers over the base (coat, sheen) leave it at wo
 #if CD_FEATURE_SHEEN
   float sheen_e_o, sheen_o;  // gltf_sheen_e and gltf_sheen_below at wo
 #endif
@@ -270,7 +310,17 @@ float gltf_spec_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
 float gltf_diffuse_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   return g->outer * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * (1.0f - g->spec.a_o) *
-         luminance(b->base_color);
+         (1.0f - gltf_diffuse_transmission(b)) * luminance(b->base_color);
+}
+
+float gltf_difftrans_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  return g->outer * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * (1.0f - g->spec.a_o) *
+         lobe->diffuse_transmission * luminance(lobe->diffuse_transmission_color);
+#else
+  return 0.0f;
+#endif
 }
 
 float gltf_ms_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
@@ -282,11 +332,18 @@ float gltf_glass_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   return g->outer * (1.0f - lobe->metallic) * lobe->transmission;
 }
 
-GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
+GltfAtWo gltf_at_wo(const Bsdf* b, float3 wo) {
   GltfAtWo g;
+  float cos_o = wo.z;
   g.e = gltf_energy(b, cos_o);
   g.spec = gltf_spec_layer(b, &g.e, cos_o);
-  g.coat = gltf_coat_layer(b, cos_o);
+  g.coat_tilted = b->lobe.gltf.coat_own_normal;
+  g.coat_o = cos_o;
+  if (g.coat_tilted) {
+    g.coat_frame = frame_from_z(frame_to_local(&b->frame, b->lobe.gltf.coat_n));
+    g.coat_o = dot(wo, g.coat_frame.n);
+  }
+  g.coat = gltf_coat_layer(b, clamp(g.coat_o, 0.0f, 1.0f));
   g.base_norm = gltf_coat_base_norm(b, &g.coat, &g.spec);
   g.outer = 1.0f - g.coat.a_o;
 #if CD_FEATURE_SHEEN
@@ -304,12 +361,26 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float cos_o) {
   return g;
 }
 
+// A direction in the coat's frame, and |w.n_c|: the cosine the coat's albedo is taken at
+float3 gltf_coat_local(const GltfAtWo* g, float3 w) { return g->coat_tilted ? frame_to_local(&g->coat_frame, w) : w; }
+float gltf_coat_mu(const GltfAtWo* g, float3 w) {
+  return fmin(fabs(g->coat_tilted ? dot(w, g->coat_frame.n) : w.z), 1.0f);
+}
+
+// What the coat leaves of light reflected below it into wi (both crossings)
+float gltf_coat_below(const GltfAtWo* g, float3 wi) { return gltf_below(&g->coat, gltf_coat_mu(g, wi)); }
+
+// What the coat leaves of light transmitted into wi: one crossing, at the outside direction's angle
+float gltf_coat_across(const Bsdf* b, const GltfAtWo* g, float3 wi) {
+  return 1.0f - gltf_layer_albedo(&g->coat, b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi));
+}
+
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
 float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, float* pdf) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   *pdf = 0.0f;
   GgxEnergy e = g->e;
-  GltfLayer spec = g->spec, coat = g->coat;
+  GltfLayer spec = g->spec;
   const float* w = g->w;
   float m = lobe->metallic, t = lobe->transmission;
   float3 under = (float3)(0.0f);  // all components below the coat
@@ -320,7 +391,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
     bool glossy = m > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
     if (glossy) d = ggx_reflection_eval(lobe->ggx, wo, wi, &p, &cos_h);
     float3 fd = glossy ? fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_h) : (float3)(0.0f);
-    under = (1.0f - m) * (1.0f - t) * gltf_below(&spec, wi.z) * g->base_norm * b->base_color * INV_PI_F;
+    under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) * gltf_below(&spec, wi.z) * g->base_norm *
+            b->base_color * INV_PI_F;
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
       under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
@@ -331,6 +403,14 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
       *pdf += w[GLTF_MS] * sample_cosine_hemisphere_pdf(wi.z);
     }
   }
+  float3 dtrans = (float3)(0.0f);  // the diffuse transmission, layered as a reflection
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  if (wi.z < 0.0f && lobe->diffuse_transmission > 0.0f) {
+    dtrans = (1.0f - m) * (1.0f - t) * lobe->diffuse_transmission * gltf_below(&spec, -wi.z) * g->base_norm *
+             lobe->diffuse_transmission_color * INV_PI_F;
+    *pdf += w[GLTF_DIFFTRANS] * sample_cosine_hemisphere_pdf(-wi.z);
+  }
+#endif
   if (t > 0.0f) {
     float glass_p;
     under += (1.0f - m) * t *
@@ -345,17 +425,22 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
           under * fmin(g->sheen_o, gltf_sheen_below(b, gltf_sheen_e(b, wi.z))) + gltf_sheen_f(b, g->sheen_e_o, wo, wi);
       *pdf += w[GLTF_SHEEN] * sheen_sample_pdf(wi);
     } else {
-      under *= b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -wi.z));
+      float e_i = gltf_sheen_e(b, -wi.z);
+      under *= b->entering ? g->sheen_o : gltf_sheen_below(b, e_i);
+      dtrans *= fmin(g->sheen_o, gltf_sheen_below(b, e_i));
     }
   }
 #endif
   // Reflected light crosses the coat twice; transmitted light once, at the angle of the
-  // direction outside
-  float3 f =
-      under * (wi.z > 0.0f ? gltf_below(&coat, wi.z) : 1.0f - gltf_layer_albedo(&coat, b->entering ? wo.z : -wi.z));
+  // direction outside (the diffuse transmission twice, as a reflection)
+  float3 f = under * (wi.z > 0.0f ? gltf_coat_below(g, wi) : gltf_coat_across(b, g, wi));
+  if (wi.z < 0.0f) f += dtrans * gltf_coat_below(g, wi);
   if (wi.z > 0.0f && lobe->coat > 0.0f && !ggx_is_delta(lobe->coat_ggx)) {
     float coat_p, coat_h;
-    float coat_d = ggx_reflection_eval(lobe->coat_ggx, wo, wi, &coat_p, &coat_h);
+    float3 wi_c = gltf_coat_local(g, wi);
+    float coat_d = ggx_reflection_eval(lobe->coat_ggx, gltf_coat_local(g, wo), wi_c, &coat_p, &coat_h);
+    // About a normal of its own, the coat's projected solid angle is wi.n_c, not wi.z
+    if (g->coat_tilted) coat_d *= wi_c.z / wi.z;
     f += gltf_coat_fresnel(b, coat_h) * coat_d;
     *pdf += w[GLTF_COAT] * coat_p;
   }
@@ -366,7 +451,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
 float3 bsdf_gltf_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
   if (wo.z <= 0.0f) return (float3)(0.0f);
-  GltfAtWo g = gltf_at_wo(b, wo.z);
+  GltfAtWo g = gltf_at_wo(b, wo);
   return gltf_eval_at(b, &g, wo, wi, pdf);
 }
 
@@ -386,10 +471,25 @@ int gltf_ggx_direction(Ggx g, float3 wo, float2 u, BsdfSample* bs) {
 }
 
 // Each component's sample from wo (wo.z > 0); a mirror reflection crosses the coat twice
+// (in the coat's frame where it has its own normal: a mirror about n_c, a GGX sample about it)
 int gltf_coat_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  if (ggx_is_delta(lobe->coat_ggx)) return gltf_mirror(wo, (float3)(gltf_coat_fresnel(b, wo.z)), g->w[GLTF_COAT], bs);
-  return gltf_ggx_direction(lobe->coat_ggx, wo, u, bs);
+  if (!g->coat_tilted) {
+    if (ggx_is_delta(lobe->coat_ggx)) return gltf_mirror(wo, (float3)(gltf_coat_fresnel(b, wo.z)), g->w[GLTF_COAT], bs);
+    return gltf_ggx_direction(lobe->coat_ggx, wo, u, bs);
+  }
+  float3 wo_c = gltf_coat_local(g, wo);
+  if (ggx_is_delta(lobe->coat_ggx)) {
+    if (gltf_mirror(wo_c, (float3)(gltf_coat_fresnel(b, wo_c.z)), g->w[GLTF_COAT], bs) != GLTF_SAMPLE_DONE)
+      return GLTF_SAMPLE_FAILED;
+    bs->wi = frame_from_local(&g->coat_frame, bs->wi);
+    if (!(bs->wi.z > 0.0f) || !(wo_c.z > 0.0f)) return GLTF_SAMPLE_FAILED;
+    bs->f *= wo_c.z / bs->wi.z;  // weight / wi.z: the integrator weighs by wi.z
+    return GLTF_SAMPLE_DONE;
+  }
+  if (gltf_ggx_direction(lobe->coat_ggx, wo_c, u, bs) != GLTF_SAMPLE_DIRECTION) return GLTF_SAMPLE_FAILED;
+  bs->wi = frame_from_local(&g->coat_frame, bs->wi);
+  return bs->wi.z > 0.0f ? GLTF_SAMPLE_DIRECTION : GLTF_SAMPLE_FAILED;
 }
 
 int gltf_sheen_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
@@ -409,7 +509,7 @@ int gltf_metal_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) {
     float3 weight = gltf_mirror_below_sheen(g, lobe->metallic * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z));
-    return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_METAL], bs);
+    return gltf_mirror(wo, gltf_coat_below(g, (float3)(-wo.x, -wo.y, wo.z)) * weight, g->w[GLTF_METAL], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);
 }
@@ -419,13 +519,19 @@ int gltf_spec_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, floa
   if (ggx_is_delta(lobe->ggx)) {
     float3 fd = fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), wo.z);
     float3 weight = gltf_mirror_below_sheen(g, (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fd);
-    return gltf_mirror(wo, gltf_below(&g->coat, wo.z) * weight, g->w[GLTF_SPEC], bs);
+    return gltf_mirror(wo, gltf_coat_below(g, (float3)(-wo.x, -wo.y, wo.z)) * weight, g->w[GLTF_SPEC], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);
 }
 
 int gltf_diffuse_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   bs->wi = sample_cosine_hemisphere(u.x, u.y);
+  return GLTF_SAMPLE_DIRECTION;
+}
+
+int gltf_difftrans_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  float3 d = sample_cosine_hemisphere(u.x, u.y);
+  bs->wi = (float3)(d.x, d.y, -d.z);
   return GLTF_SAMPLE_DIRECTION;
 }
 
@@ -440,8 +546,7 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   if (!energy_dielectric_sample(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
     return GLTF_SAMPLE_FAILED;
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
-  float att =
-      bs->wi.z > 0.0f ? gltf_below(&g->coat, wo.z) : 1.0f - gltf_layer_albedo(&g->coat, b->entering ? wo.z : -bs->wi.z);
+  float att = bs->wi.z > 0.0f ? gltf_coat_below(g, bs->wi) : gltf_coat_across(b, g, bs->wi);
 #if CD_FEATURE_SHEEN
   if (max_component(lobe->sheen) > 0.0f)
     att *= bs->wi.z > 0.0f || b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -bs->wi.z));
@@ -455,7 +560,7 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
 // within the component; a chosen direction is weighed by the whole mixture
 bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
-  GltfAtWo at_wo = gltf_at_wo(b, wo.z);
+  GltfAtWo at_wo = gltf_at_wo(b, wo);
   const uint last = GLTF_COMPONENT_COUNT - 1u;
   float cdf[GLTF_COMPONENT_COUNT - 1];
   cdf[0] = at_wo.w[0];
@@ -477,7 +582,9 @@ bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* 
   bool transmits = bs->wi.z < 0.0f;
   bs->f = gltf_eval_at(b, &at_wo, wo, bs->wi, &bs->pdf);
   bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | kind;
-  bs->eta = transmits && !b->lobe.gltf.thin ? b->lobe.gltf.eta : 1.0f;
+  // A diffuse component's transmission does not refract (the direction, evaluated as the
+  // whole mixture, counts as the component that sampled it)
+  bs->eta = transmits && !b->lobe.gltf.thin && !(kind & BSDF_DIFFUSE) ? b->lobe.gltf.eta : 1.0f;
   return bs->pdf > 0.0f;
 }
 
@@ -495,6 +602,10 @@ uint bsdf_gltf_flags(const Bsdf* b) {
 #if CD_FEATURE_SHEEN
   if (max_component(lobe->sheen) > 0.0f) flags |= BSDF_GLOSSY;
 #endif
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  if (plastic && lobe->diffuse_transmission > 0.0f && max_component(lobe->diffuse_transmission_color) > 0.0f)
+    flags |= BSDF_DIFFUSE | BSDF_TRANSMISSION;
+#endif
   return flags;
 }
 
@@ -506,8 +617,15 @@ void gltf_ggx_lobe(Ggx g, float3 wo, float w, BsdfLobes* l) {
   if (!ggx_is_delta(g)) bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(g), w);
 }
 
+// (about n_c where the coat has its own normal)
 void gltf_coat_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
-  gltf_ggx_lobe(b->lobe.gltf.coat_ggx, wo, w, l);
+  Ggx c = b->lobe.gltf.coat_ggx;
+  if (!g->coat_tilted) {
+    gltf_ggx_lobe(c, wo, w, l);
+  } else if (!ggx_is_delta(c)) {
+    float3 n = g->coat_frame.n;
+    bsdf_lobes_add(l, 2.0f * dot(wo, n) * n - wo, bsdf_lobe_omega_ggx(c), w);
+  }
 }
 
 // The sheen spreads over the hemisphere whatever its roughness: a cosine lobe's support
@@ -525,6 +643,10 @@ void gltf_spec_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfL
 
 void gltf_diffuse_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
   bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), w);
+}
+
+void gltf_difftrans_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, -1.0f), bsdf_lobe_omega_cosine(), w);
 }
 
 void gltf_ms_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, BsdfLobes* l) {
@@ -548,7 +670,7 @@ void gltf_glass_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, Bsdf
 
 void bsdf_gltf_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
   if (wo.z <= 0.0f) return;
-  GltfAtWo g = gltf_at_wo(b, wo.z);
+  GltfAtWo g = gltf_at_wo(b, wo);
 #define GLTF_LOBES(id, name, kind) gltf_##name##_lobes(b, &g, wo, g.w[id], l);
   GLTF_COMPONENTS(GLTF_LOBES)
 #undef GLTF_LOBES

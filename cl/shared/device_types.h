@@ -27,6 +27,7 @@
   X(gltf_bsdf, CD_FEATURE_GLTF_BSDF, 1, "a mesh's material shaded as MATERIAL_GLTF (kernel_type)") \
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
   X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
+  X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
   X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
@@ -66,15 +67,18 @@
 #define TEX_METALLIC_ROUGHNESS 1  // B metallic, G roughness
 #define TEX_NORMAL 2
 #define TEX_EMISSION 3
-#define TEX_TRANSMISSION 4         // R
-#define TEX_SPECULAR 5             // A
-#define TEX_SPECULAR_COLOR 6       // RGB
-#define TEX_CLEARCOAT 7            // R
-#define TEX_CLEARCOAT_ROUGHNESS 8  // G
-#define TEX_ANISOTROPY 9           // RG direction in tangent space, B strength
-#define TEX_SHEEN_COLOR 10         // RGB (sRGB)
-#define TEX_SHEEN_ROUGHNESS 11     // A
-#define TEX_SLOTS 12
+#define TEX_TRANSMISSION 4                 // R
+#define TEX_SPECULAR 5                     // A
+#define TEX_SPECULAR_COLOR 6               // RGB
+#define TEX_CLEARCOAT 7                    // R
+#define TEX_CLEARCOAT_ROUGHNESS 8          // G
+#define TEX_ANISOTROPY 9                   // RG direction in tangent space, B strength
+#define TEX_SHEEN_COLOR 10                 // RGB (sRGB)
+#define TEX_SHEEN_ROUGHNESS 11             // A
+#define TEX_CLEARCOAT_NORMAL 12            // tangent-space normal of the clearcoat layer
+#define TEX_DIFFUSE_TRANSMISSION 13        // A
+#define TEX_DIFFUSE_TRANSMISSION_COLOR 14  // RGB (sRGB)
+#define TEX_SLOTS 15
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
 // on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
@@ -209,13 +213,16 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Parameters of a MATERIAL_GLTF material, 64 bytes; factors multiply their texture slots
+// Parameters of a MATERIAL_GLTF material, 96 bytes; factors multiply their texture slots
 typedef struct {
   float ior;  // KHR_materials_ior (1.5)
   float metallic, roughness, transmission;
   float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
   float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
-  float sheen[4];  // KHR_materials_sheen: rgb colour factor, w = sheen roughness factor
+  float sheen[4];                 // KHR_materials_sheen: rgb colour factor, w = sheen roughness factor
+  float diffuse_transmission[4];  // KHR_materials_diffuse_transmission: rgb colour factor, w = factor
+  float clearcoat_normal_scale;   // KHR_materials_clearcoat clearcoatNormalTexture.scale
+  unsigned int pad[3];
 } GltfMaterial;
 
 // Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
@@ -227,13 +234,13 @@ typedef struct {
   unsigned int pad;
 } ConductorMaterial;
 
-// A material type's own parameters (Material.type selects the member), 64 bytes
+// A material type's own parameters (Material.type selects the member), 96 bytes
 typedef union {
   GltfMaterial gltf;
   ConductorMaterial conductor;
 } MaterialParams;
 
-// Material, 496 bytes: what every type has, then its type's parameters. Colours are linear
+// Material, 624 bytes: what every type has, then its type's parameters. Colours are linear
 // RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;   // MATERIAL_*
@@ -420,15 +427,16 @@ typedef struct {
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)                                 \
-  SIZE(GltfMaterial, 64) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
+  SIZE(GltfMaterial, 96) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
     FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
-    FIELD(GltfMaterial, sheen, 48)                                                                            \
+    FIELD(GltfMaterial, sheen, 48) FIELD(GltfMaterial, diffuse_transmission, 64)                              \
+    FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, pad, 84)                              \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
-  SIZE(MaterialParams, 64)                                                                                    \
-  SIZE(Material, 496) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
+  SIZE(MaterialParams, 96)                                                                                    \
+  SIZE(Material, 624) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
     FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
-    FIELD(Material, textures, 112)                                                                            \
+    FIELD(Material, textures, 144)                                                                            \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
   SIZE(TexelF, 16)                                                                                            \

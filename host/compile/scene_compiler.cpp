@@ -85,6 +85,9 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   g.anisotropy_rotation = m.anisotropy_rotation;
   for (int c = 0; c < 3; ++c) g.sheen[c] = m.sheen_color[c];
   g.sheen[3] = m.sheen_roughness;
+  for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = m.diffuse_transmission_color[c];
+  g.diffuse_transmission[3] = m.diffuse_transmission;
+  g.clearcoat_normal_scale = m.clearcoat_normal_scale;
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {

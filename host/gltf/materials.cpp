@@ -99,9 +99,11 @@ void read_clearcoat(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc
   m->clearcoat_roughness = float(number_or(cc, "clearcoatRoughnessFactor", -1, 0.0));
   set_texture_slot(ctx, m, TEX_CLEARCOAT, cc, "clearcoatTexture", false);
   set_texture_slot(ctx, m, TEX_CLEARCOAT_ROUGHNESS, cc, "clearcoatRoughnessTexture", false);
+  // The coat's own normal map (normalTextureInfo: texCoord, scale, KHR_texture_transform);
+  // without it the coat has the unmapped normal, whatever the base's normalTexture
+  set_texture_slot(ctx, m, TEX_CLEARCOAT_NORMAL, cc, "clearcoatNormalTexture", false);
   if (cc.Has("clearcoatNormalTexture"))
-    ctx.warn.add(
-        "KHR_materials_clearcoat clearcoatNormalTexture is not supported yet: the coat uses the base's normal");
+    m->clearcoat_normal_scale = float(number_or(cc.Get("clearcoatNormalTexture"), "scale", -1, 1.0));
 }
 
 void read_anisotropy(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
@@ -118,6 +120,16 @@ void read_sheen(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m)
   m->sheen_roughness = float(number_or(sh, "sheenRoughnessFactor", -1, 0.0));
   set_texture_slot(ctx, m, TEX_SHEEN_COLOR, sh, "sheenColorTexture", true);
   set_texture_slot(ctx, m, TEX_SHEEN_ROUGHNESS, sh, "sheenRoughnessTexture", false);
+}
+
+// KHR_materials_diffuse_transmission: the factor (texture A) and the colour (sRGB texture RGB)
+void read_diffuse_transmission(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
+  const tinygltf::Value& dt = extension(gm, "KHR_materials_diffuse_transmission");
+  m->diffuse_transmission = float(number_or(dt, "diffuseTransmissionFactor", -1, 0.0));
+  for (int c = 0; c < 3; ++c)
+    m->diffuse_transmission_color[c] = float(number_or(dt, "diffuseTransmissionColorFactor", c, 1.0));
+  set_texture_slot(ctx, m, TEX_DIFFUSE_TRANSMISSION, dt, "diffuseTransmissionTexture", false);
+  set_texture_slot(ctx, m, TEX_DIFFUSE_TRANSMISSION_COLOR, dt, "diffuseTransmissionColorTexture", true);
 }
 
 // KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
@@ -198,10 +210,12 @@ void check_ranges(const std::string& name, MaterialDesc* m) {
   in(m->clearcoat_roughness, 0.0f, 1.0f, "clearcoatRoughnessFactor");
   in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
   in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
+  in(m->diffuse_transmission, 0.0f, 1.0f, "diffuseTransmissionFactor");
   in(m->ior, 0.0f, 10.0f, "ior");
   for (int c = 0; c < 3; ++c) {
     in(m->specular_color[c], 0.0f, 1e6f, "specularColorFactor");
     in(m->sheen_color[c], 0.0f, 1.0f, "sheenColorFactor");
+    in(m->diffuse_transmission_color[c], 0.0f, 1.0f, "diffuseTransmissionColorFactor");
     if (m->type == MATERIAL_CONDUCTOR) {
       in(m->conductor_eta[c], 0.0f, 100.0f, "conductor eta");
       in(m->conductor_k[c], 0.0f, 100.0f, "conductor k");
@@ -237,6 +251,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_clearcoat(ctx, gm, &m);
   read_anisotropy(ctx, gm, &m);
   read_sheen(ctx, gm, &m);
+  read_diffuse_transmission(ctx, gm, &m);
   read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);

@@ -9,12 +9,16 @@ namespace candela {
 
 uint32_t MaterialDesc::kernel_type() const {
   bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f &&
-                    sheen_color == glm::vec3(0.0f);
+                    sheen_color == glm::vec3(0.0f) && diffuse_transmission == 0.0f;
   return unlit || (type == MATERIAL_GLTF && lambertian) ? MATERIAL_DIFFUSE : type;
 }
 
 bool MaterialDesc::has_sheen() const {
   return kernel_type() == MATERIAL_GLTF && std::max({sheen_color.x, sheen_color.y, sheen_color.z}) > 0.0f;
+}
+
+bool MaterialDesc::has_diffuse_transmission() const {
+  return kernel_type() == MATERIAL_GLTF && diffuse_transmission > 0.0f;
 }
 
 bool MaterialDesc::alpha_tested() const {
@@ -80,6 +84,7 @@ SceneFeatures Scene::features() const {
     f.alpha |= materials.at(m.material).alpha_tested();
     f.media |= materials.at(m.material).medium >= 0;
     f.sheen |= materials.at(m.material).has_sheen();
+    f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

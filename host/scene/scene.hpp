@@ -71,9 +71,12 @@ struct MaterialDesc {
   float transmission = 0.0f;                           // KHR_materials_transmission
   bool thin_walled = true;                             // no KHR_materials_volume (or thickness 0): a sheet, not a solid
   float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
+  float clearcoat_normal_scale = 1.0f;                 // its clearcoatNormalTexture's scale
   float anisotropy_strength = 0.0f, anisotropy_rotation = 0.0f;  // KHR_materials_anisotropy
   glm::vec3 sheen_color{0.0f};                                   // KHR_materials_sheen (0: no sheen)
   float sheen_roughness = 0.0f;
+  float diffuse_transmission = 0.0f;  // KHR_materials_diffuse_transmission
+  glm::vec3 diffuse_transmission_color{1.0f};
   bool unlit = false;  // KHR_materials_unlit: shows base colour x vertex colour, no lighting
   float normal_scale = 1.0f;
   glm::vec3 conductor_eta{0.0f}, conductor_k{0.0f};  // MATERIAL_CONDUCTOR
@@ -89,12 +92,15 @@ struct MaterialDesc {
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
   bool alpha_tested() const;
   // The BSDF the kernel shades it with: MATERIAL_DIFFUSE for a glTF material that is exactly
-  // Lambertian whatever its textures (metallic, specular, transmission and clearcoat factors
-  // and the sheen colour all 0, each of which multiplies its texture), else `type`; an unlit
+  // Lambertian whatever its textures (metallic, specular, transmission, clearcoat and diffuse
+  // transmission factors and the sheen colour all 0, each of which multiplies its texture),
+  // else `type`; an unlit
   // material has no BSDF (MATERIAL_DIFFUSE, never evaluated)
   uint32_t kernel_type() const;
   // A glTF-shaded material with a sheen layer (KHR_materials_sheen)
   bool has_sheen() const;
+  // A glTF-shaded material with a diffuse transmission (KHR_materials_diffuse_transmission)
+  bool has_diffuse_transmission() const;
 };
 
 struct TextureDesc {

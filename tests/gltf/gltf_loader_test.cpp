@@ -483,4 +483,81 @@ TEST(GltfLoader, SamplerMagFilterNearestSelectsNearestLookups) {
   EXPECT_EQ(c.buffers.textures[size_t(s.materials[0].texture(TEX_EMISSION).index)].flags & TEXTURE_NEAREST, 0u);
 }
 
+// A 1x1 PNG as a data URI
+const char* const kPixelPng =
+    "data:image/png;base64,"
+    "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg==";
+
+// KHR_materials_clearcoat's clearcoatNormalTexture reaches its slot with its texCoord, scale
+// and KHR_texture_transform, as linear data, with no warning; the compiled material carries it
+TEST(GltfLoader, ClearcoatNormalTextureIsRead) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  j["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_texture_transform"};
+  j["textures"] = {{{"source", 0}}};
+  j["images"] = {{{"uri", kPixelPng}}};
+  j["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {
+      {"clearcoatFactor", 1},
+      {"clearcoatNormalTexture",
+       {{"index", 0},
+        {"texCoord", 1},
+        {"scale", 0.5},
+        {"extensions", {{"KHR_texture_transform", {{"offset", {0.25, 0}}}}}}}}};
+  Scene s = load_gltf(dir.write("coat.gltf", j.dump()));
+  const MaterialDesc& m = s.materials[0];
+  const TextureSlot& slot = m.texture(TEX_CLEARCOAT_NORMAL);
+  ASSERT_NE(slot.index, NO_TEXTURE);
+  EXPECT_EQ(slot.texcoord, 1);
+  EXPECT_FALSE(s.textures.at(size_t(slot.index)).srgb);
+  EXPECT_NEAR(glm::vec2(slot.transform * glm::vec3(0.0f, 0.0f, 1.0f)).x, 0.25f, 1e-6f);
+  EXPECT_FLOAT_EQ(m.clearcoat_normal_scale, 0.5f);
+  EXPECT_EQ(m.texture(TEX_NORMAL).index, NO_TEXTURE);  // the base keeps its own (none)
+  EXPECT_EQ(join(s.warnings).find("clearcoatNormalTexture"), std::string::npos) << join(s.warnings);
+  CompiledScene c = compile_scene(s);
+  EXPECT_FLOAT_EQ(c.buffers.materials[0].params.gltf.clearcoat_normal_scale, 0.5f);
+  EXPECT_EQ(c.buffers.materials[0].textures[TEX_CLEARCOAT_NORMAL].index, slot.index);
+  EXPECT_EQ(c.buffers.materials[0].textures[TEX_CLEARCOAT_NORMAL].texcoord, 1u);
+}
+
+// KHR_materials_diffuse_transmission: factor (texture A, linear), colour (texture RGB, sRGB),
+// the defaults of the extension, its range checks, and the kernel feature it turns on
+TEST(GltfLoader, DiffuseTransmissionIsRead) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  j["extensionsUsed"] = {"KHR_materials_diffuse_transmission"};
+  j["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  j["images"] = {{{"uri", kPixelPng}}, {{"uri", kPixelPng}}};
+  j["materials"][0]["extensions"]["KHR_materials_diffuse_transmission"] = {
+      {"diffuseTransmissionFactor", 0.4},
+      {"diffuseTransmissionColorFactor", {0.9, 0.5, 0.2}},
+      {"diffuseTransmissionTexture", {{"index", 0}}},
+      {"diffuseTransmissionColorTexture", {{"index", 1}}}};
+  j["materials"].push_back(j["materials"][0]);
+  j["materials"][1]["extensions"]["KHR_materials_diffuse_transmission"] = json::object();
+  Scene s = load_gltf(dir.write("dt.gltf", j.dump()));
+  const MaterialDesc& m = s.materials[0];
+  EXPECT_FLOAT_EQ(m.diffuse_transmission, 0.4f);
+  EXPECT_EQ(m.diffuse_transmission_color, glm::vec3(0.9f, 0.5f, 0.2f));
+  const TextureSlot &factor = m.texture(TEX_DIFFUSE_TRANSMISSION), &color = m.texture(TEX_DIFFUSE_TRANSMISSION_COLOR);
+  ASSERT_NE(factor.index, NO_TEXTURE);
+  ASSERT_NE(color.index, NO_TEXTURE);
+  EXPECT_FALSE(s.textures.at(size_t(factor.index)).srgb);
+  EXPECT_TRUE(s.textures.at(size_t(color.index)).srgb);
+  EXPECT_EQ(m.kernel_type(), MATERIAL_GLTF);  // not the Lambertian short cut, though specular is 0
+  EXPECT_TRUE(s.features().diffuse_transmission);
+  EXPECT_EQ(join(s.warnings).find("KHR_materials_diffuse_transmission"), std::string::npos) << join(s.warnings);
+  // Defaults: factor 0, colour white; that material is Lambertian
+  EXPECT_FLOAT_EQ(s.materials[1].diffuse_transmission, 0.0f);
+  EXPECT_EQ(s.materials[1].diffuse_transmission_color, glm::vec3(1.0f));
+  EXPECT_EQ(s.materials[1].kernel_type(), MATERIAL_DIFFUSE);
+  CompiledScene c = compile_scene(s);
+  const dev::GltfMaterial& g = c.buffers.materials[0].params.gltf;
+  EXPECT_FLOAT_EQ(g.diffuse_transmission[3], 0.4f);
+  EXPECT_FLOAT_EQ(g.diffuse_transmission[1], 0.5f);
+  for (double bad : {-0.1, 1.5}) {
+    j["materials"][0]["extensions"]["KHR_materials_diffuse_transmission"]["diffuseTransmissionFactor"] = bad;
+    EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
+  }
+}
+
 }  // namespace candela::test

@@ -1,0 +1,456 @@
+// The clearcoat's own normal (KHR_materials_clearcoat clearcoatNormalTexture) and the diffuse
+// transmission (KHR_materials_diffuse_transmission) of the glTF BSDF (cl/bsdf/bsdf_gltf.cl), on
+// PoCL and rusticl, through the real dispatch (tests/bsdf/test_gltf_layers.cl): the coat's
+// specular peak follows the coat's normal map while the base's does not (and, as the
+// extension says, a base normal map leaves the coat alone); sampling against the pdf
+// (chi-square, sampled f and pdf equal to bsdf_eval's) with distinct normals and with diffuse
+// transmission on; a white furnace (white base, transmission colour 1: the BSDF integrates
+// to 1 over the sphere); the reflection / transmission split (1 - d) : d; a factor of 0 gives
+// bit for bit the material of a kernel built without CD_FEATURE_DIFFUSE_TRANSMISSION.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <glm/glm.hpp>
+
+#include "device/energy.hpp"
+#include "device/kernel_sources.hpp"
+#include "device/program_cache.hpp"
+#include "support/kernels.hpp"
+#include "support/stats.hpp"
+
+namespace candela::test {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr size_t kSamples = 1 << 18;
+size_t samples_on(const std::string& device) { return device == "rusticl" ? kSamples / 4 : kSamples; }
+
+glm::dvec3 direction(double z, double phi) {
+  double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+cl_float4 f4(glm::dvec3 v, double w = 0.0) { return {{float(v.x), float(v.y), float(v.z), float(w)}}; }
+
+// Texture 0 of the test scene: one texel, a tangent-space normal tilted by kTilt degrees
+// toward +x (the tangent), as RGBA8
+constexpr double kTilt = 12.0;
+
+struct Layer {
+  double metallic = 0.0, roughness = 0.4, specular = 1.0, transmission = 0.0;
+  glm::dvec3 base{1.0};
+  double coat = 0.0, coat_roughness = 0.3;
+  bool coat_normal = false, base_normal = false;  // texture 0 in those slots
+  double diffuse_transmission = 0.0;
+  glm::dvec3 dt_color{1.0};
+  glm::dvec3 sheen{0.0};
+};
+
+dev::Material material(const Layer& l) {
+  dev::Material m{};
+  m.type = MATERIAL_GLTF;
+  for (int c = 0; c < 3; ++c) m.base_color[c] = float(l.base[c]);
+  m.base_color[3] = 1.0f;
+  m.normal_scale = 1.0f;
+  for (dev::TextureRef& t : m.textures) {
+    t.index = NO_TEXTURE;
+    t.m[0] = t.m[4] = 1.0f;
+  }
+  if (l.coat_normal) m.textures[TEX_CLEARCOAT_NORMAL].index = 0;
+  if (l.base_normal) m.textures[TEX_NORMAL].index = 0;
+  dev::GltfMaterial& g = m.params.gltf;
+  g.ior = 1.5f;
+  for (int c = 0; c < 3; ++c) g.specular_color[c] = 1.0f;
+  g.specular_color[3] = float(l.specular);
+  g.metallic = float(l.metallic);
+  g.roughness = float(l.roughness);
+  g.transmission = float(l.transmission);
+  g.clearcoat = float(l.coat);
+  g.clearcoat_roughness = float(l.coat_roughness);
+  g.clearcoat_normal_scale = 1.0f;
+  for (int c = 0; c < 3; ++c) g.sheen[c] = float(l.sheen[c]);
+  g.sheen[3] = 0.5f;
+  for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = float(l.dt_color[c]);
+  g.diffuse_transmission[3] = float(l.diffuse_transmission);
+  return m;
+}
+
+// The texel of texture 0, and the normal the kernel decodes from it (2 c / 255 - 1)
+struct Texel {
+  unsigned char rgba[4];
+  glm::dvec3 normal() const {
+    glm::dvec3 n(2.0 * rgba[0] / 255.0 - 1.0, 2.0 * rgba[1] / 255.0 - 1.0, 2.0 * rgba[2] / 255.0 - 1.0);
+    return glm::normalize(n);
+  }
+};
+Texel tilted() {
+  double a = kTilt * kPi / 180.0;
+  auto enc = [](double v) { return (unsigned char)std::lround((v + 1.0) * 0.5 * 255.0); };
+  return {{enc(std::sin(a)), enc(0.0), enc(std::cos(a)), 255}};
+}
+
+// The program's buffers for material 0: texture 0 (tilted()) and the GGX albedo table
+struct LayerScene {
+  cl::Buffer textures, texels, ggx;
+  LayerScene(KernelRig& r, const cl::Program& program, const std::string& cache_file) {
+    dev::TextureInfo info{};
+    info.width = info.height = 1;
+    info.flags = WRAP_CLAMP | (WRAP_CLAMP << 8);
+    Texel t = tilted();
+    textures = cl::Buffer(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof info, &info);
+    texels = cl::Buffer(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof t.rgba, t.rgba);
+    ggx = ggx_albedo_table(r.context, r.queue, program, cache_file).buffer;
+  }
+};
+
+void set_scene(cl::Kernel& k, int* a, const cl::Buffer& mat, const LayerScene& s, cl_uint use_ggx) {
+  k.setArg((*a)++, mat);
+  k.setArg((*a)++, s.textures);
+  k.setArg((*a)++, s.texels);
+  k.setArg((*a)++, s.ggx);
+  k.setArg((*a)++, use_ggx);
+}
+
+// test_layers_sample: 3 float4 per sample
+std::vector<cl_float4> sample(KernelRig& r, const cl::Program& program, const LayerScene& sc, const dev::Material& m,
+                              cl_uint use_ggx, glm::dvec3 wo, size_t n, cl_uint seed) {
+  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
+  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, 3 * n * sizeof(cl_float4));
+  cl::Kernel k(program, "test_layers_sample");
+  int a = 0;
+  set_scene(k, &a, mat, sc, use_ggx);
+  k.setArg(a++, f4(wo));
+  k.setArg(a++, seed);
+  k.setArg(a++, out);
+  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
+  std::vector<cl_float4> o(3 * n);
+  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, o.size() * sizeof(cl_float4), o.data());
+  return o;
+}
+
+// test_layers_eval: (f, pdf) per pair
+std::vector<cl_float4> eval(KernelRig& r, const cl::Program& program, const LayerScene& sc, const dev::Material& m,
+                            cl_uint use_ggx, const std::vector<cl_float4>& pairs) {
+  size_t n = pairs.size() / 2;
+  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
+  cl::Buffer in(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pairs.size() * sizeof(cl_float4),
+                const_cast<cl_float4*>(pairs.data()));
+  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+  cl::Kernel k(program, "test_layers_eval");
+  int a = 0;
+  set_scene(k, &a, mat, sc, use_ggx);
+  k.setArg(a++, in);
+  k.setArg(a++, out);
+  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
+  std::vector<cl_float4> o(n);
+  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, o.size() * sizeof(cl_float4), o.data());
+  return o;
+}
+
+// bsdf_sample agrees with bsdf_eval and bsdf_pdf; the pdf integrates to 1 over the sphere less
+// what fails; chi-square of the sampled directions against the pdf in cells of equal solid
+// angle (z uniform in [-1, 1] x phi), each integrated on sub x sub midpoints
+void check_sampling(KernelRig& r, const LayerScene& sc, const dev::Material& m, glm::dvec3 wo, size_t n, bool fast,
+                    double alpha) {
+  const int nz = 32, nphi = 64, sub = fast ? 6 : 12;
+  std::vector<cl_float4> s = sample(r, r.program, sc, m, 1u, wo, n, 11u);
+  std::vector<double> observed(nz * nphi + 1, 0.0);
+  size_t mismatched = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const cl_float4 &a = s[3 * i], &f = s[3 * i + 1], &e = s[3 * i + 2];
+    if (a.s[3] == 0.0f) {
+      observed[nz * nphi] += 1.0;
+      continue;
+    }
+    ASSERT_EQ(f.s[3], 0.0f) << "no delta lobe here";
+    for (int ch = 0; ch < 3; ++ch)
+      if (std::fabs(f.s[ch] - e.s[ch]) > 1e-3 * std::fabs(e.s[ch]) + 1e-6) ++mismatched;
+    if (std::fabs(a.s[3] - e.s[3]) > 1e-3 * e.s[3]) ++mismatched;
+    int iz = std::clamp(int((a.s[2] + 1.0) * 0.5 * nz), 0, nz - 1);
+    double phi = std::atan2(a.s[1], a.s[0]);
+    if (phi < 0.0) phi += 2.0 * kPi;
+    int ip = std::clamp(int(phi / (2.0 * kPi) * nphi), 0, nphi - 1);
+    observed[iz * nphi + ip] += 1.0;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  std::vector<cl_float4> pairs;
+  for (int iz = 0; iz < nz; ++iz)
+    for (int ip = 0; ip < nphi; ++ip)
+      for (int a = 0; a < sub; ++a)
+        for (int b = 0; b < sub; ++b) {
+          pairs.push_back(f4(wo));
+          pairs.push_back(
+              f4(direction(-1.0 + 2.0 * (iz + (a + 0.5) / sub) / nz, 2.0 * kPi * (ip + (b + 0.5) / sub) / nphi)));
+        }
+  std::vector<cl_float4> ev = eval(r, r.program, sc, m, 1u, pairs);
+  std::vector<double> expected(nz * nphi + 1, 0.0);
+  double d_omega = 4.0 * kPi / (double(nz) * nphi * sub * sub), total = 0.0;
+  for (size_t i = 0; i < ev.size(); ++i) expected[i / (sub * sub)] += ev[i].s[3] * d_omega;
+  for (int i = 0; i < nz * nphi; ++i) total += expected[i];
+  EXPECT_LE(total, 1.0 + 2e-3);
+  EXPECT_NEAR(total, 1.0 - observed[nz * nphi] / n, 5e-3);
+  expected[nz * nphi] = std::max(0.0, 1.0 - total);
+  double sum = 0.0;
+  for (double& x : expected) sum += x;
+  for (double& x : expected) x *= n / sum;
+  ChiSquare cs = chi_square_test(observed, expected);
+  EXPECT_GT(cs.p_value, alpha) << "chi-square " << cs.statistic << " on " << cs.dof << " dof";
+}
+
+// Mean and standard error of the sample weights f |cos| / pdf per channel, split by the side
+// of the sampled direction
+struct Split {
+  glm::dvec3 reflected{0.0}, transmitted{0.0}, r_err{0.0}, t_err{0.0};
+};
+Split split(const std::vector<cl_float4>& s) {
+  size_t n = s.size() / 3;
+  glm::dvec3 sum[2] = {glm::dvec3(0.0), glm::dvec3(0.0)}, sum2[2] = {glm::dvec3(0.0), glm::dvec3(0.0)};
+  for (size_t i = 0; i < n; ++i) {
+    const cl_float4 &a = s[3 * i], &f = s[3 * i + 1];
+    if (a.s[3] == 0.0f) continue;
+    int side = a.s[2] > 0.0f ? 0 : 1;
+    for (int c = 0; c < 3; ++c) {
+      double w = double(f.s[c]) * std::fabs(a.s[2]) / a.s[3];
+      sum[side][c] += w;
+      sum2[side][c] += w * w;
+    }
+  }
+  Split out;
+  for (int c = 0; c < 3; ++c) {
+    out.reflected[c] = sum[0][c] / n;
+    out.transmitted[c] = sum[1][c] / n;
+    out.r_err[c] = std::sqrt(std::max(0.0, sum2[0][c] / n - out.reflected[c] * out.reflected[c]) / n);
+    out.t_err[c] = std::sqrt(std::max(0.0, sum2[1][c] / n - out.transmitted[c] * out.transmitted[c]) / n);
+  }
+  return out;
+}
+
+// f wi.z (what the BSDF reflects toward wi per unit solid angle of incident light) along the
+// plane of incidence: wi at polar angles -89..89 degrees toward +x, wo at -30 degrees
+constexpr double kWoDeg = 30.0;
+glm::dvec3 in_plane(double deg) {
+  double a = deg * kPi / 180.0;
+  return {std::sin(a), 0.0, std::cos(a)};
+}
+const std::vector<double>& scan_angles() {
+  static const std::vector<double> angles = [] {
+    std::vector<double> a;
+    for (int k = -890; k <= 890; ++k) a.push_back(0.1 * k);
+    return a;
+  }();
+  return angles;
+}
+std::vector<double> projected_f(KernelRig& r, const LayerScene& sc, const dev::Material& m) {
+  glm::dvec3 wo = in_plane(-kWoDeg);
+  std::vector<cl_float4> pairs;
+  for (double d : scan_angles()) {
+    pairs.push_back(f4(wo));
+    pairs.push_back(f4(in_plane(d)));
+  }
+  std::vector<cl_float4> ev = eval(r, r.program, sc, m, 1u, pairs);
+  std::vector<double> out;
+  for (size_t i = 0; i < ev.size(); ++i)
+    out.push_back(std::max({ev[i].s[0], ev[i].s[1], ev[i].s[2]}) * in_plane(scan_angles()[i]).z);
+  return out;
+}
+size_t peak(const std::vector<double>& v) { return size_t(std::max_element(v.begin(), v.end()) - v.begin()); }
+double peak_deg(const std::vector<double>& v) { return scan_angles()[peak(v)]; }
+// The polar angle (in the plane, toward +x) of wo's mirror image about the decoded normal
+double mirror_deg(glm::dvec3 n) {
+  glm::dvec3 wo = in_plane(-kWoDeg), r = 2.0 * glm::dot(wo, n) * n - wo;
+  return std::atan2(r.x, r.z) * 180.0 / kPi;
+}
+
+class ClearcoatNormal : public ::testing::TestWithParam<const char*> {};
+class DiffuseTransmission : public ::testing::TestWithParam<const char*> {};
+
+// A smooth coat (roughness 0.1) tilted by its normal map: its peak moves to wo's mirror image
+// about the coat's normal, 2 x 12 degrees away; the rough base specular lobe under it stays at
+// the mirror image about the shading normal. A base normal map without a coat normal map moves
+// the base's peak and leaves the coat's at the unmapped normal's
+TEST_P(ClearcoatNormal, CoatPeakFollowsTheCoatNormalAndTheBaseStays) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  LayerScene sc(r, r.program, r.program_cache_file);
+  double tilted_deg = mirror_deg(tilted().normal()), flat_deg = kWoDeg;
+  ASSERT_NEAR(tilted_deg, kWoDeg + 2.0 * kTilt, 0.5);
+  Layer coat_only;
+  coat_only.base = glm::dvec3(0.0);
+  coat_only.specular = 0.0;
+  coat_only.coat = 1.0;
+  coat_only.coat_roughness = 0.1;
+  Layer full = coat_only;
+  full.specular = 1.0;  // the base: its specular lobe alone
+  full.roughness = 0.3;
+  for (bool coat_normal : {false, true}) {
+    SCOPED_TRACE(coat_normal ? "coat normal map" : "no normal map");
+    Layer c = coat_only, f = full;
+    c.coat_normal = f.coat_normal = coat_normal;
+    std::vector<double> coat = projected_f(r, sc, material(c)), all = projected_f(r, sc, material(f)), base;
+    for (size_t i = 0; i < all.size(); ++i) base.push_back(all[i] - coat[i]);
+    EXPECT_NEAR(peak_deg(coat), coat_normal ? tilted_deg : flat_deg, 0.5);
+    EXPECT_NEAR(peak_deg(base), flat_deg, 1.0);
+    // The base lobe is broad, the coat's narrow: the coat dominates at its own peak
+    size_t at = peak(coat);
+    EXPECT_GT(coat[at], 2.0 * base[at]);
+  }
+  // The base's normal map moves the base, not the coat (the coat has no normal map of its own)
+  Layer c = coat_only, f = full;
+  c.base_normal = f.base_normal = true;
+  std::vector<double> coat = projected_f(r, sc, material(c)), all = projected_f(r, sc, material(f)), base;
+  for (size_t i = 0; i < all.size(); ++i) base.push_back(all[i] - coat[i]);
+  EXPECT_NEAR(peak_deg(coat), flat_deg, 0.5);
+  EXPECT_NEAR(peak_deg(base), tilted_deg, 3.0);
+}
+
+// Sampling with distinct coat and base normals (and with diffuse transmission under a tilted
+// coat): chi-square against the pdf, sampled f and pdf equal to bsdf_eval's
+TEST_P(ClearcoatNormal, SamplingMatchesThePdfWithDistinctNormals) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  LayerScene sc(r, r.program, r.program_cache_file);
+  bool fast = std::string(GetParam()) == "rusticl";
+  std::vector<Layer> cases(4);
+  cases[0].coat = 1.0;
+  cases[0].coat_roughness = 0.3;
+  cases[0].coat_normal = true;
+  cases[1] = cases[0];
+  cases[1].metallic = 1.0;
+  cases[1].roughness = 0.5;
+  cases[1].base = glm::dvec3(0.9, 0.6, 0.3);
+  cases[2] = cases[0];
+  cases[2].coat_normal = false;
+  cases[2].base_normal = true;
+  cases[3] = cases[0];
+  cases[3].diffuse_transmission = 0.6;
+  cases[3].coat = 0.7;
+  std::vector<double> wo_z = {0.8, 0.35};
+  double alpha = sidak_alpha(1e-3, int(cases.size() * wo_z.size()));
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (double z : wo_z) {
+      SCOPED_TRACE("case " + std::to_string(c) + ", wo.z " + std::to_string(z));
+      check_sampling(r, sc, material(cases[c]), direction(z, 2.8), samples_on(GetParam()), fast, alpha);
+    }
+}
+
+TEST_P(DiffuseTransmission, SamplingMatchesThePdf) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  LayerScene sc(r, r.program, r.program_cache_file);
+  bool fast = std::string(GetParam()) == "rusticl";
+  std::vector<Layer> cases(4);
+  cases[0].diffuse_transmission = 0.5;
+  cases[0].dt_color = glm::dvec3(0.9, 0.5, 0.2);
+  cases[1] = cases[0];
+  cases[1].diffuse_transmission = 1.0;
+  cases[1].specular = 0.0;
+  cases[2] = cases[0];
+  cases[2].transmission = 0.5;
+  cases[2].roughness = 0.3;
+  cases[3] = cases[0];
+  cases[3].sheen = glm::dvec3(0.8, 0.7, 0.6);
+  cases[3].coat = 0.5;
+  std::vector<double> wo_z = {0.8, 0.3};
+  if (!fast) wo_z.push_back(0.05);
+  double alpha = sidak_alpha(1e-3, int(cases.size() * wo_z.size()));
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (double z : wo_z) {
+      SCOPED_TRACE("case " + std::to_string(c) + ", wo.z " + std::to_string(z));
+      check_sampling(r, sc, material(cases[c]), direction(z, 0.4), samples_on(GetParam()), fast, alpha);
+    }
+}
+
+// White furnace: white base, factor 0.5, colour white, with the specular layer (the GGX
+// albedo table bound) or without one: all the light comes back, reflected or transmitted
+TEST_P(DiffuseTransmission, WhiteFurnaceIntegratesToOne) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  LayerScene sc(r, r.program, r.program_cache_file);
+  size_t n = samples_on(GetParam());
+  for (double specular : {0.0, 1.0})
+    for (double rough : {0.2, 0.7})
+      for (double z : {0.9, 0.5, 0.15}) {
+        SCOPED_TRACE("specular " + std::to_string(specular) + ", roughness " + std::to_string(rough) + ", wo.z " +
+                     std::to_string(z));
+        Layer l;
+        l.diffuse_transmission = 0.5;
+        l.specular = specular;
+        l.roughness = rough;
+        Split s = split(sample(r, r.program, sc, material(l), 1u, direction(z, 1.0), n, 5u));
+        for (int c = 0; c < 3; ++c) {
+          double total = s.reflected[c] + s.transmitted[c], err = s.r_err[c] + s.t_err[c];
+          // Without a specular layer every weight is exactly 1; the albedo table's
+          // interpolation leaves a few 1e-3 with one
+          EXPECT_NEAR(total, 1.0, 4.0 * err + (specular > 0.0 ? 1e-2 : 1e-4));
+        }
+      }
+}
+
+// Without a specular layer a white base splits the light (1 - d) : d, the transmitted part
+// tinted by the colour; with one, the transmitted light is d times the full factor's
+TEST_P(DiffuseTransmission, ReflectionAndTransmissionSplitByTheFactor) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  LayerScene sc(r, r.program, r.program_cache_file);
+  size_t n = samples_on(GetParam());
+  glm::dvec3 color(1.0, 0.5, 0.25);
+  for (double z : {0.9, 0.3}) {
+    glm::dvec3 wo = direction(z, 2.0);
+    for (double d : {0.25, 0.5, 0.8}) {
+      SCOPED_TRACE("factor " + std::to_string(d) + ", wo.z " + std::to_string(z));
+      Layer l;
+      l.specular = 0.0;
+      l.diffuse_transmission = d;
+      l.dt_color = color;
+      Split s = split(sample(r, r.program, sc, material(l), 1u, wo, n, 9u));
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(s.reflected[c], 1.0 - d, 4.0 * s.r_err[c] + 1e-4);
+        EXPECT_NEAR(s.transmitted[c], d * color[c], 4.0 * s.t_err[c] + 1e-4);
+      }
+      Layer spec = l, full = l;
+      spec.specular = full.specular = 1.0;
+      full.diffuse_transmission = 1.0;
+      Split a = split(sample(r, r.program, sc, material(spec), 1u, wo, n, 9u));
+      Split b = split(sample(r, r.program, sc, material(full), 1u, wo, n, 10u));
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(a.transmitted[c], d * b.transmitted[c], 4.0 * (a.t_err[c] + d * b.t_err[c]) + 1e-4);
+    }
+  }
+}
+
+// Factor 0: bsdf_sample and bsdf_eval give bit for bit what the program built with
+// CD_FEATURE_DIFFUSE_TRANSMISSION=0 (the kernel of a scene without it) gives
+TEST_P(DiffuseTransmission, FactorZeroIsTheMaterialWithoutTheFeature) {
+  CANDELA_RIG_OR_SKIP(GetParam(), r);
+  ProgramBuild plain =
+      build_program(r.context, r.device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_DIFFUSE_TRANSMISSION=0");
+  LayerScene sc(r, r.program, r.program_cache_file), sp(r, plain.program, plain.cache_file);
+  std::vector<Layer> cases(4);
+  cases[1].metallic = 1.0;
+  cases[2].transmission = 1.0;
+  cases[2].roughness = 0.1;
+  cases[3].coat = 1.0;
+  cases[3].coat_normal = true;
+  size_t n = samples_on(GetParam()) / 8;
+  for (size_t ci = 0; ci < cases.size(); ++ci) {
+    dev::Material m = material(cases[ci]);
+    for (double z : {0.9, 0.3, 0.01}) {
+      SCOPED_TRACE("case " + std::to_string(ci) + ", wo.z " + std::to_string(z));
+      glm::dvec3 wo = direction(z, 0.6);
+      std::vector<cl_float4> a = sample(r, r.program, sc, m, 1u, wo, n, 5u),
+                             b = sample(r, plain.program, sp, m, 1u, wo, n, 5u);
+      EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(cl_float4)), 0);
+      std::vector<cl_float4> pairs;
+      for (size_t i = 0; i < n; ++i) {
+        pairs.push_back(f4(wo));
+        pairs.push_back(a[3 * i].s[3] > 0.0f ? a[3 * i] : f4(direction(-0.5, 0.1 * double(i))));
+      }
+      std::vector<cl_float4> ea = eval(r, r.program, sc, m, 1u, pairs), eb = eval(r, plain.program, sp, m, 1u, pairs);
+      EXPECT_EQ(std::memcmp(ea.data(), eb.data(), ea.size() * sizeof(cl_float4)), 0);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, ClearcoatNormal, ::testing::Values("pocl", "rusticl"),
+                         [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Devices, DiffuseTransmission, ::testing::Values("pocl", "rusticl"),
+                         [](const auto& info) { return std::string(info.param); });
+
+}  // namespace
+}  // namespace candela::test
