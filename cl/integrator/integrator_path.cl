@@ -110,11 +110,14 @@ float path_lobe_pdf(float omega, float d) {
 // a reflect-only surface wastes half its samples below it (M_nee x 2). Light sampling
 // takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
 // path, at the light sample and where the sampled ray finds the light, on the same inputs:
-// no contraction, so both give the same answer.
-bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index) {
+// no contraction, so both give the same answer. `pmf`: the light's selection probability
+// at ctx when the caller has it (the light sample's: lights_select_pmf's value exactly),
+// else negative (lights_select_pmf computes it).
+bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index, float pmf) {
 #pragma OPENCL FP_CONTRACT OFF
-  LightExtent e = lights_extent(sc, index, ctx);
+  LightExtent e = lights_extent(sc, index, ctx->p);
   if (!(e.omega > 0.0f)) return true;  // a delta light
+  e.pmf = pmf >= 0.0f ? pmf : lights_select_pmf(sc, ctx, index);
   float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
   float m_nee = 0.0f, m_bsdf = 0.0f;
   for (uint k = 0u; k < lobes->count; ++k) {
@@ -147,7 +150,7 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
   float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);
-  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx, ls.light)) return (float3)(0.0f);
+  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx, ls.light, ls.pmf)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
   float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
@@ -240,7 +243,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       if (counts_emission || ps.decide) {
         float3 le = lights_environment_radiance(sc, ps.ray.dir);
         if (!counts_emission && max_component(le) > 0.0f)
-          counts_emission = !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)params->environment_light);
+          counts_emission = !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)params->environment_light, -1.0f);
         if (counts_emission) ps.radiance += ps.beta * le;
       }
       break;
@@ -266,7 +269,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       float3 le = surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
       if (!counts_emission && max_component(le) > 0.0f) {
         int light = lights_of_prim(sc, (uint)hit.prim);
-        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)light);
+        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)light, -1.0f);
       }
       if (counts_emission) ps.radiance += ps.beta * le;
     }

@@ -22,6 +22,7 @@ typedef struct {
   bool at_infinity;  // shadow ray along wi without end
   float3 target;     // finite lights: the sampled point, moved off the light toward ctx.p
   uint light;        // index of the light picked
+  float pmf;         // the probability of picking it (lights_select_pmf)
 } LightSample;
 
 // What STRATEGY_AUTO's choice between light and BSDF sampling needs of a light seen from a
@@ -31,7 +32,7 @@ typedef struct {
   float3 dir;       // unit direction to the light's centre (an environment: its bright part's)
   float omega;      // solid angle (0: a delta light)
   float radius;     // angle from dir that holds the whole light
-  float pmf;        // selection probability
+  float pmf;        // selection probability (set by path_nee_takes, not lights_extent)
   float integral;   // an environment: integral of its luminance over the sphere
   bool everywhere;  // an environment: it surrounds the point, overlapping every lobe
   bool map;         // an environment map: sampled over the whole sphere, even at reflect-only surfaces
@@ -517,12 +518,11 @@ bool lights_select(const SceneData* sc, const LightSampleContext* ctx, uint x_se
 // Picks a light (lights_select) and samples a direction toward it
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float u_select, float2 u,
                    LightSample* ls) {
-  float pmf;
-  if (!lights_select(sc, ctx, x_select, u_select, &ls->light, &pmf)) return false;
+  if (!lights_select(sc, ctx, x_select, u_select, &ls->light, &ls->pmf)) return false;
   __global const Light* light = &sc->lights[ls->light];
   ls->is_delta = false;
   bool ok = lights_sample_light(sc, light, ctx, u, ls);
-  ls->pdf *= pmf;
+  ls->pdf *= ls->pmf;
   return ok;
 }
 
@@ -563,11 +563,10 @@ int lights_of_prim(const SceneData* sc, uint prim) {
   return lo < sc->params->num_lights && lights_prim(&sc->lights[lo]) == prim ? (int)lo : NO_LIGHT;
 }
 
-// Light `index` as STRATEGY_AUTO's choice sees it from ctx (its selection probability
-// depends on where ctx is and which way it faces)
-LightExtent lights_extent(const SceneData* sc, uint index, const LightSampleContext* ctx) {
+// Light `index` as STRATEGY_AUTO's choice sees it from p, its selection probability aside
+// (lights_select_pmf: it depends on where the shading point is and which way it faces)
+LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
   __global const Light* light = &sc->lights[index];
-  float3 p = ctx->p;
   LightExtent e;
   e.dir = (float3)(0.0f);
   e.omega = 0.0f;
@@ -580,6 +579,5 @@ LightExtent lights_extent(const SceneData* sc, uint index, const LightSampleCont
   if (feature && light->type == id) lights_##name##_extent(sc, light, p, &e);
   CD_LIGHTS(LIGHTS_EXTENT)
 #undef LIGHTS_EXTENT
-  if (e.omega > 0.0f) e.pmf = lights_select_pmf(sc, ctx, index);  // delta lights need none
   return e;
 }
