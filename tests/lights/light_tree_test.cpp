@@ -72,6 +72,10 @@ void check_tree(const CompiledScene& c) {
     EXPECT_EQ(nodes[node].child, l) << "light " << l << "'s trail ends at another light's leaf";
   }
   EXPECT_EQ(nodes.size(), 2 * in_tree - 1);
+  uint32_t depth = 0;
+  for (const dev::LightTreeTrail& t : trails)
+    if (t.depth != LIGHT_TREE_NONE) depth = std::max(depth, t.depth);
+  std::printf("%zu lights in the tree, deepest leaf at depth %u\n", in_tree, depth);
   EXPECT_NEAR(nodes[0].share, share, 1e-5);
   for (size_t i = 0; i < nodes.size(); ++i) {
     const dev::LightTreeNode& n = nodes[i];
