@@ -380,7 +380,10 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // theta_i' the smallest angle between the shading normal and a direction into the sphere
 // (the |cos| the estimator weighs by; 1 in a medium, n = 0). Both cosines are kept at
 // least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so float
-// rounding never gives 0 to a light that can contribute. Sampling and the pmf of a given
+// rounding never gives 0 to a light that can contribute; and a child of nonzero importance
+// is taken with probability at least the root's `min_prob`, which the host sets so that the
+// product over the deepest trail, times the tree's share, stays above 2^-124: no light's
+// pmf underflows (to 0 on devices that flush denormals). Sampling and the pmf of a given
 // light (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
 // STRATEGY_AUTO's two evaluations of a light's selection probability agree exactly.
 #define LIGHT_TREE_MIN_COS 1e-3f
@@ -423,10 +426,18 @@ float lights_tree_first(const SceneData* sc, uint node, const LightSampleContext
 #pragma OPENCL FP_CONTRACT OFF
   float a = lights_tree_importance(&sc->light_tree[node + 1u], ctx);
   float b = lights_tree_importance(&sc->light_tree[sc->light_tree[node].child], ctx);
-  if (isinf(a) || isinf(b)) return isinf(a) ? (isinf(b) ? 0.5f : 1.0f) : 0.0f;
   float sum = a + b;
   if (!(sum > 0.0f)) return -1.0f;  // neither child can light ctx.p
-  return isinf(sum) ? 0.5f * a / (0.5f * a + 0.5f * b) : a / sum;
+  float first;
+  if (isinf(a) || isinf(b))
+    first = isinf(a) ? (isinf(b) ? 0.5f : 1.0f) : 0.0f;
+  else
+    first = isinf(sum) ? 0.5f * a / (0.5f * a + 0.5f * b) : a / sum;
+  if (a > 0.0f && b > 0.0f) {
+    float lo = sc->light_tree[0].min_prob;
+    first = clamp(first, lo, 1.0f - lo);
+  }
+  return first;
 }
 
 // Whether selection uses the tree (it has lights, and the scene was compiled for it)

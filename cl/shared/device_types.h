@@ -325,7 +325,7 @@ typedef struct {
   unsigned int child;  // interior: index of the second child; leaf: index of its light
   unsigned int leaf;   // 1: a leaf
   float share;         // root: probability that selection goes into the tree (0 elsewhere)
-  unsigned int pad;
+  float min_prob;      // root: least probability of a child that can light the point (see lights.cl)
 } LightTreeNode;
 
 // The path from the root of the light tree to a light's leaf, 16 bytes: step k (k < depth)
@@ -472,7 +472,7 @@ typedef struct {
     FIELD(Light, params, 32)                                                                                  \
   SIZE(LightTreeNode, 64) FIELD(LightTreeNode, intensity, 12) FIELD(LightTreeNode, cos_o, 28) \
     FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, cos_e, 44) FIELD(LightTreeNode, child, 48) \
-    FIELD(LightTreeNode, leaf, 52) FIELD(LightTreeNode, share, 56) \
+    FIELD(LightTreeNode, leaf, 52) FIELD(LightTreeNode, share, 56) FIELD(LightTreeNode, min_prob, 60) \
   SIZE(LightTreeTrail, 16) FIELD(LightTreeTrail, depth, 8) \
   SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48)               \
     FIELD(Medium, emission_grid, 44) FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68)                 \

@@ -251,6 +251,10 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
   Builder builder{bounds, order, &tree};
   builder.build(0, order.size(), 0u, 0u);
   tree.nodes[0].share = float(std::min(share, 1.0));
+  // Least probability of a child: min_prob^depth x share >= 2^-124 (a normal float)
+  if (tree.depth > 0)
+    tree.nodes[0].min_prob =
+        float(std::min(0.25, std::pow(std::ldexp(1.0, -124) / double(tree.nodes[0].share), 1.0 / double(tree.depth))));
   return tree;
 }
 

@@ -76,6 +76,10 @@ void check_tree(const CompiledScene& c) {
   for (const dev::LightTreeTrail& t : trails)
     if (t.depth != LIGHT_TREE_NONE) depth = std::max(depth, t.depth);
   std::printf("%zu lights in the tree, deepest leaf at depth %u\n", in_tree, depth);
+  // No trail's least pmf (every turn at min_prob) underflows
+  if (depth > 0) {
+    EXPECT_GE(depth * std::log2(double(nodes[0].min_prob)) + std::log2(double(nodes[0].share)), -124.01);
+  }
   EXPECT_NEAR(nodes[0].share, share, 1e-5);
   for (size_t i = 0; i < nodes.size(); ++i) {
     const dev::LightTreeNode& n = nodes[i];
