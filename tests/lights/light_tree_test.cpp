@@ -157,7 +157,7 @@ TEST_P(LightTreeTest, PmfSumsToOneAndCoversEveryLightThatCanContribute) {
     random_contexts(compiled_, kContexts, &ps, &ns);
     size_t n = compiled_.buffers.lights.size();
     auto out = rig().output<float>(kContexts * n);
-    rig().run("test_lights_select_pmf", kContexts, *scene_, rig().input(ps), rig().input(ns), out);
+    rig().run("test_lights_select_pmf", kContexts * n, *scene_, rig().input(ps), rig().input(ns), out);
     std::vector<float> pmf = out.read();
     for (int c = 0; c < kContexts; ++c) {
       double sum = 0.0;
@@ -197,7 +197,7 @@ TEST_P(LightTreeTest, SelectionFrequenciesMatchPmf) {
       }
       // Expected counts from lights_select_pmf of every light (also the ones never drawn)
       auto pmf_out = rig().output<float>(n);
-      rig().run("test_lights_select_pmf", 1, *scene_, rig().input(std::vector<cl_float4>{ps[size_t(c)]}),
+      rig().run("test_lights_select_pmf", n, *scene_, rig().input(std::vector<cl_float4>{ps[size_t(c)]}),
                 rig().input(std::vector<cl_float4>{ns[size_t(c)]}), pmf_out);
       std::vector<float> pmf = pmf_out.read();
       for (size_t l = 0; l < n; ++l) {

@@ -379,7 +379,7 @@ TEST(PunctualLights, SampleIsDeltaWithPmfAndLightsPdfIsZero) {
   std::vector<cl_float4> raw = out.read();
   // The selection probability of each light at p (the light tree's for the point and the spot)
   auto sel_out = rig.output<float>(3);
-  rig.run("test_lights_select_pmf", 1, sd, rig.input(std::vector<cl_float4>{f4(p)}),
+  rig.run("test_lights_select_pmf", 3, sd, rig.input(std::vector<cl_float4>{f4(p)}),
           rig.input(std::vector<cl_float4>{f4({0.0, 0.0, 1.0})}), sel_out);
   std::vector<float> sel = sel_out.read();
   EXPECT_NEAR(double(sel[0]) + sel[1] + sel[2], 1.0, 1e-6);

@@ -96,14 +96,15 @@ __kernel void test_lights_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global co
 }
 
 // Light selection's pmf (lights_select_pmf) of every light at contexts c: p = ps[c], n = ns[c]
-// (n = 0: a point in a medium); out[c num_lights + l]
+// (n = 0: a point in a medium); one work-item per (c, l): out[c num_lights + l]
 __kernel void test_lights_select_pmf(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
                                      __global const float4* ps, __global const float4* ns, __global float* out) {
-  uint c = get_global_id(0);
+  uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
-  LightSampleContext ctx = test_lights_context(ps[c], ns[c], 0u);
   uint n = params->num_lights;
-  for (uint l = 0u; l < n; ++l) out[c * n + l] = lights_select_pmf(&sc, &ctx, l);
+  uint c = i / n, l = i % n;
+  LightSampleContext ctx = test_lights_context(ps[c], ns[c], 0u);
+  out[i] = lights_select_pmf(&sc, &ctx, l);
 }
 
 // One light selection (lights_select, with the integrator's random numbers) per work-item
