@@ -11,7 +11,7 @@
 //                  (lights_extent): path_nee_takes. A light sample counts only for a light
 //                  the vertex takes by light sampling; a BSDF-sampled ray that finds an
 //                  emitter or the environment counts it only for a light the vertex it left
-//                  did not take (the path state keeps that vertex's position and lobes).
+//                  did not take (the path state keeps that vertex's light-sampling context and lobes).
 //                  Delta lights, which no sampled ray can find, are light-sampled at every
 //                  vertex under nee and auto.
 // Emission found by a delta lobe's ray always counts (no light sample can find it there).
@@ -30,17 +30,17 @@
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
   Ray ray;
-  float3 beta;           // throughput
-  float3 radiance;       // light gathered so far
-  uint depth;            // scattering events so far
-  bool specular_bounce;  // emission the ray finds counts: the camera ray, a delta lobe's
-                         // ray, or one from a vertex that took no light sample
-  bool decide;           // STRATEGY_AUTO: emission counts for lights the vertex it left
-  float3 prev_p;         // (at prev_p, with lobes `lobes`) did not take by light sampling
-  BsdfLobes lobes;
-  float eta_scale;    // product of eta^2 over transmissions, so roulette sees radiance scale
-  int medium;         // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
-  MediumStack media;  // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+  float3 beta;              // throughput
+  float3 radiance;          // light gathered so far
+  uint depth;               // scattering events so far
+  bool specular_bounce;     // emission the ray finds counts: the camera ray, a delta lobe's
+                            // ray, or one from a vertex that took no light sample
+  bool decide;              // STRATEGY_AUTO: emission counts for lights the vertex it left
+  LightSampleContext prev;  // (seen from `prev`, with lobes `lobes`) did not take by light
+  BsdfLobes lobes;          // sampling
+  float eta_scale;          // product of eta^2 over transmissions, so roulette sees radiance scale
+  int medium;               // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
+  MediumStack media;        // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
 } PathState;
 
 PathState path_start(const SceneData* sc, Ray ray) {
@@ -110,11 +110,14 @@ float path_lobe_pdf(float omega, float d) {
 // a reflect-only surface wastes half its samples below it (M_nee x 2). Light sampling
 // takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
 // path, at the light sample and where the sampled ray finds the light, on the same inputs:
-// no contraction, so both give the same answer.
-bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, float3 p, uint index) {
+// no contraction, so both give the same answer. `pmf`: the light's selection probability
+// at ctx when the caller has it (the light sample's: lights_select_pmf's value exactly),
+// else negative (lights_select_pmf computes it).
+bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index, float pmf) {
 #pragma OPENCL FP_CONTRACT OFF
-  LightExtent e = lights_extent(sc, index, p);
+  LightExtent e = lights_extent(sc, index, ctx->p);
   if (!(e.omega > 0.0f)) return true;  // a delta light
+  e.pmf = pmf >= 0.0f ? pmf : lights_select_pmf(sc, ctx, index);
   float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
   float m_nee = 0.0f, m_bsdf = 0.0f;
   for (uint k = 0u; k < lobes->count; ++k) {
@@ -143,10 +146,11 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, float3 p, uint 
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
                          const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
   uint x_select = rng_next_uint(rng);
+  float u_select = rng_next(rng);
   float2 u = rng_next_2d(rng);
   LightSample ls;
-  if (!lights_sample(sc, ctx, x_select, u, &ls)) return (float3)(0.0f);
-  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx->p, ls.light)) return (float3)(0.0f);
+  if (!lights_sample(sc, ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);
+  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx, ls.light, ls.pmf)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
   float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);
@@ -180,9 +184,10 @@ float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 w
   ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
   ctx.transmits = true;
   uint x_select = rng_next_uint(rng);
+  float u_select = rng_next(rng);
   float2 u = rng_next_2d(rng);
   LightSample ls;
-  if (!lights_sample(sc, &ctx, x_select, u, &ls)) return (float3)(0.0f);
+  if (!lights_sample(sc, &ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);
   float3 contrib = ls.radiance * (phase_eval(g, wo, ls.wi) / ls.pdf);
   if (max_component(contrib) <= 0.0f) return (float3)(0.0f);
   return contrib * path_shadow_ray(sc, &ctx, &ls, media, rng);
@@ -238,7 +243,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       if (counts_emission || ps.decide) {
         float3 le = lights_environment_radiance(sc, ps.ray.dir);
         if (!counts_emission && max_component(le) > 0.0f)
-          counts_emission = !path_nee_takes(sc, &ps.lobes, ps.prev_p, (uint)params->environment_light);
+          counts_emission = !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)params->environment_light, -1.0f);
         if (counts_emission) ps.radiance += ps.beta * le;
       }
       break;
@@ -264,7 +269,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
       float3 le = surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
       if (!counts_emission && max_component(le) > 0.0f) {
         int light = lights_of_prim(sc, (uint)hit.prim);
-        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, ps.prev_p, (uint)light);
+        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)light, -1.0f);
       }
       if (counts_emission) ps.radiance += ps.beta * le;
     }
@@ -280,8 +285,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     bool chooses = samples_lights && strategy == STRATEGY_AUTO;
     BsdfLobes lobes;
     if (chooses) lobes = bsdf_lobes(&bsdf, wo);
+    LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
     if (samples_lights) {
-      LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
       ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
                                                  sc->materials[s.material].medium, rng);
     }
@@ -296,7 +301,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     ps.specular_bounce = delta || !samples_lights;
     ps.decide = chooses && !delta;
     if (ps.decide) {
-      ps.prev_p = s.p;
+      ps.prev = ctx;  // the light selection the light sample saw here
       ps.lobes = lobes;
     }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;

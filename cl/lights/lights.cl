@@ -1,5 +1,6 @@
 // Light sampling from a context (a surface point, or a point in a medium), through one
-// light-selection alias table with probabilities proportional to power. Directions and pdfs
+// light-selection alias table with probabilities proportional to power, or the light tree
+// (below) that weighs each light by what it can send to the shading point. Directions and pdfs
 // are measured from ctx.p; a finite light's shadow ray ends at `target`, just off the
 // light's surface on ctx.p's side. Each light type has lights_NAME_sample and
 // lights_NAME_pdf; the dispatch on the type is generated from CD_LIGHTS
@@ -21,6 +22,7 @@ typedef struct {
   bool at_infinity;  // shadow ray along wi without end
   float3 target;     // finite lights: the sampled point, moved off the light toward ctx.p
   uint light;        // index of the light picked
+  float pmf;         // the probability of picking it (lights_select_pmf)
 } LightSample;
 
 // What STRATEGY_AUTO's choice between light and BSDF sampling needs of a light seen from a
@@ -30,7 +32,7 @@ typedef struct {
   float3 dir;       // unit direction to the light's centre (an environment: its bright part's)
   float omega;      // solid angle (0: a delta light)
   float radius;     // angle from dir that holds the whole light
-  float pmf;        // selection probability
+  float pmf;        // selection probability (set by path_nee_takes, not lights_extent)
   float integral;   // an environment: integral of its luminance over the sphere
   bool everywhere;  // an environment: it surrounds the point, overlapping every lobe
   bool map;         // an environment map: sampled over the whole sphere, even at reflect-only surfaces
@@ -366,6 +368,136 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
   return 0.0f;
 }
 
+// Light tree (Conty Estevez & Kulla 2018, Importance Sampling of Many Lights with Adaptive
+// Tree Splitting): selection descends from the root, taking each child with probability
+// proportional to its importance at the shading point, an estimate of the irradiance its
+// lights can send there; the selection pmf is the product of those probabilities. A node's
+// importance is I cos(theta') cos(theta_i') / d^2: I its summed peak intensity, d the
+// distance to its centre (at least half its diagonal: points in or near the box), theta'
+// the smallest angle its emission cone can make with the direction to ctx.p (the angle
+// from the cone's axis less theta_o and less the angle theta_b its bounding sphere
+// subtends; 0 importance beyond theta_e: no light in the node emits toward ctx.p), and
+// theta_i' the smallest angle between the shading normal and a direction into the sphere
+// (the |cos| the estimator weighs by; 1 in a medium, n = 0). Both cosines are kept at
+// least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so float
+// rounding never gives 0 to a light that can contribute; and a child of nonzero importance
+// is taken with probability at least the root's `min_prob`, which the host sets so that the
+// product over the deepest trail, times the tree's share, stays above 2^-124: no light's
+// pmf underflows (to 0 on devices that flush denormals). Sampling and the pmf of a given
+// light (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
+// STRATEGY_AUTO's two evaluations of a light's selection probability agree exactly.
+#define LIGHT_TREE_MIN_COS 1e-3f
+
+// cos(a - b) for angles a, b in [0, pi] given by their cosines, or 1 when a <= b
+float lights_tree_cos_minus(float cos_a, float cos_b) {
+#pragma OPENCL FP_CONTRACT OFF
+  if (cos_a >= cos_b) return 1.0f;
+  float sin_a = sqrt(fmax(0.0f, 1.0f - cos_a * cos_a)), sin_b = sqrt(fmax(0.0f, 1.0f - cos_b * cos_b));
+  return cos_a * cos_b + sin_a * sin_b;
+}
+
+float lights_tree_importance(__global const LightTreeNode* node, const LightSampleContext* ctx) {
+#pragma OPENCL FP_CONTRACT OFF
+  if (!(node->intensity > 0.0f)) return 0.0f;
+  float3 lo = load3(node->lo), hi = load3(node->hi);
+  float3 c = 0.5f * (lo + hi);
+  float3 diag = hi - lo;
+  float r2 = 0.25f * dot(diag, diag);  // bounding sphere radius^2
+  float3 d = ctx->p - c;
+  float dist2 = dot(d, d);
+  float cos_b = -1.0f;  // inside the sphere: directions everywhere
+  if (dist2 > r2) cos_b = sqrt(fmax(0.0f, 1.0f - r2 / dist2));
+  float3 w = dist2 > 0.0f ? d * rsqrt(dist2) : (float3)(0.0f, 0.0f, 1.0f);  // from the node to ctx.p
+  // Emitter side: theta' = max(0, theta_w - theta_o - theta_b)
+  float cos_w = clamp(dot(load3(node->axis), w), -1.0f, 1.0f);
+  float cos_p = lights_tree_cos_minus(lights_tree_cos_minus(cos_w, node->cos_o), cos_b);
+  if (cos_p < node->cos_e - LIGHT_TREE_MIN_COS) return 0.0f;
+  float importance = node->intensity * fmax(cos_p, LIGHT_TREE_MIN_COS);
+  // Receiver side: theta_i' = max(0, theta_i - theta_b), |cos| to the shading normal
+  if (dot(ctx->ns, ctx->ns) > 0.0f) {
+    float cos_i = fmin(fabs(dot(ctx->ns, w)), 1.0f);
+    importance *= fmax(lights_tree_cos_minus(cos_i, cos_b), LIGHT_TREE_MIN_COS);
+  }
+  return importance / fmax(fmax(dist2, r2), 1e-30f);
+}
+
+// Probability of taking the first child of interior node `node`, from its children's importances
+float lights_tree_first(const SceneData* sc, uint node, const LightSampleContext* ctx) {
+#pragma OPENCL FP_CONTRACT OFF
+  float a = lights_tree_importance(&sc->light_tree[node + 1u], ctx);
+  float b = lights_tree_importance(&sc->light_tree[sc->light_tree[node].child], ctx);
+  float sum = a + b;
+  if (!(sum > 0.0f)) return -1.0f;  // neither child can light ctx.p
+  float first;
+  if (isinf(a) || isinf(b))
+    first = isinf(a) ? (isinf(b) ? 0.5f : 1.0f) : 0.0f;
+  else
+    first = isinf(sum) ? 0.5f * a / (0.5f * a + 0.5f * b) : a / sum;
+  if (a > 0.0f && b > 0.0f) {
+    float lo = sc->light_tree[0].min_prob;
+    first = clamp(first, lo, 1.0f - lo);
+  }
+  return first;
+}
+
+// Whether selection uses the tree (it has lights, and the scene was compiled for it)
+bool lights_tree_used(const SceneData* sc) { return sc->light_tree[0].intensity > 0.0f; }
+
+// A light of the tree chosen with u, and its probability within the tree; false when no
+// light of the tree can light ctx.p
+bool lights_tree_sample(const SceneData* sc, const LightSampleContext* ctx, float u, uint* light, float* pmf) {
+#pragma OPENCL FP_CONTRACT OFF
+  if (!(lights_tree_importance(&sc->light_tree[0], ctx) > 0.0f)) return false;
+  uint node = 0u;
+  float prob = 1.0f;
+  while (sc->light_tree[node].leaf == 0u) {
+    float first = lights_tree_first(sc, node, ctx);
+    if (first < 0.0f) return false;
+    if (u < first) {
+      u = fmin(u / first, 0x1.fffffep-1f);
+      prob *= first;
+      node = node + 1u;
+    } else {
+      u = fmin((u - first) / (1.0f - first), 0x1.fffffep-1f);
+      prob *= 1.0f - first;
+      node = sc->light_tree[node].child;
+    }
+  }
+  *light = sc->light_tree[node].child;
+  *pmf = prob;
+  return prob > 0.0f;
+}
+
+// The probability with which lights_tree_sample picks `light` (one of the tree's) at ctx
+float lights_tree_pmf(const SceneData* sc, const LightSampleContext* ctx, uint light) {
+#pragma OPENCL FP_CONTRACT OFF
+  if (!(lights_tree_importance(&sc->light_tree[0], ctx) > 0.0f)) return 0.0f;
+  __global const LightTreeTrail* trail = &sc->light_trails[light];
+  uint node = 0u;
+  float prob = 1.0f;
+  for (uint k = 0u; k < trail->depth; ++k) {
+    float first = lights_tree_first(sc, node, ctx);
+    if (first < 0.0f) return 0.0f;
+    if (((trail->bits[k >> 5] >> (k & 31u)) & 1u) == 0u) {
+      prob *= first;
+      node = node + 1u;
+    } else {
+      prob *= 1.0f - first;
+      node = sc->light_tree[node].child;
+    }
+  }
+  return prob;
+}
+
+// The probability with which lights_sample picks light `index` at ctx: the alias table's
+// for lights outside the tree (and for all without one), else the tree's share times the
+// tree's pmf
+float lights_select_pmf(const SceneData* sc, const LightSampleContext* ctx, uint index) {
+  __global const Light* light = &sc->lights[index];
+  if (!lights_tree_used(sc) || sc->light_trails[index].depth == LIGHT_TREE_NONE) return light->pmf;
+  return sc->light_tree[0].share * lights_tree_pmf(sc, ctx, index);
+}
+
 // Samples a direction toward `light` by its type
 bool lights_sample_light(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx, float2 u,
                          LightSample* ls) {
@@ -376,23 +508,43 @@ bool lights_sample_light(const SceneData* sc, __global const Light* light, const
   return false;
 }
 
-// Picks a light by x_select (power-proportional alias table) and samples a direction toward it
-bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float2 u, LightSample* ls) {
+// Picks a light: x_select draws from the alias table (probabilities proportional to
+// power); when it falls on a light of the light tree and the tree is used, u_select
+// descends the tree instead (lights_tree_sample), so the lights outside it (directional,
+// environment) keep their share by power. *pmf = lights_select_pmf(ctx, *light).
+bool lights_select(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float u_select, uint* light,
+                   float* pmf) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
-  ls->light = sample_discrete_alias(sc->light_alias, n, x_select);
+  *light = sample_discrete_alias(sc->light_alias, n, x_select);
+  *pmf = sc->lights[*light].pmf;
+  if (lights_tree_used(sc) && sc->light_trails[*light].depth != LIGHT_TREE_NONE) {
+    float tree_pmf;
+    if (!lights_tree_sample(sc, ctx, u_select, light, &tree_pmf)) return false;
+    *pmf = sc->light_tree[0].share * tree_pmf;
+  }
+  return *pmf > 0.0f;
+}
+
+// Picks a light (lights_select) and samples a direction toward it
+bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float u_select, float2 u,
+                   LightSample* ls) {
+  if (!lights_select(sc, ctx, x_select, u_select, &ls->light, &ls->pmf)) return false;
   __global const Light* light = &sc->lights[ls->light];
   ls->is_delta = false;
   bool ok = lights_sample_light(sc, light, ctx, u, ls);
-  ls->pdf *= light->pmf;
-  return ok && light->pmf > 0.0f;
+  ls->pdf *= ls->pmf;
+  return ok;
 }
 
 // The pdf with which lights_sample picks light `index` and direction wi from ctx
 float lights_pdf(const SceneData* sc, const LightSampleContext* ctx, uint index, float3 wi) {
   __global const Light* light = &sc->lights[index];
-#define LIGHTS_PDF(id, name, feature) \
-  if (feature && light->type == id) return light->pmf * lights_##name##_pdf(sc, light, ctx, wi);
+#define LIGHTS_PDF(id, name, feature)                                   \
+  if (feature && light->type == id) {                                   \
+    float pdf = lights_##name##_pdf(sc, light, ctx, wi);                \
+    return pdf > 0.0f ? lights_select_pmf(sc, ctx, index) * pdf : 0.0f; \
+  }
   CD_LIGHTS(LIGHTS_PDF)
 #undef LIGHTS_PDF
   return 0.0f;
@@ -422,7 +574,8 @@ int lights_of_prim(const SceneData* sc, uint prim) {
   return lo < sc->params->num_lights && lights_prim(&sc->lights[lo]) == prim ? (int)lo : NO_LIGHT;
 }
 
-// Light `index` as STRATEGY_AUTO's choice sees it from p
+// Light `index` as STRATEGY_AUTO's choice sees it from p, its selection probability aside
+// (lights_select_pmf: it depends on where the shading point is and which way it faces)
 LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
   __global const Light* light = &sc->lights[index];
   LightExtent e;
@@ -430,7 +583,7 @@ LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
   e.omega = 0.0f;
   e.radius = PI_F;
   e.integral = 0.0f;
-  e.pmf = light->pmf;
+  e.pmf = 0.0f;
   e.everywhere = false;
   e.map = false;
 #define LIGHTS_EXTENT(id, name, feature) \

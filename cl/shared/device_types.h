@@ -313,6 +313,39 @@ typedef struct {
   float params[8];    // per-type parameters, see above
 } Light;
 
+// A node of the light tree, 64 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
+// Importance Sampling of Many Lights with Adaptive Tree Splitting). The tree holds the
+// finite lights (triangles, points, spots), one per leaf; nodes are stored depth first, an
+// interior node's first child right after it. Each node bounds its lights' positions
+// (lo, hi), the directions they emit in (every light's emission axis lies within theta_o
+// of `axis`, and each emits only within theta_e beyond its axis) and sums their peak
+// radiant intensity (luminance; a triangle: L A). A scene without finite lights, or one
+// compiled for power selection, has one node of intensity 0: every light goes through the
+// alias table.
+typedef struct {
+  float lo[3];
+  float intensity;
+  float hi[3];
+  float cos_o;  // cos theta_o
+  float axis[3];
+  float cos_e;         // cos theta_e
+  unsigned int child;  // interior: index of the second child; leaf: index of its light
+  unsigned int leaf;   // 1: a leaf
+  float share;         // root: probability that selection goes into the tree (0 elsewhere)
+  float min_prob;      // root: least probability of a child that can light the point (see lights.cl)
+} LightTreeNode;
+
+// The path from the root of the light tree to a light's leaf, 16 bytes: step k (k < depth)
+// goes to the second child when bit k of bits[0] (k < 32) or bits[1] (k >= 32) is set.
+// Lights outside the tree have depth LIGHT_TREE_NONE.
+#define LIGHT_TREE_NONE 0xffffffffu
+#define LIGHT_TREE_MAX_DEPTH 64u
+typedef struct {
+  unsigned int bits[2];
+  unsigned int depth;
+  unsigned int pad;
+} LightTreeTrail;
+
 // A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
 // RGB at density 1; MEDIUM_GRID and MEDIUM_NANOVDB multiply them by the density at the point
 // (grid value x density_scale). `emission` is radiance emitted per unit length (L_e(z)
@@ -407,6 +440,8 @@ typedef struct {
   X(float, srgb_to_linear)   \
   X(Light, lights)           \
   X(AliasBin, light_alias)   \
+  X(LightTreeNode, light_tree) \
+  X(LightTreeTrail, light_trails) \
   X(float, env_distribution) \
   X(Medium, media)           \
   X(float, densities)        \
@@ -443,6 +478,10 @@ typedef struct {
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                                                 \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)                      \
     FIELD(Light, params, 32)                                                                                  \
+  SIZE(LightTreeNode, 64) FIELD(LightTreeNode, intensity, 12) FIELD(LightTreeNode, cos_o, 28) \
+    FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, cos_e, 44) FIELD(LightTreeNode, child, 48) \
+    FIELD(LightTreeNode, leaf, 52) FIELD(LightTreeNode, share, 56) FIELD(LightTreeNode, min_prob, 60) \
+  SIZE(LightTreeTrail, 16) FIELD(LightTreeTrail, depth, 8) \
   SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48)               \
     FIELD(Medium, emission_grid, 44) FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68)                 \
     FIELD(Medium, grid_min, 80) FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)               \

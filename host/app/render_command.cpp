@@ -20,6 +20,7 @@
 #include "app/report.hpp"
 #include "base/atomic_file.hpp"
 #include "compile/camera.hpp"
+#include "compile/light_tree.hpp"
 #include "compile/scene_compiler.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
@@ -164,6 +165,11 @@ void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
       ->check(integer_in(0, 100000));
   render->add_option("--strategy", a.strategy,
                      enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto");
+  render
+      ->add_option("--light-selection", a.light_selection,
+                   "tree|power: light selection by the light tree (estimated contribution at the shading point; "
+                   "default) or by power alone")
+      ->check(CLI::IsMember({"tree", "power"}));
   render->add_flag("--no-energy-compensation", a.no_energy_compensation,
                    "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
                    "default: rough metal and glass keep their albedo)");
@@ -253,6 +259,7 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
                        const std::vector<DeviceEntry>& devices) {
   auto compiled =
       std::make_shared<CompiledScene>(a.generic ? compile_scene(*scene, SceneFeatures::all()) : compile_scene(*scene));
+  if (a.light_selection == "power") drop_light_tree(&compiled->buffers);
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
   *scene = Scene();
   return Renderer(devices, std::move(compiled), camera, settings, true);

@@ -18,7 +18,8 @@ struct RenderArgs {
   std::string device;
   uint32_t seed = 0;
   uint32_t max_depth = 16;
-  std::string strategy;  // empty: the scene's (extras candela.strategy), else auto
+  std::string strategy;                  // empty: the scene's (extras candela.strategy), else auto
+  std::string light_selection = "tree";  // --light-selection tree|power
   bool no_energy_compensation = false;
   std::string background;
   std::string env;

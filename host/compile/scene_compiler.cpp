@@ -7,6 +7,7 @@
 #include "base/error.hpp"
 #include "compile/bvh_builder.hpp"
 #include "compile/environment_distribution.hpp"
+#include "compile/light_tree.hpp"
 #include "scene/environment.hpp"
 
 namespace candela {
@@ -389,7 +390,8 @@ dev::Light compile_environment_map(const EnvironmentDesc& env, dev::SceneBuffers
   return l;
 }
 
-// Every emissive triangle, punctual light and the environment, with the selection table.
+// Every emissive triangle, punctual light and the environment, with the selection table
+// and the light tree over the finite ones (light_tree.hpp).
 // Triangle lights come first, in increasing primitive order: the kernel finds the light of
 // an emitter it hits by a binary search (lights_of_prim, cl/lights/lights.cl).
 int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
@@ -448,6 +450,9 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   std::vector<double> pmf;
   b->light_alias = alias_table(power, &pmf);
   for (size_t i = 0; i < b->lights.size(); ++i) b->lights[i].pmf = float(pmf[i]);
+  LightTree tree = build_light_tree(*b, power, pmf);
+  b->light_tree = std::move(tree.nodes);
+  b->light_trails = std::move(tree.trails);
   return environment;
 }
 

@@ -34,9 +34,9 @@ __kernel void test_lights_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const
   ls.wi = ls.radiance = ls.target = (float3)(0.0f);
   ls.pdf = 0.0f;
   ls.is_delta = ls.at_infinity = false;
-  bool ok = lights_sample(&sc, &ctx, x_select, u, &ls);
-  // The light lights_sample picked, by the same table lookup
-  uint index = sample_discrete_alias(sc.light_alias, params->num_lights, x_select);
+  float u_select = rng_next(&rng);
+  bool ok = lights_sample(&sc, &ctx, x_select, u_select, u, &ls);
+  uint index = ls.light;  // the light lights_sample picked
   __global const Light* light = &sc.lights[index];
   uint flags = ok ? TL_OK | (ls.at_infinity ? TL_AT_INFINITY : 0u) | (ls.is_delta ? TL_DELTA : 0u) : 0u;
   float pdf_eval = 0.0f;
@@ -93,4 +93,32 @@ __kernel void test_lights_pdf_cells(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global co
     sum += row;
   }
   out[c] = sum * (cell.y - cell.x) * (cell.w - cell.z) / (float)(sub * sub);
+}
+
+// Light selection's pmf (lights_select_pmf) of every light at contexts c: p = ps[c], n = ns[c]
+// (n = 0: a point in a medium); one work-item per (c, l): out[c num_lights + l]
+__kernel void test_lights_select_pmf(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
+                                     __global const float4* ps, __global const float4* ns, __global float* out) {
+  uint i = get_global_id(0);
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  uint n = params->num_lights;
+  uint c = i / n, l = i % n;
+  LightSampleContext ctx = test_lights_context(ps[c], ns[c], 0u);
+  out[i] = lights_select_pmf(&sc, &ctx, l);
+}
+
+// One light selection (lights_select, with the integrator's random numbers) per work-item
+// from (p, n): out[i] = (light, pmf, lights_select_pmf(light), selected ? 1 : 0)
+__kernel void test_lights_select(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 p,
+                                 float4 n, uint seed, __global float4* out) {
+  uint i = get_global_id(0);
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  LightSampleContext ctx = test_lights_context(p, n, 0u);
+  Rng rng = rng_init(i, 0u, seed);
+  uint x_select = rng_next_uint(&rng);
+  float u_select = rng_next(&rng);
+  uint light = 0u;
+  float pmf = 0.0f;
+  bool ok = lights_select(&sc, &ctx, x_select, u_select, &light, &pmf);
+  out[i] = (float4)((float)light, pmf, ok ? lights_select_pmf(&sc, &ctx, light) : 0.0f, ok ? 1.0f : 0.0f);
 }

@@ -1,0 +1,266 @@
+#include "compile/light_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
+#include <limits>
+#include <numeric>
+
+#include "base/error.hpp"
+
+namespace candela {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Where a set of lights lies and which way it emits: positions in [lo, hi], emission axes
+// within theta_o of `axis`, each light emitting within theta_e beyond its own axis
+struct LightBounds {
+  glm::vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
+  double intensity = 0.0;
+  glm::dvec3 axis{0.0, 0.0, 1.0};
+  double theta_o = 0.0, theta_e = 0.0;
+  bool empty() const { return !(intensity > 0.0) && lo.x > hi.x; }
+  glm::vec3 centroid() const { return 0.5f * (lo + hi); }
+};
+
+double angle_between(const glm::dvec3& a, const glm::dvec3& b) {
+  return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+}
+
+// The smallest cone (Conty & Kulla's union of two bounding cones) holding both
+LightBounds unite(LightBounds a, const LightBounds& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  LightBounds u;
+  u.lo = glm::min(a.lo, b.lo);
+  u.hi = glm::max(a.hi, b.hi);
+  u.intensity = a.intensity + b.intensity;
+  u.theta_e = std::max(a.theta_e, b.theta_e);
+  const LightBounds* wide = a.theta_o >= b.theta_o ? &a : &b;
+  const LightBounds* narrow = wide == &a ? &b : &a;
+  double theta_d = angle_between(wide->axis, narrow->axis);
+  if (std::min(theta_d + narrow->theta_o, kPi) <= wide->theta_o) {
+    u.axis = wide->axis;
+    u.theta_o = wide->theta_o;
+    return u;
+  }
+  double theta_o = 0.5 * (wide->theta_o + theta_d + narrow->theta_o);
+  if (theta_o >= kPi) {
+    u.axis = wide->axis;
+    u.theta_o = kPi;
+    return u;
+  }
+  // Turn the wide cone's axis toward the narrow one's by theta_o - wide.theta_o
+  glm::dvec3 t = narrow->axis - glm::dot(narrow->axis, wide->axis) * wide->axis;
+  double tl = glm::length(t);
+  if (!(tl > 1e-12)) {  // opposite axes: any perpendicular
+    t = std::abs(wide->axis.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    t -= glm::dot(t, wide->axis) * wide->axis;
+    tl = glm::length(t);
+  }
+  double rot = theta_o - wide->theta_o;
+  u.axis = glm::normalize(std::cos(rot) * wide->axis + std::sin(rot) * (t / tl));
+  u.theta_o = theta_o;
+  return u;
+}
+
+// Conty & Kulla's orientation measure: the solid angle the cone's emission reaches,
+// weighted by the cosine to the nearest emission axis
+double orientation_measure(const LightBounds& b) {
+  double to = b.theta_o, tw = std::min(b.theta_o + b.theta_e, kPi);
+  return 2.0 * kPi * (1.0 - std::cos(to)) +
+         0.5 * kPi * (2.0 * tw * std::sin(to) - std::cos(to - 2.0 * tw) - 2.0 * to * std::sin(to) + std::cos(to));
+}
+
+double surface_area(const LightBounds& b) {
+  glm::dvec3 d = glm::dvec3(b.hi) - glm::dvec3(b.lo);
+  return 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+float cos_down(double theta) {  // float cosine no larger than the exact one: a cone never shrinks
+  return std::nextafter(float(std::cos(theta)), -2.0f);
+}
+
+// One light's bounds (triangles: radiance L times area A per emitting side, about the front
+// normal, or both ways when double-sided; points: intensity I in all directions; spots: I
+// about the axis out to the outer cone angle)
+LightBounds light_bounds(const dev::Light& l, const dev::SceneBuffers& b, double power) {
+  LightBounds lb;
+  if (l.type == LIGHT_TRIANGLE) {
+    const dev::Prim& p = b.prims[l.index];
+    glm::dvec3 v[3];
+    for (int k = 0; k < 3; ++k) {
+      glm::vec3 f(b.positions[3 * size_t(p.v[k])], b.positions[3 * size_t(p.v[k]) + 1],
+                  b.positions[3 * size_t(p.v[k]) + 2]);
+      lb.lo = glm::min(lb.lo, f);
+      lb.hi = glm::max(lb.hi, f);
+      v[k] = glm::dvec3(f);
+    }
+    glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+    double nl = glm::length(n);
+    lb.axis = nl > 0.0 ? n / nl : glm::dvec3(0, 0, 1);
+    bool two_sided = (b.materials[p.material].flags & MATERIAL_DOUBLE_SIDED) != 0u;
+    lb.theta_o = two_sided || !(nl > 0.0) ? kPi : 0.0;
+    lb.theta_e = 0.5 * kPi;
+    lb.intensity = power / (kPi * (two_sided ? 2.0 : 1.0));
+  } else {
+    glm::vec3 pos(l.params[0], l.params[1], l.params[2]);
+    lb.lo = lb.hi = pos;
+    lb.intensity = dev::luminance_rgb(l.radiance[0], l.radiance[1], l.radiance[2]);
+    if (l.type == LIGHT_SPOT) {
+      lb.axis = glm::normalize(glm::dvec3(l.params[3], l.params[4], l.params[5]));
+      lb.theta_o = 0.0;
+      lb.theta_e = std::acos(std::clamp(-double(l.params[7]) / double(l.params[6]), -1.0, 1.0));
+    } else {
+      lb.theta_o = kPi;
+      lb.theta_e = 0.5 * kPi;
+    }
+  }
+  // Every light keeps an intensity > 0: a light the alias table can pick, the tree can too
+  lb.intensity = std::max(lb.intensity, 1e-30);
+  return lb;
+}
+
+struct Builder {
+  const std::vector<LightBounds>& bounds;
+  std::vector<uint32_t>& order;  // light indices, partitioned in place
+  LightTree* tree;
+
+  // Builds the subtree over order[begin, end) at `depth` with trail `bits`; returns its bounds
+  LightBounds build(size_t begin, size_t end, uint32_t depth, uint64_t bits) {
+    size_t index = tree->nodes.size();
+    tree->nodes.emplace_back();
+    tree->depth = std::max(tree->depth, int(depth));
+    if (end - begin == 1) {
+      uint32_t light = order[begin];
+      dev::LightTreeTrail& t = tree->trails[light];
+      t.bits[0] = uint32_t(bits);
+      t.bits[1] = uint32_t(bits >> 32);
+      t.depth = depth;
+      write(index, bounds[light], light, 1u);
+      return bounds[light];
+    }
+    if (depth + 1 >= LIGHT_TREE_MAX_DEPTH) throw Error("light tree deeper than LIGHT_TREE_MAX_DEPTH");
+    size_t mid = split(begin, end, depth);
+    LightBounds a = build(begin, mid, depth + 1, bits);
+    uint32_t second = uint32_t(tree->nodes.size());
+    LightBounds b = build(mid, end, depth + 1, bits | (uint64_t(1) << depth));
+    LightBounds u = unite(a, b);
+    write(index, u, second, 0u);
+    return u;
+  }
+
+  void write(size_t index, const LightBounds& b, uint32_t child, uint32_t leaf) {
+    dev::LightTreeNode& n = tree->nodes[index];
+    for (int k = 0; k < 3; ++k) {
+      n.lo[k] = b.lo[k];
+      n.hi[k] = b.hi[k];
+      n.axis[k] = float(b.axis[k]);
+    }
+    n.intensity = float(std::min(b.intensity, double(std::numeric_limits<float>::max())));
+    n.intensity = std::max(n.intensity, std::numeric_limits<float>::min());
+    n.cos_o = b.theta_o >= kPi ? -1.0f : cos_down(b.theta_o);
+    n.cos_e = cos_down(b.theta_e);
+    n.child = child;
+    n.leaf = leaf;
+  }
+
+  // Where to split order[begin, end): the lowest-cost bucket boundary, or the median along
+  // the widest centroid axis when no cost separates them (or the tree grows deep)
+  size_t split(size_t begin, size_t end, uint32_t depth) {
+    glm::vec3 clo(std::numeric_limits<float>::max()), chi(-std::numeric_limits<float>::max());
+    LightBounds all;
+    for (size_t i = begin; i < end; ++i) {
+      glm::vec3 c = bounds[order[i]].centroid();
+      clo = glm::min(clo, c);
+      chi = glm::max(chi, c);
+      all = unite(all, bounds[order[i]]);
+    }
+    glm::vec3 ext = chi - clo;
+    int widest = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    constexpr int kBuckets = 12;
+    double best = std::numeric_limits<double>::infinity();
+    int best_axis = -1, best_bucket = -1;
+    glm::dvec3 box = glm::dvec3(all.hi) - glm::dvec3(all.lo);
+    double box_max = std::max(box.x, std::max(box.y, box.z));
+    if (depth < 40) {
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!(ext[axis] > 0.0f)) continue;
+        LightBounds bucket[kBuckets];
+        for (size_t i = begin; i < end; ++i)
+          bucket[bucket_of(order[i], axis, clo, ext)] =
+              unite(bucket[bucket_of(order[i], axis, clo, ext)], bounds[order[i]]);
+        // Costs of the kBuckets - 1 boundaries: sweep from above, then from below
+        double right_cost[kBuckets] = {};
+        LightBounds acc;
+        for (int k = kBuckets - 1; k > 0; --k) {
+          acc = unite(acc, bucket[k]);
+          right_cost[k] = acc.empty() ? 0.0 : acc.intensity * surface_area(acc) * orientation_measure(acc);
+        }
+        double kr = box_max / std::max(box[axis], 1e-30);  // Conty & Kulla's penalty on thin splits
+        acc = LightBounds();
+        for (int k = 0; k + 1 < kBuckets; ++k) {
+          acc = unite(acc, bucket[k]);
+          double left = acc.empty() ? 0.0 : acc.intensity * surface_area(acc) * orientation_measure(acc);
+          double cost = kr * (left + right_cost[k + 1]);
+          if (cost < best) {
+            best = cost;
+            best_axis = axis;
+            best_bucket = k;
+          }
+        }
+      }
+    }
+    if (best_axis >= 0 && best > 0.0) {
+      auto mid = std::partition(order.begin() + long(begin), order.begin() + long(end),
+                                [&](uint32_t l) { return bucket_of(l, best_axis, clo, ext) <= best_bucket; });
+      size_t m = size_t(mid - order.begin());
+      if (m > begin && m < end) return m;
+    }
+    size_t m = begin + (end - begin) / 2;
+    std::nth_element(
+        order.begin() + long(begin), order.begin() + long(m), order.begin() + long(end),
+        [&](uint32_t x, uint32_t y) { return bounds[x].centroid()[widest] < bounds[y].centroid()[widest]; });
+    return m;
+  }
+
+  int bucket_of(uint32_t light, int axis, const glm::vec3& clo, const glm::vec3& ext) const {
+    float t = (bounds[light].centroid()[axis] - clo[axis]) / ext[axis];
+    return std::clamp(int(t * 12.0f), 0, 11);
+  }
+};
+
+}  // namespace
+
+LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<double>& power,
+                           const std::vector<double>& pmf) {
+  LightTree tree;
+  tree.trails.assign(buffers.lights.size(), dev::LightTreeTrail{{0u, 0u}, LIGHT_TREE_NONE, 0u});
+  std::vector<LightBounds> bounds(buffers.lights.size());
+  std::vector<uint32_t> order;
+  double share = 0.0;
+  for (size_t i = 0; i < buffers.lights.size(); ++i) {
+    const dev::Light& l = buffers.lights[i];
+    if (l.type != LIGHT_TRIANGLE && l.type != LIGHT_POINT && l.type != LIGHT_SPOT) continue;
+    bounds[i] = light_bounds(l, buffers, power[i]);
+    order.push_back(uint32_t(i));
+    share += pmf[i];
+  }
+  if (order.empty()) return tree;
+  Builder builder{bounds, order, &tree};
+  builder.build(0, order.size(), 0u, 0u);
+  tree.nodes[0].share = float(std::min(share, 1.0));
+  // Least probability of a child: min_prob^depth x share >= 2^-124 (a normal float)
+  if (tree.depth > 0)
+    tree.nodes[0].min_prob =
+        float(std::min(0.25, std::pow(std::ldexp(1.0, -124) / double(tree.nodes[0].share), 1.0 / double(tree.depth))));
+  return tree;
+}
+
+void drop_light_tree(dev::SceneBuffers* buffers) {
+  buffers->light_tree.clear();
+  buffers->light_trails.clear();
+}
+
+}  // namespace candela

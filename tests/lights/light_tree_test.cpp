@@ -1,0 +1,257 @@
+// The light tree (host/compile/light_tree.cpp, cl/lights/lights.cl) on the real kernel code:
+//  - its structure: every tree light's trail leads to its leaf, every node bounds its
+//    children's positions and emission cones;
+//  - lights_select_pmf sums to 1 over the lights at random shading points (inside the
+//    lights' bounds too, and in a medium, n = 0), and is > 0 for every light that can
+//    light the point;
+//  - the frequencies of lights_select match lights_select_pmf (chi-square, alpha 0.01 with
+//    the Sidak correction over this file's chi-square tests), and the pmf it reports is
+//    the one lights_select_pmf computes;
+//  - renders with the tree and with selection by power alone agree within standard errors,
+//    and nee and auto still agree with the tree.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <glm/glm.hpp>
+#include <memory>
+#include <random>
+
+#include "compile/camera.hpp"
+#include "compile/light_tree.hpp"
+#include "compile/scene_compiler.hpp"
+#include "gltf/gltf_loader.hpp"
+#include "render/renderer.hpp"
+#include "support/stats.hpp"
+#include "support/test_support.hpp"
+
+namespace candela::test {
+namespace {
+
+constexpr int kChiSquareTests = 3 * 2;  // per device: 3 contexts on 2 scenes
+const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
+
+CompiledScene compiled(const std::string& file) { return compile_scene(load_gltf(scene_path(file))); }
+
+glm::dvec3 node_lo(const dev::LightTreeNode& n) { return {n.lo[0], n.lo[1], n.lo[2]}; }
+glm::dvec3 node_hi(const dev::LightTreeNode& n) { return {n.hi[0], n.hi[1], n.hi[2]}; }
+glm::dvec3 node_axis(const dev::LightTreeNode& n) { return {n.axis[0], n.axis[1], n.axis[2]}; }
+
+// Whether cone (axis a, cos_o a) holds cone b: the angle between the axes plus b's theta_o
+// within a's theta_o (1e-5 rad of rounding)
+bool cone_holds(const dev::LightTreeNode& a, const dev::LightTreeNode& b) {
+  double theta_a = std::acos(std::clamp(double(a.cos_o), -1.0, 1.0));
+  double theta_b = std::acos(std::clamp(double(b.cos_o), -1.0, 1.0));
+  double d = std::acos(std::clamp(glm::dot(node_axis(a), node_axis(b)), -1.0, 1.0));
+  return theta_a >= 3.14159 || d + theta_b <= theta_a + 1e-5;
+}
+
+void check_tree(const CompiledScene& c) {
+  const auto& nodes = c.buffers.light_tree;
+  const auto& trails = c.buffers.light_trails;
+  ASSERT_FALSE(nodes.empty());
+  ASSERT_EQ(trails.size(), c.buffers.lights.size());
+  size_t in_tree = 0;
+  double share = 0.0;
+  for (size_t l = 0; l < trails.size(); ++l) {
+    const dev::Light& light = c.buffers.lights[l];
+    bool finite = light.type == LIGHT_TRIANGLE || light.type == LIGHT_POINT || light.type == LIGHT_SPOT;
+    if (!finite) {
+      EXPECT_EQ(trails[l].depth, LIGHT_TREE_NONE);
+      continue;
+    }
+    ++in_tree;
+    share += light.pmf;
+    uint32_t node = 0;
+    for (uint32_t k = 0; k < trails[l].depth; ++k) {
+      ASSERT_EQ(nodes[node].leaf, 0u);
+      node = ((trails[l].bits[k >> 5] >> (k & 31)) & 1u) ? nodes[node].child : node + 1;
+      ASSERT_LT(node, nodes.size());
+    }
+    EXPECT_EQ(nodes[node].leaf, 1u);
+    EXPECT_EQ(nodes[node].child, l) << "light " << l << "'s trail ends at another light's leaf";
+  }
+  EXPECT_EQ(nodes.size(), 2 * in_tree - 1);
+  uint32_t depth = 0;
+  for (const dev::LightTreeTrail& t : trails)
+    if (t.depth != LIGHT_TREE_NONE) depth = std::max(depth, t.depth);
+  std::printf("%zu lights in the tree, deepest leaf at depth %u\n", in_tree, depth);
+  // No trail's least pmf (every turn at min_prob) underflows
+  if (depth > 0) {
+    EXPECT_GE(depth * std::log2(double(nodes[0].min_prob)) + std::log2(double(nodes[0].share)), -124.01);
+  }
+  EXPECT_NEAR(nodes[0].share, share, 1e-5);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const dev::LightTreeNode& n = nodes[i];
+    if (n.leaf) continue;
+    for (const dev::LightTreeNode* ch : {&nodes[i + 1], &nodes[n.child]}) {
+      EXPECT_TRUE(glm::all(glm::lessThanEqual(node_lo(n), node_lo(*ch))));
+      EXPECT_TRUE(glm::all(glm::greaterThanEqual(node_hi(n), node_hi(*ch))));
+      EXPECT_TRUE(cone_holds(n, *ch)) << "node " << i;
+      EXPECT_LE(n.cos_e, ch->cos_e);
+      EXPECT_GE(n.intensity, 0.999 * ch->intensity);
+    }
+  }
+}
+
+TEST(LightTree, TrailsLeadToLeavesAndNodesBoundChildren) {
+  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+    SCOPED_TRACE(f);
+    check_tree(compiled(f));
+  }
+}
+
+// Points that can light p: a point light always, a spot when p lies inside its outer cone,
+// a single-sided triangle when p lies in front of its plane (by a margin)
+bool can_light(const CompiledScene& c, size_t l, const glm::dvec3& p) {
+  const dev::Light& light = c.buffers.lights[l];
+  if (light.type == LIGHT_POINT) return true;
+  if (light.type == LIGHT_SPOT) {
+    glm::dvec3 d = glm::normalize(p - glm::dvec3(light.params[0], light.params[1], light.params[2]));
+    double cos_outer = -double(light.params[7]) / double(light.params[6]);
+    return glm::dot(d, glm::dvec3(light.params[3], light.params[4], light.params[5])) > cos_outer + 1e-3;
+  }
+  if (light.type != LIGHT_TRIANGLE) return true;
+  const dev::Prim& pr = c.buffers.prims[light.index];
+  glm::dvec3 v[3];
+  for (int k = 0; k < 3; ++k)
+    v[k] = {c.buffers.positions[3 * pr.v[k]], c.buffers.positions[3 * pr.v[k] + 1],
+            c.buffers.positions[3 * pr.v[k] + 2]};
+  glm::dvec3 n = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
+  if (c.buffers.materials[pr.material].flags & MATERIAL_DOUBLE_SIDED) return true;
+  return glm::dot(n, p - v[0]) > 1e-3;
+}
+
+class LightTreeTest : public DeviceTest {
+ protected:
+  void use(const std::string& file) {
+    compiled_ = compiled(file);
+    scene_ = std::make_unique<SceneOnDevice>(rig(), compiled_);
+  }
+  CompiledScene compiled_;
+  std::unique_ptr<SceneOnDevice> scene_;
+};
+
+// Random shading points over the lights' bounds grown by half (so some lie inside node
+// boxes, some outside), with random normals; every fourth in a medium (n = 0)
+void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* ps, std::vector<cl_float4>* ns) {
+  const dev::LightTreeNode& root = c.buffers.light_tree[0];
+  glm::dvec3 lo = node_lo(root), hi = node_hi(root), mid = 0.5 * (lo + hi), half = 0.75 * (hi - lo) + 0.5;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < count; ++i) {
+    ps->push_back(f4(mid + glm::dvec3(u(rng), u(rng), u(rng)) * half));
+    glm::dvec3 n = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+    ns->push_back(f4(i % 4 == 3 ? glm::dvec3(0.0) : n));
+  }
+}
+
+TEST_P(LightTreeTest, PmfSumsToOneAndCoversEveryLightThatCanContribute) {
+  if (IsSkipped()) return;
+  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+    SCOPED_TRACE(f);
+    use(f);
+    constexpr int kContexts = 64;
+    std::vector<cl_float4> ps, ns;
+    random_contexts(compiled_, kContexts, &ps, &ns);
+    size_t n = compiled_.buffers.lights.size();
+    auto out = rig().output<float>(kContexts * n);
+    rig().run("test_lights_select_pmf", kContexts * n, *scene_, rig().input(ps), rig().input(ns), out);
+    std::vector<float> pmf = out.read();
+    for (int c = 0; c < kContexts; ++c) {
+      double sum = 0.0;
+      for (size_t l = 0; l < n; ++l) {
+        sum += pmf[c * n + l];
+        if (can_light(compiled_, l, d3(ps[size_t(c)]))) {
+          EXPECT_GT(pmf[c * n + l], 0.0f) << "light " << l << " at context " << c;
+        }
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-4) << "context " << c;
+    }
+  }
+}
+
+TEST_P(LightTreeTest, SelectionFrequenciesMatchPmf) {
+  if (IsSkipped()) return;
+  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+    SCOPED_TRACE(f);
+    use(f);
+    std::vector<cl_float4> ps, ns;
+    random_contexts(compiled_, 3, &ps, &ns);
+    ns[2] = f4(glm::dvec3(0.0));  // one in a medium
+    size_t n = compiled_.buffers.lights.size();
+    constexpr size_t kSamples = 1 << 20;
+    for (int c = 0; c < 3; ++c) {
+      auto out = rig().output<cl_float4>(kSamples);
+      rig().run("test_lights_select", kSamples, *scene_, ps[size_t(c)], ns[size_t(c)], cl_uint(11 + c), out);
+      std::vector<cl_float4> s = out.read();
+      std::vector<double> observed(n, 0.0), expected(n, 0.0);
+      for (const cl_float4& x : s) {
+        if (x.s[3] == 0.0f) continue;  // selection failed: counted as no light (expected 1 - sum)
+        size_t l = size_t(x.s[0]);
+        ASSERT_LT(l, n);
+        observed[l] += 1.0;
+        ASSERT_EQ(x.s[1], x.s[2]) << "the sampled pmf differs from lights_select_pmf";
+        expected[l] = double(x.s[2]);
+      }
+      // Expected counts from lights_select_pmf of every light (also the ones never drawn)
+      auto pmf_out = rig().output<float>(n);
+      rig().run("test_lights_select_pmf", n, *scene_, rig().input(std::vector<cl_float4>{ps[size_t(c)]}),
+                rig().input(std::vector<cl_float4>{ns[size_t(c)]}), pmf_out);
+      std::vector<float> pmf = pmf_out.read();
+      for (size_t l = 0; l < n; ++l) {
+        if (observed[l] > 0.0) {
+          EXPECT_EQ(float(expected[l]), pmf[l]);
+        }
+        expected[l] = double(pmf[l]) * double(kSamples);
+      }
+      ChiSquare t = chi_square_test(observed, expected);
+      EXPECT_GT(t.p_value, kAlpha) << "context " << c << ": chi2 " << t.statistic << " dof " << t.dof;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, LightTreeTest, kernel_devices(), DeviceParamName());
+
+// Renders of `file` with the tree and with selection by power: image means agree within
+// 5 standard errors of the two (plus 0.5 %); prints both relMSE against a reference
+Film render(const std::string& file, bool tree, Strategy strategy, uint32_t spp, uint32_t seed) {
+  Scene scene = load_gltf(scene_path(file));
+  auto c = std::make_shared<CompiledScene>(compile_scene(scene));
+  if (!tree) drop_light_tree(&c->buffers);
+  RenderSettings settings;
+  settings.width = 64;
+  settings.height = 48;
+  settings.strategy = strategy;
+  settings.max_depth = 3;
+  settings.seed = seed;
+  Renderer r(pocl_device(), std::shared_ptr<const CompiledScene>(c), compile_camera(scene, 64, 48), settings);
+  return r.render(0, spp).film;
+}
+
+void expect_agree(const Film& a, const Film& b, const char* what) {
+  Estimate ma = image_mean(a), mb = image_mean(b);
+  double se = std::hypot(ma.standard_error, mb.standard_error);
+  EXPECT_NEAR(ma.mean, mb.mean, 5.0 * se + 0.005 * mb.mean) << what;
+  std::printf("%s: %.5f +- %.5f against %.5f +- %.5f\n", what, ma.mean, ma.standard_error, mb.mean, mb.standard_error);
+}
+
+TEST(LightTreeRender, TreeAndPowerSelectionAgree) {
+  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+    SCOPED_TRACE(f);
+    Film tree = render(f, true, Strategy::Nee, 32, 1), power = render(f, false, Strategy::Nee, 32, 2);
+    expect_agree(tree, power, f);
+  }
+}
+
+TEST(LightTreeRender, NeeAndAutoAgreeWithTheTree) {
+  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+    SCOPED_TRACE(f);
+    Film nee = render(f, true, Strategy::Nee, 32, 3), automatic = render(f, true, Strategy::Auto, 32, 4);
+    expect_agree(automatic, nee, f);
+  }
+}
+
+}  // namespace
+}  // namespace candela::test
