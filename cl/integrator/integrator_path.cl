@@ -66,7 +66,7 @@ PathState path_start(const SceneData* sc, Ray ray) {
 float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const LightSample* ls,
                        const MediumStack* media, Rng* rng) {
   Ray shadow;
-  shadow.org = offset_ray_origin(ctx->p, dot(ls->wi, ctx->n) >= 0.0f ? ctx->n : -ctx->n);
+  shadow.org = offset_ray_origin(ctx->p, ctx->n * (dot(ls->wi, ctx->n) >= 0.0f ? 1.0f : -1.0f));
   float tmax = INFINITY;
   shadow.dir = ls->wi;
   if (!ls->at_infinity) {
@@ -301,7 +301,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
-    ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);
+    ps.ray.org = offset_ray_origin(s.p, s.ng * (dot(bs.wi, s.ng) > 0.0f ? 1.0f : -1.0f));
     ps.ray.dir = bs.wi;
 #if CD_FEATURE_MEDIA
     if (bs.flags & BSDF_TRANSMISSION) path_cross_boundary(sc, &ps, &s);
