@@ -310,10 +310,34 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
   return ps.radiance;
 }
 
+// The pixel (row-major index) of launch index i, 0 <= i < width * height: launches hand out
+// the image in 8x8 tiles, a band of 8 rows at a time from the top and the band's tiles from
+// the left; inside a whole tile the order is Morton's Z-order (x in the even bits of the
+// index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
+// Neighbouring work-items (a work-group of 64 is about one tile) trace neighbouring primary
+// rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
+// the pixel only, so the order changes no image.
+uint pixel_of_launch_index(uint i, uint width, uint height) {
+  uint band = i / (8u * width), in_band = i - band * 8u * width;
+  uint th = min(8u, height - 8u * band);  // the band's height
+  uint tile = in_band / (8u * th), local = in_band - tile * 8u * th;
+  uint tw = min(8u, width - 8u * tile);  // the tile's width
+  uint lx, ly;
+  if (tw == 8u && th == 8u) {
+    lx = (local & 1u) | ((local >> 1u) & 2u) | ((local >> 2u) & 4u);
+    ly = ((local >> 1u) & 1u) | ((local >> 2u) & 2u) | ((local >> 3u) & 4u);
+  } else {
+    ly = local / tw;
+    lx = local - ly * tw;
+  }
+  return (8u * band + ly) * width + 8u * tile + lx;
+}
+
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
                            __global float4* film_mean, __global float4* film_m2) {
-  uint pixel = params->pixel_begin + (uint)get_global_id(0);
-  if (pixel >= params->pixel_end) return;
+  uint index = params->pixel_begin + (uint)get_global_id(0);
+  if (index >= params->pixel_end) return;
+  uint pixel = pixel_of_launch_index(index, params->width, params->height);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint px = pixel % params->width, py = pixel / params->width;
