@@ -312,7 +312,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 
 // The pixel (row-major index) of launch index i, 0 <= i < width * height: launches hand out
 // the image in 8x8 tiles, a band of 8 rows at a time from the top and the band's tiles from
-// the left; inside a whole tile the order is Morton's Z-order (x in the even bits of the
+// the left; inside a whole tile the order is the Z-order (Morton 1966, A Computer Oriented
+// Geodetic Data Base and a New Technique in File Sequencing: x in the even bits of the
 // index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
 // Neighbouring work-items (a work-group of 64 is about one tile) trace neighbouring primary
 // rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
@@ -320,15 +321,15 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
 uint pixel_of_launch_index(uint i, uint width, uint height) {
   uint band = i / (8u * width), in_band = i - band * 8u * width;
   uint th = min(8u, height - 8u * band);  // the band's height
-  uint tile = in_band / (8u * th), local = in_band - tile * 8u * th;
+  uint tile = in_band / (8u * th), k = in_band - tile * 8u * th;
   uint tw = min(8u, width - 8u * tile);  // the tile's width
   uint lx, ly;
   if (tw == 8u && th == 8u) {
-    lx = (local & 1u) | ((local >> 1u) & 2u) | ((local >> 2u) & 4u);
-    ly = ((local >> 1u) & 1u) | ((local >> 2u) & 2u) | ((local >> 3u) & 4u);
+    lx = (k & 1u) | ((k >> 1u) & 2u) | ((k >> 2u) & 4u);
+    ly = ((k >> 1u) & 1u) | ((k >> 2u) & 2u) | ((k >> 3u) & 4u);
   } else {
-    ly = local / tw;
-    lx = local - ly * tw;
+    ly = k / tw;
+    lx = k - ly * tw;
   }
   return (8u * band + ly) * width + 8u * tile + lx;
 }
