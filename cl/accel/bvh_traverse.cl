@@ -167,6 +167,7 @@ bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes, __g
                   float tmax) {
   WatertightRay wr = watertight_ray(ray);
   BvhRay br = bvh_ray(ray);
+  float bound = fmin(tmax, FLT_MAX);  // a pushed child enters at or before tmax, and finitely
   int stack[BVH_STACK_SIZE];
   int sp = 0;
   int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
@@ -177,11 +178,11 @@ bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes, __g
       bvh_node_children(&br, nodes, ref, tmax, d, c);
       if (d[0] != INFINITY) {
         stack[sp] = c[3];
-        sp += d[3] != INFINITY && d[3] <= tmax;
+        sp += d[3] <= bound;
         stack[sp] = c[2];
-        sp += d[2] != INFINITY && d[2] <= tmax;
+        sp += d[2] <= bound;
         stack[sp] = c[1];
-        sp += d[1] != INFINITY && d[1] <= tmax;
+        sp += d[1] <= bound;
         ref = c[0];
         continue;
       }
