@@ -1,6 +1,7 @@
 // 4-wide BVH traversal: one float4 slab test per axis tests a node's four child boxes at
 // once; hit children are visited nearest first (a sorting network on their entry
-// distances, the others on a short stack); any-hit early exit for shadow rays.
+// distances, the others on a short stack); any-hit early exit for shadow rays, whose stack
+// holds node references only (half the private memory of the closest-hit one's).
 // The node and leaf layout (BvhNode, BvhTriangle, cl/shared/device_types.h) is private to this
 // file and host/bvh_builder.cpp; everything else sees hits by stable primitive index.
 // Hits on triangles flagged BVH_TRI_ALPHA_TEST count only where the scene's alpha test
@@ -47,73 +48,104 @@ float4 bvh_min4(float4 a, float4 b) { return a < b ? a : b; }
     ca = ct_;                     \
   }
 
-// Closest hit in (0, tmax), or with any_hit the first hit found; `sc` goes to the alpha test
+// A ray's constants for the node test: origin and inverse direction splatted, and the
+// offsets (in floats, within a node) of the slabs' near planes: lo_* where the direction is
+// positive, hi_* (4 floats on) where it is negative; the far planes are the others. Unused
+// slots (lo > hi) then give an entry beyond the exit.
+typedef struct {
+  float4 ox, oy, oz, ix, iy, iz;
+  int near_x, near_y, near_z;
+} BvhRay;
+
+CD_ALWAYS_INLINE BvhRay bvh_ray(Ray ray) {
+  BvhRay r;
+  float3 inv_dir = safe_inverse(ray.dir);
+  r.ox = (float4)(ray.org.x), r.oy = (float4)(ray.org.y), r.oz = (float4)(ray.org.z);
+  r.ix = (float4)(inv_dir.x), r.iy = (float4)(inv_dir.y), r.iz = (float4)(inv_dir.z);
+  r.near_x = inv_dir.x >= 0.0f ? 0 : 4;
+  r.near_y = inv_dir.y >= 0.0f ? 8 : 12;
+  r.near_z = inv_dir.z >= 0.0f ? 16 : 20;
+  return r;
+}
+
+// The children of node `ref` that the ray enters before tmax, nearest first: entry
+// distances d[0..3] (INFINITY: missed) and references c[0..3]
+CD_ALWAYS_INLINE void bvh_node_children(const BvhRay* r, __global const BvhNode* nodes, int ref, float tmax, float* d,
+                                        int* c) {
+  __global const float* b = (__global const float*)&nodes[ref];
+  int far_x = r->near_x ^ 4, far_y = r->near_y ^ 4, far_z = r->near_z ^ 4;
+  float4 enter =
+      bvh_max4(bvh_max4((vload4(0, b + r->near_x) - r->ox) * r->ix, (vload4(0, b + r->near_y) - r->oy) * r->iy),
+               bvh_max4((vload4(0, b + r->near_z) - r->oz) * r->iz, (float4)(0.0f)));
+  float4 exit = bvh_min4(bvh_min4((vload4(0, b + far_x) - r->ox) * r->ix, (vload4(0, b + far_y) - r->oy) * r->iy),
+                         bvh_min4((vload4(0, b + far_z) - r->oz) * r->iz, (float4)(tmax)));
+  // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), with room
+  // for OpenCL's 2.5 ulp division in inv_dir
+  float4 e = enter <= exit * 1.000001f ? enter : (float4)(INFINITY);
+  int4 k = vload4(0, nodes[ref].child);
+  float d0 = e.s0, d1 = e.s1, d2 = e.s2, d3 = e.s3;
+  int c0 = k.s0, c1 = k.s1, c2 = k.s2, c3 = k.s3;
+  BVH_SORT2(d0, c0, d1, c1);
+  BVH_SORT2(d2, c2, d3, c3);
+  BVH_SORT2(d0, c0, d2, c2);
+  BVH_SORT2(d1, c1, d3, c3);
+  BVH_SORT2(d1, c1, d2, c2);
+  d[0] = d0, d[1] = d1, d[2] = d2, d[3] = d3;
+  c[0] = c0, c[1] = c1, c[2] = c2, c[3] = c3;
+}
+
+// Does triangle i (leaf position) count as a hit in (0, tmax)?
+CD_ALWAYS_INLINE bool bvh_leaf_hit(const struct SceneData* sc, const WatertightRay* wr,
+                                   __global const BvhTriangle* tris, int i, uint flags, Ray ray, float tmax, float* t,
+                                   float* b1, float* b2) {
+  return bvh_leaf_triangle_hit(wr, &tris[i], tmax, t, b1, b2)
+#if CD_FEATURE_ALPHA
+         && (!(flags & BVH_TRI_ALPHA_TEST) || scene_alpha_passes(sc, tris[i].prim, *b1, *b2, ray))
+#endif
+      ;
+}
+
+// Closest hit in (0, tmax); `sc` goes to the alpha test
 Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
-                  float tmax, bool any_hit) {
+                  float tmax) {
   Hit hit;
   hit.t = tmax;
   hit.prim = -1;
   hit.b1 = hit.b2 = 0.0f;
   WatertightRay wr = watertight_ray(ray);
-  float3 inv_dir = safe_inverse(ray.dir);
-  float4 ox = (float4)(ray.org.x), oy = (float4)(ray.org.y), oz = (float4)(ray.org.z);
-  float4 ix = (float4)(inv_dir.x), iy = (float4)(inv_dir.y), iz = (float4)(inv_dir.z);
-  // Offsets (in floats, within a node) of the slabs' near planes: lo_* where the
-  // direction is positive, hi_* (4 floats on) where it is negative; the far planes are the
-  // others. Unused slots (lo > hi) then give an entry beyond the exit.
-  int near_x = inv_dir.x >= 0.0f ? 0 : 4, near_y = inv_dir.y >= 0.0f ? 8 : 12, near_z = inv_dir.z >= 0.0f ? 16 : 20;
-  int far_x = near_x ^ 4, far_y = near_y ^ 4, far_z = near_z ^ 4;
-
+  BvhRay br = bvh_ray(ray);
   int stack[BVH_STACK_SIZE];
   float stack_entry[BVH_STACK_SIZE];
   int sp = 0;
   int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
   while (true) {
     if (ref >= 0) {
-      __global const float* b = (__global const float*)&nodes[ref];
-      float4 enter = bvh_max4(bvh_max4((vload4(0, b + near_x) - ox) * ix, (vload4(0, b + near_y) - oy) * iy),
-                              bvh_max4((vload4(0, b + near_z) - oz) * iz, (float4)(0.0f)));
-      float4 exit = bvh_min4(bvh_min4((vload4(0, b + far_x) - ox) * ix, (vload4(0, b + far_y) - oy) * iy),
-                             bvh_min4((vload4(0, b + far_z) - oz) * iz, (float4)(hit.t)));
-      // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), with room
-      // for OpenCL's 2.5 ulp division in inv_dir
-      float4 d = enter <= exit * 1.000001f ? enter : (float4)(INFINITY);
-      int4 c = vload4(0, nodes[ref].child);
-      float d0 = d.s0, d1 = d.s1, d2 = d.s2, d3 = d.s3;
-      int c0 = c.s0, c1 = c.s1, c2 = c.s2, c3 = c.s3;
-      BVH_SORT2(d0, c0, d1, c1);
-      BVH_SORT2(d2, c2, d3, c3);
-      BVH_SORT2(d0, c0, d2, c2);
-      BVH_SORT2(d1, c1, d3, c3);
-      BVH_SORT2(d1, c1, d2, c2);
-      if (d0 != INFINITY) {
+      float d[4];
+      int c[4];
+      bvh_node_children(&br, nodes, ref, hit.t, d, c);
+      if (d[0] != INFINITY) {
         // Farther hit children onto the stack (farthest deepest), the nearest next
-        stack[sp] = c3;
-        stack_entry[sp] = d3;
-        sp += d3 != INFINITY;
-        stack[sp] = c2;
-        stack_entry[sp] = d2;
-        sp += d2 != INFINITY;
-        stack[sp] = c1;
-        stack_entry[sp] = d1;
-        sp += d1 != INFINITY;
-        ref = c0;
+        stack[sp] = c[3];
+        stack_entry[sp] = d[3];
+        sp += d[3] != INFINITY;
+        stack[sp] = c[2];
+        stack_entry[sp] = d[2];
+        sp += d[2] != INFINITY;
+        stack[sp] = c[1];
+        stack_entry[sp] = d[1];
+        sp += d[1] != INFINITY;
+        ref = c[0];
         continue;
       }
     } else {
       for (int i = ~ref;; ++i) {
         float t, b1, b2;
         uint flags = tris[i].flags;
-        if (bvh_leaf_triangle_hit(&wr, &tris[i], hit.t, &t, &b1, &b2)
-#if CD_FEATURE_ALPHA
-            && (!(flags & BVH_TRI_ALPHA_TEST) || scene_alpha_passes(sc, tris[i].prim, b1, b2, ray))
-#endif
-        ) {
+        if (bvh_leaf_hit(sc, &wr, tris, i, flags, ray, hit.t, &t, &b1, &b2)) {
           hit.t = t;
           hit.b1 = b1;
           hit.b2 = b2;
           hit.prim = i;  // leaf position until the end
-          if (any_hit) return bvh_hit_to_prim(hit, tris);
         }
         if (flags & BVH_TRI_LAST) break;
       }
@@ -127,7 +159,42 @@ Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes, __g
   }
 }
 
+// Anything in (0, tmax) that counts as a hit? The first hit found ends the walk, so tmax
+// stays the bound, and a child entered beyond it is not pushed: the stack needs no
+// distances. The closest-hit walk skips such entries when it pops them; the nodes visited,
+// and their order, are the same.
 bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
                   float tmax) {
-  return bvh_intersect(sc, nodes, tris, ray, tmax, true).prim >= 0;
+  WatertightRay wr = watertight_ray(ray);
+  BvhRay br = bvh_ray(ray);
+  float bound = fmin(tmax, FLT_MAX);  // a pushed child enters at or before tmax, and finitely
+  int stack[BVH_STACK_SIZE];
+  int sp = 0;
+  int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
+  while (true) {
+    if (ref >= 0) {
+      float d[4];
+      int c[4];
+      bvh_node_children(&br, nodes, ref, tmax, d, c);
+      if (d[0] != INFINITY) {
+        stack[sp] = c[3];
+        sp += d[3] <= bound;
+        stack[sp] = c[2];
+        sp += d[2] <= bound;
+        stack[sp] = c[1];
+        sp += d[1] <= bound;
+        ref = c[0];
+        continue;
+      }
+    } else {
+      for (int i = ~ref;; ++i) {
+        float t, b1, b2;
+        uint flags = tris[i].flags;
+        if (bvh_leaf_hit(sc, &wr, tris, i, flags, ray, tmax, &t, &b1, &b2)) return true;
+        if (flags & BVH_TRI_LAST) break;
+      }
+    }
+    if (sp == 0) return false;
+    ref = stack[--sp];
+  }
 }

@@ -66,7 +66,7 @@ PathState path_start(const SceneData* sc, Ray ray) {
 float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const LightSample* ls,
                        const MediumStack* media, Rng* rng) {
   Ray shadow;
-  shadow.org = offset_ray_origin(ctx->p, dot(ls->wi, ctx->n) >= 0.0f ? ctx->n : -ctx->n);
+  shadow.org = offset_ray_origin(ctx->p, ctx->n * (dot(ls->wi, ctx->n) >= 0.0f ? 1.0f : -1.0f));
   float tmax = INFINITY;
   shadow.dir = ls->wi;
   if (!ls->at_infinity) {
@@ -306,7 +306,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
-    ps.ray.org = offset_ray_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng);
+    ps.ray.org = offset_ray_origin(s.p, s.ng * (dot(bs.wi, s.ng) > 0.0f ? 1.0f : -1.0f));
     ps.ray.dir = bs.wi;
 #if CD_FEATURE_MEDIA
     if (bs.flags & BSDF_TRANSMISSION) path_cross_boundary(sc, &ps, &s);
@@ -315,10 +315,35 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
   return ps.radiance;
 }
 
+// The pixel (row-major index) of launch index i, 0 <= i < width * height: launches hand out
+// the image in 8x8 tiles, a band of 8 rows at a time from the top and the band's tiles from
+// the left; inside a whole tile the order is the Z-order (Morton 1966, A Computer Oriented
+// Geodetic Data Base and a New Technique in File Sequencing: x in the even bits of the
+// index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
+// Neighbouring work-items (a work-group of 64 is about one tile) trace neighbouring primary
+// rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
+// the pixel only, so the order changes no image.
+uint pixel_of_launch_index(uint i, uint width, uint height) {
+  uint band = i / (8u * width), in_band = i - band * 8u * width;
+  uint th = min(8u, height - 8u * band);  // the band's height
+  uint tile = in_band / (8u * th), k = in_band - tile * 8u * th;
+  uint tw = min(8u, width - 8u * tile);  // the tile's width
+  uint lx, ly;
+  if (tw == 8u && th == 8u) {
+    lx = (k & 1u) | ((k >> 1u) & 2u) | ((k >> 2u) & 4u);
+    ly = ((k >> 1u) & 1u) | ((k >> 2u) & 2u) | ((k >> 3u) & 4u);
+  } else {
+    ly = k / tw;
+    lx = k - ly * tw;
+  }
+  return (8u * band + ly) * width + 8u * tile + lx;
+}
+
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
                            __global float4* film_mean, __global float4* film_m2) {
-  uint pixel = params->pixel_begin + (uint)get_global_id(0);
-  if (pixel >= params->pixel_end) return;
+  uint index = params->pixel_begin + (uint)get_global_id(0);
+  if (index >= params->pixel_end) return;
+  uint pixel = pixel_of_launch_index(index, params->width, params->height);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint px = pixel % params->width, py = pixel / params->width;

@@ -242,7 +242,7 @@ bool lights_triangle_sample(const SceneData* sc, __global const Light* light, co
   // Where alpha lets rays through, BSDF-sampled rays find the emitter only that often
   ls->radiance *= alpha_coverage(sc, light->index, b1, b2);
   ls->at_infinity = false;
-  ls->target = offset_ray_origin(y, front ? n : -n);
+  ls->target = offset_ray_origin(y, n * (front ? 1.0f : -1.0f));
   return ls->pdf > 0.0f && isfinite(ls->pdf);
 }
 

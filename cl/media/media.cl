@@ -86,7 +86,7 @@ MediumStack media_at_origin(const SceneData* sc, Ray ray) {
     scene_prim_positions(sc, (uint)hit.prim, &v0, &v1, &v2);
     float area;
     float3 n = triangle_normal_area(v0, v1, v2, &area);
-    r.org = offset_ray_origin(r.org + hit.t * r.dir, dot(n, r.dir) > 0.0f ? n : -n);
+    r.org = offset_ray_origin(r.org + hit.t * r.dir, n * (dot(n, r.dir) > 0.0f ? 1.0f : -1.0f));
   }
   MediumStack st = media_stack_empty();
   for (uint i = 0u; i < n_inside; ++i) st.entered[i] = inside[n_inside - 1u - i];
@@ -391,7 +391,7 @@ float3 media_shadow_transmittance(const SceneData* sc, Ray ray, float tmax, Medi
     scene_prim_positions(sc, (uint)hit.prim, &v0, &v1, &v2);
     float area;
     float3 n = triangle_normal_area(v0, v1, v2, &area);
-    r.org = offset_ray_origin(r.org + hit.t * r.dir, dot(n, r.dir) > 0.0f ? n : -n);
+    r.org = offset_ray_origin(r.org + hit.t * r.dir, n * (dot(n, r.dir) > 0.0f ? 1.0f : -1.0f));
     if (isfinite(tmax)) {
       tmax = dot(target - r.org, r.dir);
       if (!(tmax > 0.0f)) return tr;

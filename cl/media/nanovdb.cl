@@ -10,9 +10,12 @@
 // - the fixed-width types are typedefs of OpenCL's, and the host removes the header's
 //   `#include <stdint.h>` and puts its program-scope tables in __constant
 //   (pnanovdb_opencl_text in host/kernel_sources.cpp, which also resolves the #include);
-// - `double` is float while the header compiles: devices without cl_khr_fp64 (rusticl on
-//   llvmpipe) reject the type, and only its double-precision accessors (the map's matd, the
-//   world bounding box), which this file never calls, use it.
+// - the header's `double` is `pnanovdb_double_t`, a float (the host renames the type in its
+//   text): devices without cl_khr_fp64 (rusticl on llvmpipe) reject `double`, and only its
+//   double-precision accessors (the map's matd, the world bounding box), which this file
+//   never calls, use it;
+// - its memcpy (PNANOVDB_MEMCPY_CUSTOM) is a byte copy, which the compiler turns into one
+//   move.
 // NanoVDB reads the float map (matf, invmatf, vecf) for world <-> index.
 
 #if CD_FEATURE_NANOVDB
@@ -38,13 +41,15 @@ static inline ulong pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offse
   return (ulong)buf[w] | ((ulong)buf[w + 1u] << 32);
 }
 
+typedef float pnanovdb_double_t;
+
 // The header reinterprets the bits of a private scalar as another type of the same size
 // with memcpy(&to, &from, sizeof(to)) (float from uint; the double one is never called)
-#define pnanovdb_memcpy(dst, src, n) (*(dst) = *(const __typeof__(*(dst))*)(src))
+static inline void pnanovdb_memcpy(void* dst, const void* src, size_t n) {
+  for (size_t i = 0; i < n; ++i) ((uchar*)dst)[i] = ((const uchar*)src)[i];
+}
 
-#define double float
 #include <nanovdb/PNanoVDB.h>
-#undef double
 
 // A float grid and a read accessor (which caches the nodes of the last lookup: neighbouring
 // lookups, such as the 8 of a trilinear one, skip the walk from the root)

@@ -13,7 +13,7 @@ typedef struct SceneData {
 // Closest hit along the ray in (0, tmax), by stable primitive index, skipping hits that
 // alpha lets through (cut-outs, BLEND's stochastic passes: cl/scene/alpha.cl)
 Hit scene_intersect(const SceneData* sc, Ray ray, float tmax) {
-  return bvh_intersect(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax, false);
+  return bvh_intersect(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax);
 }
 
 // Anything in (0, tmax) along the ray, by the same alpha tests?

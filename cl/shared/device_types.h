@@ -406,8 +406,8 @@ typedef struct {
   unsigned int rr_depth;             // Russian roulette starts after this many bounces
   unsigned int sample_begin;         // first sample index of this launch
   unsigned int sample_count;         // samples per pixel in this launch
-  unsigned int pixel_begin;          // first pixel of this launch (row-major)
-  unsigned int pixel_end;            // one past the last pixel of this launch
+  unsigned int pixel_begin;          // first launch index (pixel_of_launch_index: tiles, not rows)
+  unsigned int pixel_end;            // one past the last launch index of this launch
   unsigned int energy_compensation;  // 1: multiple-scattering compensation of GGX lobes (energy.cl)
   unsigned int filter;               // FILTER_*: the density of film sample offsets (filter.cl)
 } RenderParams;

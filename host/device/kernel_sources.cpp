@@ -1,6 +1,7 @@
 #include "device/kernel_sources.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -58,6 +59,23 @@ bool replace_line(std::string* text, const std::string& line, const std::string&
   return found;
 }
 
+// Replaces every identifier `word` (not part of a longer identifier) by `by`; the count
+size_t replace_word(std::string* text, const std::string& word, const std::string& by) {
+  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  size_t n = 0;
+  for (size_t at = text->find(word); at != std::string::npos; at = text->find(word, at)) {
+    size_t end = at + word.size();
+    if ((at > 0 && ident((*text)[at - 1])) || (end < text->size() && ident((*text)[end]))) {
+      at = end;
+      continue;
+    }
+    text->replace(at, word.size(), by);
+    at += by.size();
+    ++n;
+  }
+  return n;
+}
+
 // The file's text with `#include <nanovdb/PNanoVDB.h>` (cl/media/nanovdb.cl) replaced by the
 // header's text, between #line markers
 std::string resolve_includes(const std::string& path, std::string text) {
@@ -99,18 +117,21 @@ std::string program_source(bool with_tests) {
 
 }  // namespace
 
-// PNanoVDB.h's C platform (PNANOVDB_C) as OpenCL C 1.2 takes two edits: its `#include
+// PNanoVDB.h's C platform (PNANOVDB_C) as OpenCL C 1.2 takes three edits: its `#include
 // <stdint.h>` lines go (PoCL has no stdint.h, and rusticl's is glibc's, which does not
-// compile as OpenCL; cl/media/nanovdb.cl typedefs the fixed-width types), and its program-scope
-// tables become __constant (OpenCL C 1.2 keeps program-scope data in the constant space).
+// compile as OpenCL; cl/media/nanovdb.cl typedefs the fixed-width types), its program-scope
+// tables become __constant (OpenCL C 1.2 keeps program-scope data in the constant space), and
+// its type `double` becomes pnanovdb_double_t, which cl/media/nanovdb.cl defines (devices
+// without cl_khr_fp64 reject `double`; a macro named like the keyword is not portable C).
 std::string pnanovdb_opencl_text(std::string text) {
   bool ok = replace_line(&text, "#include <stdint.h>", "");
   ok = replace_line(&text, "#define PNANOVDB_STATIC_CONST static const", "#define PNANOVDB_STATIC_CONST __constant") &&
        ok;
+  ok = replace_word(&text, "double", "pnanovdb_double_t") > 0 && ok;
   if (!ok)
     throw Error(
-        "nanovdb/PNanoVDB.h: not the layout candela adapts to OpenCL C (its stdint.h include and "
-        "PNANOVDB_STATIC_CONST)");
+        "nanovdb/PNanoVDB.h: not the layout candela adapts to OpenCL C (its stdint.h include, "
+        "PNANOVDB_STATIC_CONST and double)");
   return text;
 }
 

@@ -87,9 +87,9 @@ class DeviceRenderer {
                  const RenderSettings& settings, CompiledScene* release = nullptr);
 
   // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
-  // of about settings.launch_seconds over ranges of pixels. `stop` is polled between
-  // launches; returns false when it stopped the range part way (some pixels then hold
-  // the range's samples, the others not). `progress` gets the fraction of the range done.
+  // of about settings.launch_seconds over ranges of launch indices (8x8 tiles of pixels,
+  // pixel_of_launch_index). `stop` is polled between launches; returns false when it stopped
+  // the range part way (some tiles hold the range's samples, the others not). `progress` gets the fraction done.
   bool render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
                     const std::function<void(double)>& progress);
 
@@ -114,7 +114,7 @@ class DeviceRenderer {
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
-  size_t chunk_ = 1;           // pixels per launch
+  size_t chunk_ = 1;           // launch indices (pixels) per launch
   uint32_t batch_ = 1;         // samples per pixel for the next range
   double pass_seconds_ = 0.0;  // one sample of every pixel, measured; 0 = not yet
   double kernel_build_seconds_ = 0.0;

@@ -10,7 +10,7 @@ __kernel void test_trace_bvh(__global const BvhNode* nodes, __global const BvhTr
   r.dir = rays[2 * i + 1].xyz;
   float tmax = rays[2 * i].w;
   // No triangle is flagged for the alpha test: no scene is needed
-  Hit h = bvh_intersect(0, nodes, tris, r, tmax, false);
+  Hit h = bvh_intersect(0, nodes, tris, r, tmax);
   out[i] = (float4)(h.t, h.b1, h.b2, (float)h.prim);
   occluded[i] = bvh_occluded(0, nodes, tris, r, tmax) ? 1 : 0;
 }
