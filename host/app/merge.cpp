@@ -18,8 +18,9 @@ namespace {
 
 // Metadata that must agree: the inputs are then samples of the same estimator (camera and
 // lighting are fingerprints of the device camera and of the background and environment)
-const char* const kMustMatch[] = {"scene",  "seed",    "strategy", "max_depth", "energy_compensation",
-                                  "filter", "sampler", "camera",   "lighting"};
+const char* const kMustMatch[] = {
+    "scene",  "seed",    "strategy", "light_selection", "max_depth", "energy_compensation",
+    "filter", "sampler", "camera",   "lighting"};
 
 bool partial(const RgbImage& img) {
   auto it = img.metadata.find("partial_pass");

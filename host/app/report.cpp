@@ -90,6 +90,7 @@ void record_render(const RenderArgs& a, const RenderSettings& settings, const Re
   report.max_depth = settings.max_depth;
   report.sample_offset = a.sample_offset;
   report.strategy = a.strategy;
+  report.light_selection = a.light_selection;
   report.filter = enum_name(kPixelFilterNames, settings.filter);
   report.sampler = enum_name(kSamplerNames, settings.sampler);
   report.energy_compensation = settings.energy_compensation;
@@ -171,6 +172,7 @@ std::map<std::string, std::string> image_metadata(const RenderReport& r) {
                                              {"device", r.device},
                                              {"seed", std::to_string(r.seed)},
                                              {"strategy", r.strategy},
+                                             {"light_selection", r.light_selection},
                                              {"max_depth", std::to_string(r.max_depth)},
                                              {"dropped_samples", std::to_string(r.dropped_samples)},
                                              {"scene", r.scene},
@@ -213,6 +215,7 @@ void write_stats(const RenderReport& r, const std::string& path) {
                       {"width", r.width},
                       {"height", r.height},
                       {"strategy", r.strategy},
+                      {"light_selection", r.light_selection},
                       {"energy_compensation", r.energy_compensation},
                       {"filter", r.filter},
                       {"sampler", r.sampler},

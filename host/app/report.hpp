@@ -23,7 +23,7 @@ struct RenderReport {
   double seconds = 0.0;
   std::string device;  // every device's description, joined by " + "
   uint32_t seed = 0, max_depth = 0, sample_offset = 0;
-  std::string strategy, filter, sampler;
+  std::string strategy, light_selection, filter, sampler;
   bool energy_compensation = true;
   uint64_t dropped_samples = 0;
   bool partial_pass = false;  // stopped inside a range of samples

@@ -162,6 +162,8 @@ fi
 "${render[@]}" -o "$tmp/s0.exr" --width 16 --spp 2 >/dev/null 2>&1
 "${render[@]}" -o "$tmp/s1.exr" --width 16 --spp 2 --sample-offset 2 --sampler independent >/dev/null 2>&1
 one_error "merge of different samplers" -- "$bin" merge "$tmp/s0.exr" "$tmp/s1.exr" -o "$tmp/never.exr"
+"${render[@]}" -o "$tmp/s2.exr" --width 16 --spp 2 --sample-offset 2 --light-selection power >/dev/null 2>&1
+one_error "merge of different light selections" -- "$bin" merge "$tmp/s0.exr" "$tmp/s2.exr" -o "$tmp/never.exr"
 "${render[@]}" -o "$tmp/s2.exr" --width 16 --spp 2 --sample-offset 2 --look-from 0,1,4 >/dev/null 2>&1
 one_error "merge of different cameras" -- "$bin" merge "$tmp/s0.exr" "$tmp/s2.exr" -o "$tmp/never.exr"
 "${render[@]}" -o "$tmp/s3.exr" --width 16 --spp 2 --sample-offset 2 --background 1,1,1 >/dev/null 2>&1
