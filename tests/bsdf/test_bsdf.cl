@@ -30,6 +30,22 @@ SurfaceHit test_bsdf_hit(float3 ng, float3 ns, float3 tangent, float3 wo, uint m
   return s;
 }
 
+// A hit of material 0 at the origin with normal +z (geometric and shading) and tangent +x,
+// on the side `front` says, at texture coordinates `uvs`: the flat point of the energy,
+// dielectric-energy, sheen and glTF-layer test kernels
+SurfaceHit test_bsdf_flat_hit(bool front, float4 uvs) {
+  SurfaceHit s;
+  s.p = (float3)(0.0f);
+  s.ng = s.ns = (float3)(0.0f, 0.0f, 1.0f);
+  s.tangent = (float3)(1.0f, 0.0f, 0.0f);
+  s.tangent_sign = 1.0f;
+  s.uvs = uvs;
+  s.vertex_color = (float3)(1.0f);
+  s.prim = s.material = 0u;
+  s.front = front;
+  return s;
+}
+
 // bsdf_sample of b from wo with (uc, u.x, u.y) drawn in that order from rng_init(i, 0, seed)
 bool test_bsdf_sample_i(const Bsdf* b, float3 wo, uint i, uint seed, BsdfSample* bs) {
   Rng rng = rng_init(i, 0u, seed);

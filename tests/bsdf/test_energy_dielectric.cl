@@ -26,15 +26,7 @@ Bsdf test_energy_dielectric_bsdf(__global const Material* materials, __global co
   SceneData sc = {CD_SCENE_BUFFERS(TEST_ENERGY_DIELECTRIC_NO_BUFFER) 0};
   sc.materials = materials;
   if (with_table) sc.ggx_albedo = table;
-  SurfaceHit s;
-  s.p = (float3)(0.0f);
-  s.ng = s.ns = (float3)(0.0f, 0.0f, 1.0f);
-  s.tangent = (float3)(1.0f, 0.0f, 0.0f);
-  s.tangent_sign = 1.0f;
-  s.uvs = (float4)(0.0f);
-  s.vertex_color = (float3)(1.0f);
-  s.prim = s.material = 0u;
-  s.front = front != 0u;
+  SurfaceHit s = test_bsdf_flat_hit(front != 0u, (float4)(0.0f));
   return bsdf_at(&sc, &s);
 }
 

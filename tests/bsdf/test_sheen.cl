@@ -12,15 +12,7 @@ Bsdf test_sheen_bsdf(__global const Material* materials, __global const float* g
   sc.materials = materials;
   if (tables & 1u) sc.ggx_albedo = ggx;
   if (tables & 2u) sc.sheen_albedo = sheen;
-  SurfaceHit s;
-  s.p = (float3)(0.0f);
-  s.ng = s.ns = (float3)(0.0f, 0.0f, 1.0f);
-  s.tangent = (float3)(1.0f, 0.0f, 0.0f);
-  s.tangent_sign = 1.0f;
-  s.uvs = (float4)(0.0f);
-  s.vertex_color = (float3)(1.0f);
-  s.prim = s.material = 0u;
-  s.front = true;
+  SurfaceHit s = test_bsdf_flat_hit(true, (float4)(0.0f));
   return bsdf_at(&sc, &s);
 }
 
