@@ -386,6 +386,8 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // pmf underflows (to 0 on devices that flush denormals). Sampling and the pmf of a given
 // light (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
 // STRATEGY_AUTO's two evaluations of a light's selection probability agree exactly.
+// Inside a planar emitter of several triangles (LIGHT_TREE_CLUSTER nodes) the children are
+// taken by their share of the power, with no importance to evaluate.
 #define LIGHT_TREE_MIN_COS 1e-3f
 
 // cos(a - b) for angles a, b in [0, pi] given by their cosines, or 1 when a <= b
@@ -424,6 +426,8 @@ float lights_tree_importance(__global const LightTreeNode* node, const LightSamp
 // Probability of taking the first child of interior node `node`, from its children's importances
 float lights_tree_first(const SceneData* sc, uint node, const LightSampleContext* ctx) {
 #pragma OPENCL FP_CONTRACT OFF
+  float lo = sc->light_tree[0].min_prob;
+  if (sc->light_tree[node].leaf == LIGHT_TREE_CLUSTER) return clamp(sc->light_tree[node].share, lo, 1.0f - lo);
   float a = lights_tree_importance(&sc->light_tree[node + 1u], ctx);
   float b = lights_tree_importance(&sc->light_tree[sc->light_tree[node].child], ctx);
   float sum = a + b;
@@ -433,15 +437,13 @@ float lights_tree_first(const SceneData* sc, uint node, const LightSampleContext
     first = isinf(a) ? (isinf(b) ? 0.5f : 1.0f) : 0.0f;
   else
     first = isinf(sum) ? 0.5f * a / (0.5f * a + 0.5f * b) : a / sum;
-  if (a > 0.0f && b > 0.0f) {
-    float lo = sc->light_tree[0].min_prob;
-    first = clamp(first, lo, 1.0f - lo);
-  }
+  if (a > 0.0f && b > 0.0f) first = clamp(first, lo, 1.0f - lo);
   return first;
 }
 
-// Whether selection uses the tree (it has lights, and the scene was compiled for it)
-bool lights_tree_used(const SceneData* sc) { return sc->light_tree[0].intensity > 0.0f; }
+// Whether selection uses the tree (the kernel has it, it has lights, and the scene was
+// compiled for it)
+bool lights_tree_used(const SceneData* sc) { return CD_FEATURE_LIGHT_TREE && sc->light_tree[0].intensity > 0.0f; }
 
 // A light of the tree chosen with u, and its probability within the tree; false when no
 // light of the tree can light ctx.p
@@ -450,7 +452,7 @@ bool lights_tree_sample(const SceneData* sc, const LightSampleContext* ctx, floa
   if (!(lights_tree_importance(&sc->light_tree[0], ctx) > 0.0f)) return false;
   uint node = 0u;
   float prob = 1.0f;
-  while (sc->light_tree[node].leaf == 0u) {
+  while (sc->light_tree[node].leaf != LIGHT_TREE_LEAF) {
     float first = lights_tree_first(sc, node, ctx);
     if (first < 0.0f) return false;
     if (u < first) {

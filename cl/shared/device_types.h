@@ -30,7 +30,8 @@
   X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
   X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
-  X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")
+  X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")        \
+  X(light_tree, CD_FEATURE_LIGHT_TREE, 1, "the compiled scene has a light tree (compile_lights)")
 // clang-format on
 
 // Material types. CD_MATERIALS: X(id, name, feature), one entry per type, generates every
@@ -316,12 +317,18 @@ typedef struct {
 // A node of the light tree, 64 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
 // Importance Sampling of Many Lights with Adaptive Tree Splitting). The tree holds the
 // finite lights (triangles, points, spots), one per leaf; nodes are stored depth first, an
-// interior node's first child right after it. Each node bounds its lights' positions
+// interior node's first child right after it. Interior nodes inside a planar emitter made
+// of several triangles (a quad light; host/compile/light_tree.cpp) are LIGHT_TREE_CLUSTER:
+// they take their first child with probability `share` (its share of their power) instead
+// of by importance. Each node bounds its lights' positions
 // (lo, hi), the directions they emit in (every light's emission axis lies within theta_o
 // of `axis`, and each emits only within theta_e beyond its axis) and sums their peak
 // radiant intensity (luminance; a triangle: L A). A scene without finite lights, or one
 // compiled for power selection, has one node of intensity 0: every light goes through the
 // alias table.
+#define LIGHT_TREE_INTERIOR 0u
+#define LIGHT_TREE_LEAF 1u
+#define LIGHT_TREE_CLUSTER 2u
 typedef struct {
   float lo[3];
   float intensity;
@@ -330,8 +337,8 @@ typedef struct {
   float axis[3];
   float cos_e;         // cos theta_e
   unsigned int child;  // interior: index of the second child; leaf: index of its light
-  unsigned int leaf;   // 1: a leaf
-  float share;         // root: probability that selection goes into the tree (0 elsewhere)
+  unsigned int leaf;   // LIGHT_TREE_INTERIOR, LIGHT_TREE_LEAF or LIGHT_TREE_CLUSTER
+  float share;         // root: probability that selection goes into the tree; cluster: of the first child
   float min_prob;      // root: least probability of a child that can light the point (see lights.cl)
 } LightTreeNode;
 

@@ -260,6 +260,7 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
   auto compiled =
       std::make_shared<CompiledScene>(a.generic ? compile_scene(*scene, SceneFeatures::all()) : compile_scene(*scene));
   if (a.light_selection == "power") drop_light_tree(&compiled->buffers);
+  if (!a.generic) compiled->features.light_tree = !compiled->buffers.light_tree.empty();
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
   *scene = Scene();
   return Renderer(devices, std::move(compiled), camera, settings, true);

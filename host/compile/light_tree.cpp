@@ -122,13 +122,81 @@ LightBounds light_bounds(const dev::Light& l, const dev::SceneBuffers& b, double
   return lb;
 }
 
+glm::dvec3 triangle_vertex(const dev::SceneBuffers& b, const dev::Light& l, int k) {
+  size_t v = 3 * size_t(b.prims[l.index].v[k]);
+  return {b.positions[v], b.positions[v + 1], b.positions[v + 2]};
+}
+
+// Twice the area of the convex hull of points in the plane (Andrew's monotone chain)
+double hull_area(std::vector<glm::dvec2> p) {
+  std::sort(p.begin(), p.end(),
+            [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  auto cross = [](const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  std::vector<glm::dvec2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {  // lower hull
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0.0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {  // upper hull
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0.0) --k;
+    h[k++] = p[i];
+  }
+  double area = 0.0;
+  for (size_t i = 0; i + 1 < k; ++i) area += h[i].x * h[i + 1].y - h[i + 1].x * h[i].y;
+  return std::abs(area);
+}
+
+// Fraction of the convex hull of their vertices (in their plane) that the triangles cover
+// at least, for a cluster to be one emitter: a quad's two triangles or a disc's fan cover it
+// all; two square lamps one lamp's width apart cover half
+constexpr double kClusterCover = 0.75;
+
 struct Builder {
+  const dev::SceneBuffers& buffers;
   const std::vector<LightBounds>& bounds;
   std::vector<uint32_t>& order;  // light indices, partitioned in place
   LightTree* tree;
 
-  // Builds the subtree over order[begin, end) at `depth` with trail `bits`; returns its bounds
-  LightBounds build(size_t begin, size_t end, uint32_t depth, uint64_t bits) {
+  // Whether lights order[begin, end) make one planar emitter: triangles in one plane, all
+  // single-sided facing one way or all double-sided, that cover at least kClusterCover of
+  // their convex hull. Importance
+  // barely tells such lights apart from any point the emitter lights, so the tree picks
+  // among them by power alone (LIGHT_TREE_CLUSTER nodes), without evaluating importance.
+  bool planar_emitter(size_t begin, size_t end) const {
+    const dev::Light& first = buffers.lights[order[begin]];
+    if (first.type != LIGHT_TRIANGLE) return false;
+    const glm::dvec3 n = bounds[order[begin]].axis, p0 = triangle_vertex(buffers, first, 0);
+    glm::dvec3 extent = glm::dvec3(bounds[order[begin]].hi) - glm::dvec3(bounds[order[begin]].lo);
+    for (size_t i = begin; i < end; ++i) extent = glm::max(extent, glm::dvec3(bounds[order[i]].hi) - p0);
+    const double tolerance = 1e-5 * std::max(glm::length(extent), 1e-30);
+    // The plane's frame (Duff et al. 2017's orthonormal basis)
+    double sign = std::copysign(1.0, n.z), a = -1.0 / (sign + n.z), bxy = n.x * n.y * a;
+    glm::dvec3 t(1.0 + sign * n.x * n.x * a, sign * bxy, -sign * n.x), s(bxy, sign + n.y * n.y * a, -n.y);
+    std::vector<glm::dvec2> points;
+    points.reserve(3 * (end - begin));
+    double area = 0.0;
+    for (size_t i = begin; i < end; ++i) {
+      const dev::Light& l = buffers.lights[order[i]];
+      const LightBounds& lb = bounds[order[i]];
+      if (l.type != LIGHT_TRIANGLE || lb.theta_o != bounds[order[begin]].theta_o) return false;
+      double facing = glm::dot(lb.axis, n);
+      if ((lb.theta_o == 0.0 ? facing : std::abs(facing)) < 1.0 - 1e-9) return false;
+      for (int k = 0; k < 3; ++k) {
+        glm::dvec3 d = triangle_vertex(buffers, l, k) - p0;
+        if (std::abs(glm::dot(d, n)) > tolerance) return false;
+        points.emplace_back(glm::dot(d, t), glm::dot(d, s));
+      }
+      area += 2.0 * double(l.params[0]);
+    }
+    return area >= kClusterCover * hull_area(std::move(points));
+  }
+
+  // Builds the subtree over order[begin, end) at `depth` with trail `bits`; returns its
+  // bounds. `cluster`: the lights are part of one planar emitter (planar_emitter).
+  LightBounds build(size_t begin, size_t end, uint32_t depth, uint64_t bits, bool cluster = false) {
     size_t index = tree->nodes.size();
     tree->nodes.emplace_back();
     tree->depth = std::max(tree->depth, int(depth));
@@ -138,16 +206,18 @@ struct Builder {
       t.bits[0] = uint32_t(bits);
       t.bits[1] = uint32_t(bits >> 32);
       t.depth = depth;
-      write(index, bounds[light], light, 1u);
+      write(index, bounds[light], light, LIGHT_TREE_LEAF);
       return bounds[light];
     }
     if (depth + 1 >= LIGHT_TREE_MAX_DEPTH) throw Error("light tree deeper than LIGHT_TREE_MAX_DEPTH");
+    cluster = cluster || planar_emitter(begin, end);
     size_t mid = split(begin, end, depth);
-    LightBounds a = build(begin, mid, depth + 1, bits);
+    LightBounds a = build(begin, mid, depth + 1, bits, cluster);
     uint32_t second = uint32_t(tree->nodes.size());
-    LightBounds b = build(mid, end, depth + 1, bits | (uint64_t(1) << depth));
+    LightBounds b = build(mid, end, depth + 1, bits | (uint64_t(1) << depth), cluster);
     LightBounds u = unite(a, b);
-    write(index, u, second, 0u);
+    write(index, u, second, cluster ? LIGHT_TREE_CLUSTER : LIGHT_TREE_INTERIOR);
+    if (cluster) tree->nodes[index].share = float(a.intensity / (a.intensity + b.intensity));
     return u;
   }
 
@@ -248,8 +318,15 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
     share += pmf[i];
   }
   if (order.empty()) return tree;
-  Builder builder{bounds, order, &tree};
+  Builder builder{buffers, bounds, order, &tree};
   builder.build(0, order.size(), 0u, 0u);
+  // One light, or one planar emitter: the tree would pick as the alias table does, by power
+  if (tree.nodes[0].leaf != LIGHT_TREE_INTERIOR) {
+    LightTree none;
+    none.trails = std::move(tree.trails);
+    for (dev::LightTreeTrail& t : none.trails) t.depth = LIGHT_TREE_NONE;
+    return none;
+  }
   tree.nodes[0].share = float(std::min(share, 1.0));
   // Least probability of a child: min_prob^depth x share >= 2^-124 (a normal float)
   if (tree.depth > 0)

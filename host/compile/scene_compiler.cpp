@@ -589,6 +589,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   compile_textures(scene, &c.buffers);
   compile_media(scene, c.features, &c.buffers, &c.grids);
   c.environment_light = compile_lights(scene, &c.buffers);
+  c.features.light_tree = features.light_tree || !c.buffers.light_tree.empty();  // a scene's need only known here
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;
   for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());

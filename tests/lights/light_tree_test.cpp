@@ -46,7 +46,8 @@ bool cone_holds(const dev::LightTreeNode& a, const dev::LightTreeNode& b) {
   return theta_a >= 3.14159 || d + theta_b <= theta_a + 1e-5;
 }
 
-void check_tree(const CompiledScene& c) {
+// Checks the tree's structure and counts its LIGHT_TREE_CLUSTER nodes
+void check_tree(const CompiledScene& c, size_t* clusters) {
   const auto& nodes = c.buffers.light_tree;
   const auto& trails = c.buffers.light_trails;
   ASSERT_FALSE(nodes.empty());
@@ -64,11 +65,11 @@ void check_tree(const CompiledScene& c) {
     share += light.pmf;
     uint32_t node = 0;
     for (uint32_t k = 0; k < trails[l].depth; ++k) {
-      ASSERT_EQ(nodes[node].leaf, 0u);
+      ASSERT_NE(nodes[node].leaf, LIGHT_TREE_LEAF);
       node = ((trails[l].bits[k >> 5] >> (k & 31)) & 1u) ? nodes[node].child : node + 1;
       ASSERT_LT(node, nodes.size());
     }
-    EXPECT_EQ(nodes[node].leaf, 1u);
+    EXPECT_EQ(nodes[node].leaf, LIGHT_TREE_LEAF);
     EXPECT_EQ(nodes[node].child, l) << "light " << l << "'s trail ends at another light's leaf";
   }
   EXPECT_EQ(nodes.size(), 2 * in_tree - 1);
@@ -81,9 +82,22 @@ void check_tree(const CompiledScene& c) {
     EXPECT_GE(depth * std::log2(double(nodes[0].min_prob)) + std::log2(double(nodes[0].share)), -124.01);
   }
   EXPECT_NEAR(nodes[0].share, share, 1e-5);
+  // A tree of one light or one planar emitter would pick as the alias table does: none is built
+  EXPECT_EQ(nodes[0].leaf, LIGHT_TREE_INTERIOR);
+  *clusters = 0;
   for (size_t i = 0; i < nodes.size(); ++i) {
     const dev::LightTreeNode& n = nodes[i];
-    if (n.leaf) continue;
+    if (n.leaf == LIGHT_TREE_LEAF) continue;
+    if (n.leaf == LIGHT_TREE_CLUSTER) {  // children by their share of the power, clusters too
+      ++*clusters;
+      for (const dev::LightTreeNode* ch : {&nodes[i + 1], &nodes[n.child]})
+        EXPECT_NE(ch->leaf, LIGHT_TREE_INTERIOR) << "node " << i;
+      EXPECT_NEAR(n.share, nodes[i + 1].intensity / (nodes[i + 1].intensity + nodes[n.child].intensity), 1e-5);
+      double facing = nodes[i + 1].axis[0] * nodes[n.child].axis[0] + nodes[i + 1].axis[1] * nodes[n.child].axis[1] +
+                      nodes[i + 1].axis[2] * nodes[n.child].axis[2];
+      EXPECT_NEAR(nodes[i + 1].cos_o < -0.5f ? std::abs(facing) : facing, 1.0, 1e-6)
+          << "a cluster's lights lie in one plane, facing one way when single-sided";
+    }
     for (const dev::LightTreeNode* ch : {&nodes[i + 1], &nodes[n.child]}) {
       EXPECT_TRUE(glm::all(glm::lessThanEqual(node_lo(n), node_lo(*ch))));
       EXPECT_TRUE(glm::all(glm::greaterThanEqual(node_hi(n), node_hi(*ch))));
@@ -95,10 +109,27 @@ void check_tree(const CompiledScene& c) {
 }
 
 TEST(LightTree, TrailsLeadToLeavesAndNodesBoundChildren) {
-  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+  // many-lights: 4096 emissive quads at different heights, each one planar emitter of two
+  // triangles (one cluster node); punctual: three punctual lights
+  size_t clusters = 0;
+  check_tree(compiled("lights/many-lights.gltf"), &clusters);
+  EXPECT_EQ(clusters, 4096u);
+  check_tree(compiled("lights/punctual.gltf"), &clusters);
+  EXPECT_EQ(clusters, 0u);
+}
+
+// One quad light (the Cornell box; a large panel) is one planar emitter: no tree is built,
+// and the kernel is compiled without one
+TEST(LightTree, NoTreeForOnePlanarEmitter) {
+  for (const char* f : {"cornell-box/cornell-box.gltf", "lights/large-light-glossy.gltf"}) {
     SCOPED_TRACE(f);
-    check_tree(compiled(f));
+    CompiledScene c = compiled(f);
+    EXPECT_TRUE(c.buffers.light_tree.empty());
+    EXPECT_FALSE(c.features.light_tree);
+    ASSERT_EQ(c.buffers.light_trails.size(), c.buffers.lights.size());
+    for (const dev::LightTreeTrail& t : c.buffers.light_trails) EXPECT_EQ(t.depth, LIGHT_TREE_NONE);
   }
+  EXPECT_TRUE(compiled("lights/many-lights.gltf").features.light_tree);
 }
 
 // Points that can light p: a point light always, a spot when p lies inside its outer cone,
