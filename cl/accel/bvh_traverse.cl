@@ -1,8 +1,7 @@
-// 8-wide BVH traversal: one float8 slab test per axis tests a node's eight child boxes at
-// once (AVX on x86 CPUs); hit children are visited nearest first (a vector sorting network
-// on their entry distances, the others on a stack, stored with one vstore8); any-hit
-// early exit for shadow rays, whose stack holds node references only (half the private
-// memory of the closest-hit one's).
+// 4-wide BVH traversal: one float4 slab test per axis tests a node's four child boxes at
+// once; hit children are visited nearest first (a sorting network on their entry
+// distances, the others on a short stack); any-hit early exit for shadow rays, whose stack
+// holds node references only (half the private memory of the closest-hit one's).
 // The node and leaf layout (BvhNode, BvhTriangle, cl/shared/device_types.h) is private to this
 // file and host/bvh_builder.cpp; everything else sees hits by stable primitive index.
 // Hits on triangles flagged BVH_TRI_ALPHA_TEST count only where the scene's alpha test
@@ -34,71 +33,65 @@ float3 safe_inverse(float3 d) {
 }
 
 // Plain compares instead of fmax/fmin: the slab distances are never NaN
-float8 bvh_max8(float8 a, float8 b) { return a > b ? a : b; }
-float8 bvh_min8(float8 a, float8 b) { return a < b ? a : b; }
+float4 bvh_max4(float4 a, float4 b) { return a > b ? a : b; }
+float4 bvh_min4(float4 a, float4 b) { return a < b ? a : b; }
 
-// One step of a bitonic sorting network (Batcher 1968, Sorting networks and their
-// applications) on eight lanes: lane i and its partner (dp, cp: the same vectors with
-// lanes i and i ^ j exchanged) trade places when out of order, the lanes in `first`
-// (-1) keeping the larger distance, the others the smaller. Ties stay put.
-#define BVH_SORT_STEP(d, c, swz, first)                           \
-  {                                                               \
-    float8 dp_ = (d).swz;                                         \
-    int8 cp_ = (c).swz;                                           \
-    int8 s_ = ((first) & (dp_ > (d))) | (~(first) & (dp_ < (d))); \
-    d = select(d, dp_, s_);                                       \
-    c = select(c, cp_, s_);                                       \
+// Orders (d[a], c[a]) and (d[b], c[b]) by distance
+#define BVH_SORT2(da, ca, db, cb) \
+  {                               \
+    bool s_ = db < da;            \
+    float dt_ = s_ ? db : da;     \
+    int ct_ = s_ ? cb : ca;       \
+    db = s_ ? da : db;            \
+    cb = s_ ? ca : cb;            \
+    da = dt_;                     \
+    ca = ct_;                     \
   }
 
 // A ray's constants for the node test: origin and inverse direction splatted, and the
 // offsets (in floats, within a node) of the slabs' near planes: lo_* where the direction is
-// positive, hi_* (8 floats on) where it is negative; the far planes are the others. Unused
+// positive, hi_* (4 floats on) where it is negative; the far planes are the others. Unused
 // slots (lo > hi) then give an entry beyond the exit.
 typedef struct {
-  float8 ox, oy, oz, ix, iy, iz;
+  float4 ox, oy, oz, ix, iy, iz;
   int near_x, near_y, near_z;
 } BvhRay;
 
 CD_ALWAYS_INLINE BvhRay bvh_ray(Ray ray) {
   BvhRay r;
   float3 inv_dir = safe_inverse(ray.dir);
-  r.ox = (float8)(ray.org.x), r.oy = (float8)(ray.org.y), r.oz = (float8)(ray.org.z);
-  r.ix = (float8)(inv_dir.x), r.iy = (float8)(inv_dir.y), r.iz = (float8)(inv_dir.z);
-  r.near_x = inv_dir.x >= 0.0f ? 0 : 8;
-  r.near_y = inv_dir.y >= 0.0f ? 16 : 24;
-  r.near_z = inv_dir.z >= 0.0f ? 32 : 40;
+  r.ox = (float4)(ray.org.x), r.oy = (float4)(ray.org.y), r.oz = (float4)(ray.org.z);
+  r.ix = (float4)(inv_dir.x), r.iy = (float4)(inv_dir.y), r.iz = (float4)(inv_dir.z);
+  r.near_x = inv_dir.x >= 0.0f ? 0 : 4;
+  r.near_y = inv_dir.y >= 0.0f ? 8 : 12;
+  r.near_z = inv_dir.z >= 0.0f ? 16 : 20;
   return r;
 }
 
-// The children of node `ref` that the ray enters before tmax, farthest first: entry
-// distances *d and references *c, lanes 0 .. n - 1 the n hit children (the nearest in lane
-// n - 1), the missed ones after them (distance -INFINITY). Returns n.
-CD_ALWAYS_INLINE int bvh_node_children(const BvhRay* r, __global const BvhNode* nodes, int ref, float tmax, float8* d,
-                                       int8* c) {
+// The children of node `ref` that the ray enters before tmax, nearest first: entry
+// distances d[0..3] (INFINITY: missed) and references c[0..3]
+CD_ALWAYS_INLINE void bvh_node_children(const BvhRay* r, __global const BvhNode* nodes, int ref, float tmax, float* d,
+                                        int* c) {
   __global const float* b = (__global const float*)&nodes[ref];
-  int far_x = r->near_x ^ 8, far_y = r->near_y ^ 8, far_z = r->near_z ^ 8;
-  float8 enter =
-      bvh_max8(bvh_max8((vload8(0, b + r->near_x) - r->ox) * r->ix, (vload8(0, b + r->near_y) - r->oy) * r->iy),
-               bvh_max8((vload8(0, b + r->near_z) - r->oz) * r->iz, (float8)(0.0f)));
-  float8 exit = bvh_min8(bvh_min8((vload8(0, b + far_x) - r->ox) * r->ix, (vload8(0, b + far_y) - r->oy) * r->iy),
-                         bvh_min8((vload8(0, b + far_z) - r->oz) * r->iz, (float8)(tmax)));
+  int far_x = r->near_x ^ 4, far_y = r->near_y ^ 4, far_z = r->near_z ^ 4;
+  float4 enter =
+      bvh_max4(bvh_max4((vload4(0, b + r->near_x) - r->ox) * r->ix, (vload4(0, b + r->near_y) - r->oy) * r->iy),
+               bvh_max4((vload4(0, b + r->near_z) - r->oz) * r->iz, (float4)(0.0f)));
+  float4 exit = bvh_min4(bvh_min4((vload4(0, b + far_x) - r->ox) * r->ix, (vload4(0, b + far_y) - r->oy) * r->iy),
+                         bvh_min4((vload4(0, b + far_z) - r->oz) * r->iz, (float4)(tmax)));
   // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), with room
   // for OpenCL's 2.5 ulp division in inv_dir
-  int8 hit = enter <= exit * 1.000001f;
-  float8 e = select((float8)(-INFINITY), enter, hit);
-  int8 k = vload8(0, nodes[ref].child);
-  // Descending: six bitonic steps, all lanes at once
-  BVH_SORT_STEP(e, k, s10325476, ((int8)(-1, 0, 0, -1, -1, 0, 0, -1)));
-  BVH_SORT_STEP(e, k, s23016745, ((int8)(-1, -1, 0, 0, 0, 0, -1, -1)));
-  BVH_SORT_STEP(e, k, s10325476, ((int8)(-1, 0, -1, 0, 0, -1, 0, -1)));
-  BVH_SORT_STEP(e, k, s45670123, ((int8)(-1, -1, -1, -1, 0, 0, 0, 0)));
-  BVH_SORT_STEP(e, k, s23016745, ((int8)(-1, -1, 0, 0, -1, -1, 0, 0)));
-  BVH_SORT_STEP(e, k, s10325476, ((int8)(-1, 0, -1, 0, -1, 0, -1, 0)));
-  *d = e;
-  *c = k;
-  int4 h = hit.lo + hit.hi;
-  int2 h2 = h.lo + h.hi;
-  return -(h2.x + h2.y);
+  float4 e = enter <= exit * 1.000001f ? enter : (float4)(INFINITY);
+  int4 k = vload4(0, nodes[ref].child);
+  float d0 = e.s0, d1 = e.s1, d2 = e.s2, d3 = e.s3;
+  int c0 = k.s0, c1 = k.s1, c2 = k.s2, c3 = k.s3;
+  BVH_SORT2(d0, c0, d1, c1);
+  BVH_SORT2(d2, c2, d3, c3);
+  BVH_SORT2(d0, c0, d2, c2);
+  BVH_SORT2(d1, c1, d3, c3);
+  BVH_SORT2(d1, c1, d2, c2);
+  d[0] = d0, d[1] = d1, d[2] = d2, d[3] = d3;
+  c[0] = c0, c[1] = c1, c[2] = c2, c[3] = c3;
 }
 
 // Does triangle i (leaf position) count as a hit in (0, tmax)?
@@ -121,21 +114,27 @@ Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes, __g
   hit.b1 = hit.b2 = 0.0f;
   WatertightRay wr = watertight_ray(ray);
   BvhRay br = bvh_ray(ray);
-  int stack[BVH_STACK_SIZE + BVH_WIDTH];  // room for a full node's vstore8 at the top
-  float stack_entry[BVH_STACK_SIZE + BVH_WIDTH];
+  int stack[BVH_STACK_SIZE];
+  float stack_entry[BVH_STACK_SIZE];
   int sp = 0;
   int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
   while (true) {
     if (ref >= 0) {
-      float8 d;
-      int8 c;
-      int n = bvh_node_children(&br, nodes, ref, hit.t, &d, &c);
-      if (n > 0) {
-        // The hit children onto the stack, farthest deepest; the nearest (on top) is next
-        vstore8(c, 0, stack + sp);
-        vstore8(d, 0, stack_entry + sp);
-        sp += n - 1;
-        ref = stack[sp];
+      float d[4];
+      int c[4];
+      bvh_node_children(&br, nodes, ref, hit.t, d, c);
+      if (d[0] != INFINITY) {
+        // Farther hit children onto the stack (farthest deepest), the nearest next
+        stack[sp] = c[3];
+        stack_entry[sp] = d[3];
+        sp += d[3] != INFINITY;
+        stack[sp] = c[2];
+        stack_entry[sp] = d[2];
+        sp += d[2] != INFINITY;
+        stack[sp] = c[1];
+        stack_entry[sp] = d[1];
+        sp += d[1] != INFINITY;
+        ref = c[0];
         continue;
       }
     } else {
@@ -161,25 +160,30 @@ Hit bvh_intersect(const struct SceneData* sc, __global const BvhNode* nodes, __g
 }
 
 // Anything in (0, tmax) that counts as a hit? The first hit found ends the walk, so tmax
-// stays the bound that the node test applies to every child's exit: the stack needs no
-// distances. Until that hit the nodes visited, and their order, are the closest-hit
-// walk's (which skips an entry beyond the closest hit only once it has one).
+// stays the bound, and a child entered beyond it is not pushed: the stack needs no
+// distances. The closest-hit walk skips such entries when it pops them; the nodes visited,
+// and their order, are the same.
 bool bvh_occluded(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris, Ray ray,
                   float tmax) {
   WatertightRay wr = watertight_ray(ray);
   BvhRay br = bvh_ray(ray);
-  int stack[BVH_STACK_SIZE + BVH_WIDTH];
+  float bound = fmin(tmax, FLT_MAX);  // a pushed child enters at or before tmax, and finitely
+  int stack[BVH_STACK_SIZE];
   int sp = 0;
   int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
   while (true) {
     if (ref >= 0) {
-      float8 d;
-      int8 c;
-      int n = bvh_node_children(&br, nodes, ref, tmax, &d, &c);
-      if (n > 0) {
-        vstore8(c, 0, stack + sp);
-        sp += n - 1;
-        ref = stack[sp];
+      float d[4];
+      int c[4];
+      bvh_node_children(&br, nodes, ref, tmax, d, c);
+      if (d[0] != INFINITY) {
+        stack[sp] = c[3];
+        sp += d[3] <= bound;
+        stack[sp] = c[2];
+        sp += d[2] <= bound;
+        stack[sp] = c[1];
+        sp += d[1] <= bound;
+        ref = c[0];
         continue;
       }
     } else {

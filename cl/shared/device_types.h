@@ -164,27 +164,26 @@
 #define MEDIUM_GRID 1u     // coefficients scaled by a dense density grid (trilinear), delta tracking
 #define MEDIUM_NANOVDB 2u  // as MEDIUM_GRID, the density from a NanoVDB float grid (nanovdb.cl)
 
-// 8-wide BVH node, 224 bytes; its encoding is private to bvh_builder.cpp and
-// bvh_traverse.cl. The eight child boxes are stored by coordinate (structure of arrays) so
-// that one float8 operation tests a slab of all eight: lo_x[i] .. hi_z[i] bound child i.
+// 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
+// bvh_traverse.cl. The four child boxes are stored by coordinate (structure of arrays) so
+// that one float4 operation tests a slab of all four: lo_x[i] .. hi_z[i] bound child i.
 // child[i]: >= 0 an inner node's index; < 0 a leaf, ~child[i] its first BvhTriangle (the
 // leaf runs to the triangle flagged BVH_TRI_LAST). Unused slots have lo = +1e30 > hi =
 // -1e30, which no ray enters, and child 0.
-#define BVH_WIDTH 8
 typedef struct {
-  float lo_x[BVH_WIDTH];
-  float hi_x[BVH_WIDTH];  // must follow lo_x (and hi_y lo_y, hi_z lo_z): traversal picks by offset
-  float lo_y[BVH_WIDTH];
-  float hi_y[BVH_WIDTH];
-  float lo_z[BVH_WIDTH];
-  float hi_z[BVH_WIDTH];
-  int child[BVH_WIDTH];
+  float lo_x[4];
+  float hi_x[4];  // must follow lo_x (and hi_y lo_y, hi_z lo_z): traversal picks by offset
+  float lo_y[4];
+  float hi_y[4];
+  float lo_z[4];
+  float hi_z[4];
+  int child[4];
+  int pad[4];
 } BvhNode;
 
-// Traversal stack entries: at most BVH_WIDTH - 1 per node on the way down, and at most
-// 30 nodes on a path (each node at least two binary levels below its parent, the builder's
-// binary depth limit 60)
-#define BVH_STACK_SIZE 210
+// Traversal stack entries: at most 3 per node on the way down (the builder's
+// depth limit keeps the tree within it)
+#define BVH_STACK_SIZE 96
 
 // A triangle as the BVH leaves store it (BVH order), 48 bytes; private to the BVH files.
 #define BVH_TRI_ALPHA_TEST 1u  // hits must pass scene_alpha_passes (alphaMode MASK / BLEND)
@@ -457,8 +456,8 @@ typedef struct {
 // One entry per line, columns aligned:
 // clang-format off
 #define CD_LAYOUT(SIZE, FIELD)                                                                                \
-  SIZE(BvhNode, 224) FIELD(BvhNode, hi_x, 32) FIELD(BvhNode, lo_y, 64) FIELD(BvhNode, hi_y, 96)               \
-    FIELD(BvhNode, lo_z, 128) FIELD(BvhNode, hi_z, 160) FIELD(BvhNode, child, 192)                           \
+  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32) FIELD(BvhNode, hi_y, 48)               \
+    FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80) FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)      \
   SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16) FIELD(BvhTriangle, flags, 28) \
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \

@@ -24,17 +24,9 @@ constexpr uint32_t kParallelBinning = 32768;
 constexpr uint32_t kMinJobRefs = 4096;
 constexpr size_t kJobsPerTree = 128;
 
-// Each 8-wide node on a path down pushes at most BVH_WIDTH - 1 entries, and the nodes sit
-// at least two binary levels apart (each is a 4-wide node of the build, at binary depths
-// 1, 3, ..., with some of its children's children pulled up), below kMaxBvhDepth
-static_assert((BVH_WIDTH - 1) * (kMaxBvhDepth / 2) <= BVH_STACK_SIZE, "traversal stack too small for the depth limit");
-
-// The build's 4-wide node: the binary tree with every other level collapsed, as the
-// builder makes it; collapse8 turns the finished tree into the kernel's 8-wide BvhNode
-struct Node4 {
-  float lo_x[4], hi_x[4], lo_y[4], hi_y[4], lo_z[4], hi_z[4];
-  int child[4];
-};
+// Each 4-wide node on a path down pushes at most 3 entries, and the nodes sit two
+// binary levels apart, at binary depths 1, 3, ..., below kMaxBvhDepth
+static_assert(3 * (kMaxBvhDepth / 2) <= BVH_STACK_SIZE, "traversal stack too small for the depth limit");
 
 // Four floats in one SSE/NEON register (GCC and Clang vector extensions); lane 3 unused
 typedef float v4f __attribute__((vector_size(16)));
@@ -84,7 +76,7 @@ struct Range {
 // 4-wide nodes of one subtree (the top of the tree, or one worker's job): child
 // references inside it are indices into `nodes`, relocated when the subtrees are joined
 struct Subtree {
-  std::vector<Node4> nodes;
+  std::vector<dev::BvhNode> nodes;
   int depth = 1;
 };
 
@@ -198,17 +190,16 @@ class Builder {
     // relocated; each job's nodes freed once copied (host memory: README, Performance)
     size_t total = top.sub.nodes.size();
     for (const Job& j : jobs) total += j.out.nodes.size();
+    bvh_.nodes = std::move(top.sub.nodes);
+    bvh_.nodes.reserve(total);
     bvh_.depth = top.sub.depth;
-    std::vector<Node4> nodes4 = std::move(top.sub.nodes);
-    nodes4.reserve(total);
     for (Job& j : jobs) {
-      int offset = int(nodes4.size());
-      append(nodes4, j.out.nodes, offset);
-      std::vector<Node4>().swap(j.out.nodes);
-      nodes4[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
+      int offset = int(bvh_.nodes.size());
+      append(bvh_.nodes, j.out.nodes, offset);
+      std::vector<dev::BvhNode>().swap(j.out.nodes);
+      bvh_.nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
       bvh_.depth = std::max(bvh_.depth, j.out.depth);
     }
-    collapse8(nodes4);
     return std::move(bvh_);
   }
 
@@ -264,8 +255,8 @@ class Builder {
     for (std::thread& th : pool) th.join();
   }
 
-  static Node4 empty_node() {
-    Node4 n{};
+  static dev::BvhNode empty_node() {
+    dev::BvhNode n{};
     for (int i = 0; i < 4; ++i) {
       n.lo_x[i] = n.lo_y[i] = n.lo_z[i] = kEmptyLo;
       n.hi_x[i] = n.hi_y[i] = n.hi_z[i] = kEmptyHi;
@@ -275,7 +266,7 @@ class Builder {
   }
 
   static void set_child(Subtree& out, uint32_t node, int slot, const Range& r, int ref) {
-    Node4& n = out.nodes[node];
+    dev::BvhNode& n = out.nodes[node];
     n.lo_x[slot] = r.box.lo.x;
     n.lo_y[slot] = r.box.lo.y;
     n.lo_z[slot] = r.box.lo.z;
@@ -423,94 +414,9 @@ class Builder {
     return node;
   }
 
-  // The 8-wide tree from the 4-wide one, greedily: a node starts with its 4-wide node's
-  // children and opens the inner child of largest surface area (replacing it by its own
-  // children) while the result fits in BVH_WIDTH slots, as wide BVHs are commonly
-  // collapsed from binary ones (largest area first: the child most rays enter). The root is
-  // node 0, a node's inner children are consecutive; leaves are the 4-wide tree's.
-  void collapse8(const std::vector<Node4>& n4) {
-    bvh_.nodes.clear();
-    bvh_.nodes.reserve(n4.size() / 2 + 1);
-    struct Slot {
-      float lo[3], hi[3];
-      int ref;
-      float area() const {
-        float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-        return dx * dy + dy * dz + dz * dx;
-      }
-    };
-    auto slots_of = [&](int node, std::vector<Slot>& out) {
-      const Node4& n = n4[size_t(node)];
-      for (int i = 0; i < 4; ++i) {
-        if (n.lo_x[i] > n.hi_x[i]) continue;
-        out.push_back(Slot{{n.lo_x[i], n.lo_y[i], n.lo_z[i]}, {n.hi_x[i], n.hi_y[i], n.hi_z[i]}, n.child[i]});
-      }
-    };
-    auto used = [&](int node) {
-      int k = 0;
-      for (int i = 0; i < 4; ++i) k += n4[size_t(node)].lo_x[i] <= n4[size_t(node)].hi_x[i];
-      return k;
-    };
-    // (4-wide node, 8-wide node to fill); children are emitted depth first
-    struct Todo {
-      int node4;
-      size_t node8;
-    };
-    std::vector<Todo> todo;
-    bvh_.nodes.push_back(dev::BvhNode{});
-    todo.push_back({0, 0});
-    std::vector<Slot> slots, opened;
-    while (!todo.empty()) {
-      Todo t = todo.back();
-      todo.pop_back();
-      slots.clear();
-      slots_of(t.node4, slots);
-      while (true) {
-        int best = -1;
-        float best_area = -1.0f;
-        for (int i = 0; i < int(slots.size()); ++i)
-          if (slots[size_t(i)].ref >= 0 && int(slots.size()) - 1 + used(slots[size_t(i)].ref) <= BVH_WIDTH &&
-              slots[size_t(i)].area() > best_area) {
-            best = i;
-            best_area = slots[size_t(i)].area();
-          }
-        if (best < 0) break;
-        opened.clear();
-        slots_of(slots[size_t(best)].ref, opened);
-        slots.erase(slots.begin() + best);
-        slots.insert(slots.begin() + best, opened.begin(), opened.end());
-      }
-      dev::BvhNode n{};
-      for (int i = 0; i < BVH_WIDTH; ++i) {
-        n.lo_x[i] = n.lo_y[i] = n.lo_z[i] = kEmptyLo;
-        n.hi_x[i] = n.hi_y[i] = n.hi_z[i] = kEmptyHi;
-        n.child[i] = 0;
-      }
-      // Children's nodes in slot order: pushed in reverse onto the depth-first stack
-      size_t first_child = todo.size();
-      for (int i = 0; i < int(slots.size()); ++i) {
-        const Slot& c = slots[size_t(i)];
-        n.lo_x[i] = c.lo[0], n.lo_y[i] = c.lo[1], n.lo_z[i] = c.lo[2];
-        n.hi_x[i] = c.hi[0], n.hi_y[i] = c.hi[1], n.hi_z[i] = c.hi[2];
-        n.child[i] = c.ref;  // a leaf; an inner child's index is set when it is made
-        if (c.ref >= 0) todo.push_back({c.ref, t.node8 * BVH_WIDTH + size_t(i)});
-      }
-      std::reverse(todo.begin() + std::ptrdiff_t(first_child), todo.end());
-      bvh_.nodes[t.node8] = n;
-      // Make the children's nodes now, in slot order, so that their indices are known
-      for (size_t k = todo.size(); k > first_child; --k) {
-        Todo& c = todo[k - 1];
-        size_t parent = c.node8 / BVH_WIDTH, slot = c.node8 % BVH_WIDTH;
-        c.node8 = bvh_.nodes.size();
-        bvh_.nodes[parent].child[slot] = int(c.node8);
-        bvh_.nodes.push_back(dev::BvhNode{});
-      }
-    }
-  }
-
   // Appends `from` to `to`, inner-child references (into `from`) moved by offset
-  static void append(std::vector<Node4>& to, const std::vector<Node4>& from, int offset) {
-    for (Node4 n : from) {
+  static void append(std::vector<dev::BvhNode>& to, const std::vector<dev::BvhNode>& from, int offset) {
+    for (dev::BvhNode n : from) {
       for (int i = 0; i < 4; ++i)
         if (n.child[i] >= 0 && n.lo_x[i] <= n.hi_x[i]) n.child[i] += offset;
       to.push_back(n);
@@ -673,7 +579,6 @@ int bvh_build_threads() {
 }
 
 double sah_cost(const Bvh& bvh) {
-  const int W = BVH_WIDTH;
   if (bvh.nodes.empty()) return 0.0;
   // The root's box: the union of its children's
   auto area = [](const dev::BvhNode& n, int i) {
@@ -682,7 +587,7 @@ double sah_cost(const Bvh& bvh) {
   };
   const dev::BvhNode& root = bvh.nodes[0];
   glm::dvec3 lo(1e300), hi(-1e300);
-  for (int i = 0; i < W; ++i) {
+  for (int i = 0; i < 4; ++i) {
     if (root.lo_x[i] > root.hi_x[i]) continue;
     lo = glm::min(lo, glm::dvec3(root.lo_x[i], root.lo_y[i], root.lo_z[i]));
     hi = glm::max(hi, glm::dvec3(root.hi_x[i], root.hi_y[i], root.hi_z[i]));
@@ -695,7 +600,7 @@ double sah_cost(const Bvh& bvh) {
   // area / root area x (traversal cost for an inner child, triangle count for a leaf)
   double cost = kTraversalCost;
   for (const dev::BvhNode& n : bvh.nodes)
-    for (int i = 0; i < W; ++i) {
+    for (int i = 0; i < 4; ++i) {
       if (n.lo_x[i] > n.hi_x[i]) continue;
       double weight;
       if (n.child[i] >= 0) {

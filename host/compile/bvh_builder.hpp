@@ -1,4 +1,4 @@
-// Binned-SAH BVH over the scene's primitives, collapsed into an 8-wide BVH for
+// Binned-SAH BVH over the scene's primitives, collapsed into a 4-wide BVH for
 // bvh_traverse.cl. The node and leaf layout (BvhNode, BvhTriangle) is private to this
 // file and bvh_traverse.cl: the rest of candela refers to triangles by their stable
 // primitive index.
@@ -12,13 +12,13 @@
 namespace candela {
 
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;     // 8-wide, root at 0
+  std::vector<dev::BvhNode> nodes;     // 4-wide, root at 0
   std::vector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
-  int depth = 0;  // of the binary SAH tree before collapsing (the 8-wide tree is at most half as deep)
+  int depth = 0;                       // of the binary SAH tree before collapsing (the 4-wide tree is half as deep)
 };
 
 // Depth limit of the binary SAH tree; it bounds the kernel's traversal stack
-// (BVH_STACK_SIZE entries, BVH_WIDTH - 1 per 8-wide node on a path).
+// (BVH_STACK_SIZE entries, 3 per 4-wide node on a path).
 constexpr int kMaxBvhDepth = 60;
 
 // `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order);
@@ -31,7 +31,7 @@ Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>&
 // Threads build_bvh uses by default: CANDELA_BVH_THREADS when set (> 0), else every core
 int bvh_build_threads();
 
-// Surface-area-heuristic cost of the 8-wide tree, relative to one triangle test: 1 (the
+// Surface-area-heuristic cost of the 4-wide tree, relative to one triangle test: 1 (the
 // root) + the sum over child slots of (slot box area / root box area) x (1 for an inner
 // node, the triangle count for a leaf). Lower is better; equal trees give equal costs.
 double sah_cost(const Bvh& bvh);

@@ -125,10 +125,10 @@ static void check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
     ASSERT_EQ(node_seen[item.node]++, 0) << "node reached twice";
     const dev::BvhNode& node = bvh.nodes[item.node];
     int used = 0;
-    for (int i = 0; i < BVH_WIDTH; ++i) used += node.lo_x[i] <= node.hi_x[i];
+    for (int i = 0; i < 4; ++i) used += node.lo_x[i] <= node.hi_x[i];
     int pushes = item.pushes + std::max(0, used - 1);
     max_pushes = std::max(max_pushes, pushes);
-    for (int i = 0; i < BVH_WIDTH; ++i) {
+    for (int i = 0; i < 4; ++i) {
       glm::vec3 lo(node.lo_x[i], node.lo_y[i], node.lo_z[i]), hi(node.hi_x[i], node.hi_y[i], node.hi_z[i]);
       if (lo.x > hi.x) {  // unused slot: empty on every axis
         ASSERT_GT(lo.y, hi.y);
@@ -151,7 +151,7 @@ static void check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
       } else {
         ASSERT_GT(c, 0);
         const dev::BvhNode& child = bvh.nodes[c];
-        for (int k = 0; k < BVH_WIDTH; ++k) {
+        for (int k = 0; k < 4; ++k) {
           if (child.lo_x[k] > child.hi_x[k]) continue;
           ASSERT_TRUE(inside(glm::vec3(child.lo_x[k], child.lo_y[k], child.lo_z[k])));
           ASSERT_TRUE(inside(glm::vec3(child.hi_x[k], child.hi_y[k], child.hi_z[k])));
@@ -297,7 +297,7 @@ TEST_P(BvhTest, RandomRaysOnRealMeshesMatchBruteForceReference) {
     }
   ASSERT_GT(scene.size(), 5000u);
   glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);
-  EXPECT_GT(check_random_rays(rig(), scene, c - 0.8f * e, c + 0.8f * e, 20000, 13), 5000);
+  EXPECT_GT(check_random_rays(rig(), scene, c - 0.8f * e, c + 0.8f * e, 5000, 13), 1200);
 }
 
 TEST_P(BvhTest, RaysThroughSharedEdgesAndVerticesNeverLeak) {

@@ -71,7 +71,7 @@ void check_compiled(const candela::CompiledScene& c, const candela::CameraDesc& 
   for (const auto& t : b.bvh_tris) require(t.prim < b.prims.size(), "BVH triangle prim");
   require(!b.bvh_nodes.empty(), "BVH root");
   for (const auto& n : b.bvh_nodes)
-    for (int i = 0; i < BVH_WIDTH; ++i) {
+    for (int i = 0; i < 4; ++i) {
       if (n.lo_x[i] > n.hi_x[i]) continue;  // unused slot
       if (n.child[i] < 0) {                 // leaf run: ends at a BVH_TRI_LAST triangle inside the array
         size_t t = size_t(~n.child[i]);
