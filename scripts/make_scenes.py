@@ -756,7 +756,6 @@ def make_environment(path):
     """Spheres of several materials on a floor, lit by sky.hdr through the scene extras."""
     g = GltfWriter(GENERATOR)
     spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
-
     materials = [
         g.pbr_material("white-diffuse", pbr((0.8, 0.8, 0.8), 0.0, 1.0), spec0),
         g.pbr_material("gold", pbr((1, 1, 1), 1.0, 0.3), extras={"candela": {"conductor": "gold"}}),
@@ -864,7 +863,6 @@ def make_near_specular(path, environment):
     sky.hdr. Light sampling alone speckles the sharp lobes and the caustics under the
     glass; BSDF sampling alone the floor (small sun)."""
     g = GltfWriter(GENERATOR)
-
     glass = {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
     materials = [
         metal_pbr(g, "metal-r0.02", 0.02, (0.9, 0.9, 0.9)),
