@@ -456,15 +456,17 @@ def bump_normal(x, y, size=64, cells=6, depth=0.6):
     return (0.5 + 0.5 * n[0], 0.5 + 0.5 * n[1], 0.5 + 0.5 * n[2], 1.0)
 
 
+def pbr(base, metallic, roughness):
+    """pbrMetallicRoughness factors: opaque base colour, metallic, roughness."""
+    return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
+            "roughnessFactor": roughness}
+
+
 def material_rows(g):
     """Materials of the sphere grid, back row first, five a row."""
     spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
     glass_volume = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
                     "KHR_materials_volume": {"thicknessFactor": 0.8}}
-
-    def pbr(base, metallic, roughness):
-        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
-                "roughnessFactor": roughness}
 
     def conductor(name, roughness):
         return g.pbr_material("%s-%.2f" % (name, roughness), pbr((1, 1, 1), 1.0, roughness),
@@ -716,14 +718,44 @@ def make_tiny_sun_map(path):
     write_hdr(path, 128, 64, tiny_sun_texel(128, 64))
 
 
+def sphere_row(g, materials, radius, spacing, x0):
+    """One smooth UV sphere (accessors shared) per material, named after it, resting on
+    y = 0 in a row along x: sphere k at x = spacing k + x0."""
+    pos, nrm, uv, idx = uv_sphere(radius)
+    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
+              "TEXCOORD_0": g.vec_accessor(uv, 2)}
+    sphere_indices = g.index_accessor(idx)
+    for k, mat in enumerate(materials):
+        name = g.doc["materials"][mat]["name"]
+        mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
+        g.node(name, mesh=mesh, translation=[spacing * k + x0, radius, 0.0])
+
+
+def sky_environment(g):
+    """The scene lit by sky.hdr (strength 1, unrotated) through the scene extras."""
+    g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
+                                                                "rotation": 0.0}}}
+
+
+def square_floor(g, s, material):
+    """The node "floor": the square +-s on y = 0, facing up."""
+    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
+        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), material))
+
+
+def ceiling_panel(g, corners, strength=None):
+    """The node "panel": a one-sided white emitter (radiance `strength`, 1 where None)
+    over the quad `corners`, facing down."""
+    light = g.material("panel", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), strength=strength,
+                       double_sided=False)
+    g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
+        [f32v(q) for q in corners], (0.0, -1.0, 0.0)))), light))
+
+
 def make_environment(path):
     """Spheres of several materials on a floor, lit by sky.hdr through the scene extras."""
     g = GltfWriter(GENERATOR)
     spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
-
-    def pbr(base, metallic, roughness):
-        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
-                "roughnessFactor": roughness}
     materials = [
         g.pbr_material("white-diffuse", pbr((0.8, 0.8, 0.8), 0.0, 1.0), spec0),
         g.pbr_material("gold", pbr((1, 1, 1), 1.0, 0.3), extras={"candela": {"conductor": "gold"}}),
@@ -732,22 +764,13 @@ def make_environment(path):
                         "KHR_materials_volume": {"thicknessFactor": 1.0}}),
         g.pbr_material("red-plastic", pbr((0.8, 0.05, 0.05), 0.0, 0.2)),
     ]
-    radius = 0.45
-    pos, nrm, uv, idx = uv_sphere(radius)
-    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
-              "TEXCOORD_0": g.vec_accessor(uv, 2)}
-    sphere_indices = g.index_accessor(idx)
-    for k, mat in enumerate(materials):
-        name = g.doc["materials"][mat]["name"]
-        mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
-        g.node(name, mesh=mesh, translation=[1.1 * k - 1.65, radius, 0.0])
+    sphere_row(g, materials, 0.45, 1.1, -1.65)
     floor_mat = g.pbr_material("floor", pbr((0.5, 0.5, 0.5), 0.0, 1.0), spec0)
     s = 6.0
     floor_pos = [f32v(p) for p in ((-s, 0, s), (s, 0, s), (s, 0, -s), (-s, 0, -s))]
     g.node("floor", mesh=g.mesh("floor", floor_pos, [(0.0, 1.0, 0.0)] * 4, [0, 1, 2, 0, 2, 3], floor_mat))
     look_camera(g, (0.0, 1.3, 4.2), (0.0, 0.4, 0.0), 0.6, 1.6)
-    g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
-                                                                "rotation": 0.0}}}
+    sky_environment(g)
     g.write(path)
 
 
@@ -810,9 +833,7 @@ def make_small_light(path):
     sampling finds it every time, BSDF sampling rarely."""
     g = GltfWriter(GENERATOR)
     floor = g.material("floor", (0.5, 0.5, 0.5, 1.0))
-    s = 2.0
-    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
-        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    square_floor(g, 2.0, floor)
     light = g.material("light", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), strength=400.0,
                        double_sided=False)
     g.node("light", mesh=g.mesh("light", *flat_mesh(icosphere(2, radius=0.05)), light),
@@ -828,13 +849,8 @@ def make_large_light_glossy(path):
     points the narrow lobe hardly reflects."""
     g = GltfWriter(GENERATOR)
     metal = metal_pbr(g, "metal-r0.08", 0.08, (0.9, 0.9, 0.9))
-    s = 3.0
-    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
-        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), metal))
-    light = g.material("panel", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), double_sided=False)
-    p = [(-1.5, 1.5, -2.0), (1.5, 1.5, -2.0), (1.5, 1.5, -0.5), (-1.5, 1.5, -0.5)]
-    g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
-        [f32v(q) for q in p], (0.0, -1.0, 0.0)))), light))
+    square_floor(g, 3.0, metal)
+    ceiling_panel(g, [(-1.5, 1.5, -2.0), (1.5, 1.5, -2.0), (1.5, 1.5, -0.5), (-1.5, 1.5, -0.5)])
     look_camera(g, (0.0, 1.2, 3.5), (0.0, 0.0, -0.6), 0.7, 1.5)
     g.set_background([0, 0, 0])  # lit by its own lights alone: no default light
     g.write(path)
@@ -847,10 +863,6 @@ def make_near_specular(path, environment):
     sky.hdr. Light sampling alone speckles the sharp lobes and the caustics under the
     glass; BSDF sampling alone the floor (small sun)."""
     g = GltfWriter(GENERATOR)
-
-    def pbr(base, metallic, roughness):
-        return {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
-                "roughnessFactor": roughness}
     glass = {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
     materials = [
         metal_pbr(g, "metal-r0.02", 0.02, (0.9, 0.9, 0.9)),
@@ -860,28 +872,13 @@ def make_near_specular(path, environment):
         g.pbr_material("glass-r0.1", pbr((1, 1, 1), 0.0, 0.1),
                        dict(glass, KHR_materials_volume={"thicknessFactor": 1.0})),
     ]
-    radius = 0.4
-    pos, nrm, uv, idx = uv_sphere(radius)
-    sphere = {"POSITION": g.vec3_accessor(pos, True), "NORMAL": g.vec3_accessor(nrm, False),
-              "TEXCOORD_0": g.vec_accessor(uv, 2)}
-    sphere_indices = g.index_accessor(idx)
-    for k, mat in enumerate(materials):
-        name = g.doc["materials"][mat]["name"]
-        mesh = g.mesh_from_accessors("smooth-" + name, sphere, sphere_indices, mat)
-        g.node(name, mesh=mesh, translation=[0.95 * k - 1.9, radius, 0.0])
+    sphere_row(g, materials, 0.4, 0.95, -1.9)
     floor = g.material("floor", (0.5, 0.5, 0.5, 1.0))
-    s = 4.0
-    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
-        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    square_floor(g, 4.0, floor)
     if environment:
-        g.doc["scenes"][0]["extras"] = {"candela": {"environment": {"file": "sky.hdr", "strength": 1.0,
-                                                                    "rotation": 0.0}}}
+        sky_environment(g)
     else:
-        light = g.material("panel", (0.0, 0.0, 0.0, 1.0), emissive=(1.0, 1.0, 1.0), strength=4.0,
-                           double_sided=False)
-        p = [(-1.5, 2.5, -1.0), (1.5, 2.5, -1.0), (1.5, 2.5, 0.5), (-1.5, 2.5, 0.5)]
-        g.node("panel", mesh=g.mesh("panel", *flat_mesh(quad_triangles(orient_quad(
-            [f32v(q) for q in p], (0.0, -1.0, 0.0)))), light))
+        ceiling_panel(g, [(-1.5, 2.5, -1.0), (1.5, 2.5, -1.0), (1.5, 2.5, 0.5), (-1.5, 2.5, 0.5)], 4.0)
         g.set_background([0, 0, 0])  # lit by its own light alone: no default light
     look_camera(g, (0.0, 1.4, 4.0), (0.0, 0.35, 0.0), 0.55, 2.0)
     g.write(path)
@@ -893,9 +890,7 @@ def make_many_lights(path):
     table must not slow down per light."""
     g = GltfWriter(GENERATOR)
     floor = g.material("floor", (0.6, 0.6, 0.6, 1.0))
-    s = 4.0
-    g.node("floor", mesh=g.mesh("floor", *flat_mesh(quad_triangles(orient_quad(
-        [(-s, 0.0, -s), (-s, 0.0, s), (s, 0.0, s), (s, 0.0, -s)], (0.0, 1.0, 0.0)))), floor))
+    square_floor(g, 4.0, floor)
     ball = g.material("ball", (0.7, 0.7, 0.7, 1.0))
     sphere = flat_mesh(icosphere(2, radius=0.5))
     for k, x in enumerate((-1.5, 0.0, 1.5)):

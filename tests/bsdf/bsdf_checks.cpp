@@ -6,7 +6,8 @@
 
 namespace candela::test {
 
-size_t samples_on(const std::string& device) { return device == "rusticl" ? kSamples / 4 : kSamples; }
+size_t samples_on(const std::string& device, size_t n) { return device == "rusticl" ? n / 4 : n; }
+size_t samples_on(const std::string& device) { return samples_on(device, kSamples); }
 cl_uint seed_on(const std::string& device, cl_uint seed) { return device == "rusticl" ? seed + 1000 : seed; }
 
 namespace {
@@ -317,14 +318,24 @@ Frame shading_frame(const Geometry& g, const Oriented& o, const dev::Material& m
 BsdfRun::BsdfRun(const KernelRig& r, const dev::Material& m, const Geometry& g)
     : rig(r), material(m), geo(g), materials(r.input(std::vector<dev::Material>{m})) {}
 
+BsdfRun::BsdfRun(const KernelRig& r, const dev::Material& m, const Geometry& g, const cl::Buffer& table)
+    : BsdfRun(r, m, g) {
+  ggx_albedo = table;
+}
+
 namespace {
 
-// The shading point's arguments of the test_bsdf kernels: material table, ng, ns, tangent
+// The shading point's arguments of the test_bsdf kernels: material table, the GGX albedo
+// table where bound (the _ggx kernels), ng, ns, tangent
 struct ShadingPoint {
   const BsdfRun& run;
   cl_uint bind(cl::Kernel& k, cl_uint first) const {
-    return bind_args(k, first, run.materials, f4(run.geo.ng), f4(run.geo.ns), f4(run.geo.tangent));
+    first = bind_args(k, first, run.materials);
+    if (run.ggx_albedo()) first = bind_args(k, first, run.ggx_albedo);
+    return bind_args(k, first, f4(run.geo.ng), f4(run.geo.ns), f4(run.geo.tangent));
   }
+  // `kernel`, or its variant with the GGX albedo table
+  const char* name(const char* kernel, const char* with_table) const { return run.ggx_albedo() ? with_table : kernel; }
 };
 
 }  // namespace
@@ -332,7 +343,8 @@ struct ShadingPoint {
 Samples BsdfRun::sample(cl_uint seed, size_t n) const {
   auto out = rig.output<cl_float4>(3 * n);
   auto info = rig.output<cl_uint4>(n);
-  rig.run("test_bsdf_sample", n, ShadingPoint{*this}, f4(geo.wo), seed, out, info);
+  ShadingPoint at{*this};
+  rig.run(at.name("test_bsdf_sample", "test_bsdf_sample_ggx"), n, at, f4(geo.wo), seed, out, info);
   return {out.read(), info.read()};
 }
 
@@ -344,7 +356,8 @@ std::vector<cl_float4> BsdfRun::eval(const std::vector<std::pair<glm::dvec3, glm
     in.push_back(f4(wi));
   }
   auto out = rig.output<cl_float4>(pairs.size());
-  rig.run("test_bsdf_eval", pairs.size(), ShadingPoint{*this}, rig.input(in), out);
+  ShadingPoint at{*this};
+  rig.run(at.name("test_bsdf_eval", "test_bsdf_eval_ggx"), pairs.size(), at, rig.input(in), out);
   return out.read();
 }
 
@@ -763,6 +776,58 @@ void check_delta(const Samples& s, const std::vector<DeltaLobe>& lobes, bool pur
       EXPECT_NEAR(e.mean[c], lobes[k].contribution[c], bsdf_z() * e.se[c] + 1e-4 * lobes[k].contribution[c] + 1e-7)
           << lobes[k].name << " contribution, channel " << c;
   }
+}
+
+glm::dvec3 sphere_direction(double z, double phi) {
+  double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+void check_sphere_sampling(const std::vector<cl_float4>& records, glm::dvec3 wo, const PairEval& eval, int sub,
+                           double alpha) {
+  const int nz = 32, nphi = 64;
+  const size_t n = records.size() / 3;
+  std::vector<double> observed(nz * nphi + 1, 0.0);
+  size_t mismatched = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const cl_float4 &a = records[3 * i], &f = records[3 * i + 1], &e = records[3 * i + 2];
+    if (a.s[3] == 0.0f) {
+      observed[nz * nphi] += 1.0;
+      continue;
+    }
+    ASSERT_EQ(f.s[3], 0.0f) << "no delta lobe here";
+    for (int ch = 0; ch < 3; ++ch)
+      if (std::fabs(f.s[ch] - e.s[ch]) > 1e-3 * std::fabs(e.s[ch]) + 1e-6) ++mismatched;
+    if (std::fabs(a.s[3] - e.s[3]) > 1e-3 * e.s[3]) ++mismatched;
+    int iz = std::clamp(int((a.s[2] + 1.0) * 0.5 * nz), 0, nz - 1);
+    double phi = std::atan2(a.s[1], a.s[0]);
+    if (phi < 0.0) phi += 2.0 * kPi;
+    int ip = std::clamp(int(phi / (2.0 * kPi) * nphi), 0, nphi - 1);
+    observed[iz * nphi + ip] += 1.0;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  std::vector<cl_float4> pairs;
+  for (int iz = 0; iz < nz; ++iz)
+    for (int ip = 0; ip < nphi; ++ip)
+      for (int a = 0; a < sub; ++a)
+        for (int b = 0; b < sub; ++b) {
+          pairs.push_back(f4(wo));
+          pairs.push_back(f4(
+              sphere_direction(-1.0 + 2.0 * (iz + (a + 0.5) / sub) / nz, 2.0 * kPi * (ip + (b + 0.5) / sub) / nphi)));
+        }
+  std::vector<cl_float4> ev = eval(pairs);
+  std::vector<double> expected(nz * nphi + 1, 0.0);
+  double d_omega = 4.0 * kPi / (double(nz) * nphi * sub * sub), total = 0.0;
+  for (size_t i = 0; i < ev.size(); ++i) expected[i / (sub * sub)] += ev[i].s[3] * d_omega;
+  for (int i = 0; i < nz * nphi; ++i) total += expected[i];
+  EXPECT_LE(total, 1.0 + 2e-3);
+  EXPECT_NEAR(total, 1.0 - observed[nz * nphi] / n, 5e-3);
+  expected[nz * nphi] = std::max(0.0, 1.0 - total);
+  double sum = 0.0;
+  for (double& x : expected) sum += x;
+  for (double& x : expected) x *= n / sum;
+  ChiSquare cs = chi_square_test(observed, expected);
+  EXPECT_GT(cs.p_value, alpha) << "chi-square " << cs.statistic << " on " << cs.dof << " dof";
 }
 
 std::string BsdfTestName::operator()(const ::testing::TestParamInfo<BsdfTest::ParamType>& info) const {

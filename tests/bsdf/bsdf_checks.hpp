@@ -29,6 +29,8 @@ namespace candela::test {
 // quarter of that, as it is about 5x slower per work-item
 constexpr size_t kSamples = 1 << 20;
 size_t samples_on(const std::string& device);
+// n samples on PoCL, a quarter of them on rusticl
+size_t samples_on(const std::string& device, size_t n);
 // Each device its own random numbers, for independent evidence
 cl_uint seed_on(const std::string& device, cl_uint seed);
 
@@ -216,8 +218,12 @@ struct BsdfRun {
   const dev::Material material;
   const Geometry geo;
   cl::Buffer materials;
+  cl::Buffer ggx_albedo;  // the GGX albedo table where bound (energy compensation on), else null
 
   BsdfRun(const KernelRig& r, const dev::Material& m, const Geometry& g);
+  // The same with the GGX albedo table bound (the kernels test_bsdf_sample_ggx, test_bsdf_eval_ggx):
+  // the lobes' energy compensation on (cl/bsdf/energy.cl, energy_dielectric.cl)
+  BsdfRun(const KernelRig& r, const dev::Material& m, const Geometry& g, const cl::Buffer& table);
   // n calls of bsdf_sample from wo
   Samples sample(cl_uint seed, size_t n = kSamples) const;
   // (f, pdf) for each pair (wo, wi), the hit oriented by that wo
@@ -320,6 +326,50 @@ struct DeltaLobe {
 // frequencies and contributions match within bsdf_z() standard errors; `pure`: no
 // non-delta sample either
 void check_delta(const Samples& s, const std::vector<DeltaLobe>& lobes, bool pure);
+
+// ---- Sampling over the sphere at the flat point (kernels of their own) -------------------------
+
+// Unit direction of cosine z to +z at azimuth phi (radians) from +x
+glm::dvec3 sphere_direction(double z, double phi);
+
+// The flat-point sampling kernel `kernel` of `program` (its arguments: `scene...`, then wo,
+// seed and the output): n samples' records, three float4 each (test_bsdf_sample_record)
+template <typename... Scene>
+std::vector<cl_float4> flat_sample(const KernelRig& r, const cl::Program& program, const char* kernel, glm::dvec3 wo,
+                                   size_t n, cl_uint seed, const Scene&... scene) {
+  auto out = r.output<cl_float4>(3 * n);
+  cl::Kernel k(program, kernel);
+  bind_args(k, 0, scene..., f4(wo), seed, out);
+  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
+  return out.read();
+}
+
+// The flat-point evaluation kernel `kernel` of `program` (its arguments: `scene...`, then the
+// pairs and the output): (f, pdf) for each (wo, wi) = (pairs[2i], pairs[2i + 1])
+template <typename... Scene>
+std::vector<cl_float4> flat_eval(const KernelRig& r, const cl::Program& program, const char* kernel,
+                                 const std::vector<cl_float4>& pairs, const Scene&... scene) {
+  cl::Buffer in = r.input(pairs);  // alive until the kernel is enqueued (which retains it)
+  auto out = r.output<cl_float4>(pairs.size() / 2);
+  cl::Kernel k(program, kernel);
+  bind_args(k, 0, scene..., in, out);
+  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(pairs.size() / 2));
+  return out.read();
+}
+
+// (f, pdf) of a material's kernel for (wo, wi) pairs, given as float4 pairs
+using PairEval = std::function<std::vector<cl_float4>(const std::vector<cl_float4>& pairs)>;
+
+// For a sampling kernel whose records are three float4 a sample (test_bsdf_sample_record in
+// tests/bsdf/test_bsdf.cl: (wi, pdf), (f, 1 for a delta sample), (bsdf_eval, bsdf_pdf) at
+// wi; all zero where sampling failed), of a material without delta lobes seen from wo:
+// every sample's f and pdf are eval's (1e-3 relative); the pdf integrates to at most
+// 1 + 2e-3 and to the fraction of samples returned within 5e-3; a chi-square of the
+// sampled directions against the pdf (p > alpha) in 32 x 64 cells of equal solid angle
+// (z uniform in [-1, 1] x phi), each integrated on sub x sub midpoints, and one more for
+// the failed samples with what the pdf lacks of 1
+void check_sphere_sampling(const std::vector<cl_float4>& records, glm::dvec3 wo, const PairEval& eval, int sub,
+                           double alpha);
 
 // ---- Fixtures -----------------------------------------------------------------------------------
 

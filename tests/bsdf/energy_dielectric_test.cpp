@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 #include <random>
 
+#include "bsdf/bsdf_checks.hpp"
 #include "device/energy.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
@@ -23,10 +24,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr size_t kSamples = 1 << 18;
-
-cl_float4 f4(glm::dvec3 v, float w = 0.0f) { return {{float(v.x), float(v.y), float(v.z), w}}; }
+constexpr size_t kAlbedoSamples = 1 << 18;
 
 glm::dvec3 at_angle(double theta_deg) {
   double t = theta_deg * kPi / 180.0;
@@ -56,53 +54,25 @@ struct DielectricRig {
   // From the kernel cache (TableMatchesConvergedQuadrature computes its own afresh)
   GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file);
 
-  template <typename T>
-  std::vector<T> read(const cl::Buffer& b, size_t n) {
-    std::vector<T> v(n);
-    rig.queue.enqueueReadBuffer(b, CL_TRUE, 0, n * sizeof(T), v.data());
-    return v;
-  }
-  template <typename T>
-  cl::Buffer input(const std::vector<T>& v) {
-    return cl::Buffer(rig.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                      const_cast<T*>(v.data()));
-  }
-
   std::vector<cl_float2> lookup(const cl::Buffer& tables, const std::vector<cl_float4>& q) {
-    cl::Buffer in = input(q), out(rig.context, CL_MEM_WRITE_ONLY, q.size() * sizeof(cl_float2));
-    cl::Kernel k(rig.program, "test_energy_dielectric_lookup");
-    k.setArg(0, tables);
-    k.setArg(1, in);
-    k.setArg(2, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(q.size()));
-    return read<cl_float2>(out, q.size());
+    auto out = rig.output<cl_float2>(q.size());
+    rig.run("test_energy_dielectric_lookup", q.size(), tables, rig.input(q), out);
+    return out.read();
   }
 
   std::vector<float> quadrature(const std::vector<cl_float4>& q, cl_uint n) {
-    cl::Buffer in = input(q), out(rig.context, CL_MEM_WRITE_ONLY, q.size() * sizeof(float));
-    cl::Kernel k(rig.program, "test_energy_dielectric_quadrature");
-    k.setArg(0, in);
-    k.setArg(1, n);
-    k.setArg(2, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(q.size()));
-    return read<float>(out, q.size());
+    auto out = rig.output<float>(q.size());
+    rig.run("test_energy_dielectric_quadrature", q.size(), rig.input(q), n, out);
+    return out.read();
   }
 
   // Per sample: (X |cos| / pdf, agrees with eval), (wi, pdf)
   std::vector<cl_float4> sample(const dev::Material& m, bool with_table, bool front, glm::dvec3 wo, cl_uint seed,
-                                size_t n = kSamples) {
-    cl::Buffer mat = input(std::vector<dev::Material>{m});
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, 2 * n * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_dielectric_sample");
-    k.setArg(0, mat);
-    k.setArg(1, table.buffer);
-    k.setArg(2, cl_uint(with_table));
-    k.setArg(3, cl_uint(front));
-    k.setArg(4, f4(wo));
-    k.setArg(5, seed);
-    k.setArg(6, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-    return read<cl_float4>(out, 2 * n);
+                                size_t n = kAlbedoSamples) {
+    auto out = rig.output<cl_float4>(2 * n);
+    rig.run("test_energy_dielectric_sample", n, rig.input(std::vector<dev::Material>{m}), table.buffer,
+            cl_uint(with_table), cl_uint(front), f4(wo), seed, out);
+    return out.read();
   }
 
   // (X, pdf) for (wo, wi) pairs, each seen from the front or the back
@@ -110,18 +80,13 @@ struct DielectricRig {
                               const std::vector<bool>& front) {
     std::vector<cl_float4> in;
     for (size_t i = 0; i < pairs.size(); ++i) {
-      in.push_back(f4(pairs[i].first, front[i] ? 1.0f : 0.0f));
+      in.push_back(f4(pairs[i].first, front[i] ? 1.0 : 0.0));
       in.push_back(f4(pairs[i].second));
     }
-    cl::Buffer mat = input(std::vector<dev::Material>{m}), pb = input(in);
-    cl::Buffer out(rig.context, CL_MEM_WRITE_ONLY, pairs.size() * sizeof(cl_float4));
-    cl::Kernel k(rig.program, "test_energy_dielectric_eval");
-    k.setArg(0, mat);
-    k.setArg(1, table.buffer);
-    k.setArg(2, pb);
-    k.setArg(3, out);
-    rig.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(pairs.size()));
-    return read<cl_float4>(out, pairs.size());
+    auto out = rig.output<cl_float4>(pairs.size());
+    rig.run("test_energy_dielectric_eval", pairs.size(), rig.input(std::vector<dev::Material>{m}), table.buffer,
+            rig.input(in), out);
+    return out.read();
   }
 };
 
@@ -129,6 +94,9 @@ DielectricRig& dielectric_rig() {
   static DielectricRig r;
   return r;
 }
+
+// The side wo is seen from: a thin sheet's, outside or inside a solid
+const char* side_name(bool thin, bool front) { return thin ? "thin sheet" : front ? "outside" : "inside"; }
 
 struct Albedo {
   Estimate channel[3];
@@ -138,8 +106,8 @@ struct Albedo {
 Albedo albedo(DielectricRig& r, const dev::Material& m, bool with_table, bool front, glm::dvec3 wo, cl_uint seed) {
   std::vector<cl_float4> s = r.sample(m, with_table, front, wo, seed);
   Albedo a;
-  std::vector<cl_float4> w(kSamples);
-  for (size_t i = 0; i < kSamples; ++i) {
+  std::vector<cl_float4> w(kAlbedoSamples);
+  for (size_t i = 0; i < kAlbedoSamples; ++i) {
     w[i] = s[2 * i];
     if (s[2 * i + 1].s[3] > 0.0f && s[2 * i].s[3] != 1.0f) ++a.disagree;
   }
@@ -192,20 +160,15 @@ TEST(EnergyDielectric, WhiteGlassAlbedoIsOneFromBothSides) {
           Albedo with = albedo(r, white, true, front, at_angle(theta), seed++);
           Albedo without = albedo(r, white, false, front, at_angle(theta), seed++);
           Albedo tint = albedo(r, tinted, true, front, at_angle(theta), seed++);
-          std::printf("  %s roughness %.1f theta %2.0f: X-albedo %.5f +- %.5f compensated, %.5f not; tinted %.4f\n",
-                      thin    ? "thin sheet"
-                      : front ? "outside   "
-                              : "inside    ",
-                      roughness, theta, with.channel[1].mean, with.channel[1].standard_error, without.channel[1].mean,
-                      tint.channel[0].mean);
+          std::printf("  %-10s roughness %.1f theta %2.0f: X-albedo %.5f +- %.5f compensated, %.5f not; tinted %.4f\n",
+                      side_name(thin, front), roughness, theta, with.channel[1].mean, with.channel[1].standard_error,
+                      without.channel[1].mean, tint.channel[0].mean);
           EXPECT_EQ(with.disagree, 0u);
           EXPECT_EQ(tint.disagree, 0u);
           for (int c = 0; c < 3; ++c) {
             const Estimate& e = with.channel[c];
-            EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01) << (thin    ? "thin "
-                                                                        : front ? "outside "
-                                                                                : "inside ")
-                                                                    << roughness << " theta " << theta;
+            EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01)
+                << side_name(thin, front) << " " << roughness << " theta " << theta;
             EXPECT_LE(tint.channel[c].mean, 1.0 + 4.0 * tint.channel[c].standard_error + 0.01);
             EXPECT_LE(without.channel[c].mean, 1.0 + 4.0 * without.channel[c].standard_error);
           }
@@ -214,6 +177,42 @@ TEST(EnergyDielectric, WhiteGlassAlbedoIsOneFromBothSides) {
           }
         }
     }
+}
+
+// The compensated lobe through the harness's sampling checks (check_sampling, with the table
+// bound): rough glass of roughness 0.3, 0.7 and 1, solid and thin-walled, seen from outside
+// (50 degrees) and from inside (30 degrees; and 65, beyond the critical angle, for the
+// solid), 1M samples each. Sampled directions, the compensation lobe's cosine samples on
+// the side its reflection share picks included, follow bsdf_pdf (chi-square over the
+// sphere, cells around the mirror and the refracted or straight-through direction); the
+// pdf integrates to at most 1 and to the fraction of samples returned; every sample's f and
+// pdf are bsdf_eval's and bsdf_pdf's and its weight is bsdf_eval |cos| / bsdf_pdf; the
+// eta^2-weighted albedo stays at most 1 + 4 SE, but for the rows noted below (the test is
+// then marked skipped with the note, as the harness does with known kernel bugs)
+TEST(EnergyDielectric, CompensatedRoughGlassSamplesItsPdf) {
+  DielectricRig& r = dielectric_rig();
+  const std::string excess =
+      "the compensated lobe returns slightly more than 1 from inside rough glass of roughness 0.3 "
+      "(eta^2-weighted albedo 1.0029 +- 0.0001 at 30 degrees, 1.0014 +- 0.0002 at 65 on PoCL, 1M samples): "
+      "within the dielectric table's lookup error (4.2e-3, TableMatchesConvergedQuadrature) and the 0.01 that "
+      "WhiteGlassAlbedoIsOneFromBothSides allows";
+  KnownBugs bugs;
+  for (bool thin : {false, true})
+    for (double roughness : {0.3, 0.7, 1.0}) {
+      CellSpec cells = roughness < 0.5 ? kNarrow : kGlossy;
+      if (thin) cells.transmission = Focus::Straight;
+      std::string name = std::string(thin ? "thin_" : "") + "glass_r" + std::to_string(roughness).substr(0, 3);
+      MaterialCase mat = gltf_case(name, glass(roughness, thin), cells);
+      if (!thin && roughness == 0.3) mat.bugs = {{"albedo/inside30", excess}, {"albedo/inside65", excess}};
+      for (auto [theta, back] : {std::pair{50.0, false}, {30.0, true}, {65.0, true}}) {
+        if (thin && theta == 65.0) continue;  // a sheet has no critical angle
+        Geometry g = flat(theta, back);
+        g.name = (back ? "inside" : "outside") + std::to_string(int(theta));
+        SCOPED_TRACE(name + " " + g.name);
+        check_sampling("pocl", BsdfRun(r.rig, mat.material, g, r.table.buffer), mat, bugs);
+      }
+    }
+  BSDF_SKIP_KNOWN_BUGS(bugs);
 }
 
 // The eval-based estimator: X(wo, wi) |cos_i| integrated over the sphere with wi uniform
@@ -245,10 +244,7 @@ TEST(EnergyDielectric, EvalIsReciprocalAndConservesEnergy) {
             w[k] = {{float(x[k].s[0] * s), float(x[k].s[1] * s), float(x[k].s[2] * s), 0.0f}};
           }
           Estimate e = sample_mean(w, 1);
-          std::printf("  eval-based X-albedo, %s roughness %.1f theta %2.0f: %.4f +- %.4f\n",
-                      thin    ? "thin   "
-                      : front ? "outside"
-                              : "inside ",
+          std::printf("  eval-based X-albedo, %-10s roughness %.1f theta %2.0f: %.4f +- %.4f\n", side_name(thin, front),
                       roughness, theta, e.mean, e.standard_error);
           EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 0.01);
         }

@@ -14,24 +14,16 @@
 #include <cstring>
 #include <glm/glm.hpp>
 
+#include "bsdf/bsdf_checks.hpp"
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
-#include "support/kernels.hpp"
-#include "support/stats.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr size_t kSamples = 1 << 18;
-size_t samples_on(const std::string& device) { return device == "rusticl" ? kSamples / 4 : kSamples; }
-
-glm::dvec3 direction(double z, double phi) {
-  double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-cl_float4 f4(glm::dvec3 v, double w = 0.0) { return {{float(v.x), float(v.y), float(v.z), float(w)}}; }
+// Samples per configuration on PoCL (samples_on: a quarter on rusticl)
+constexpr size_t kLayerSamples = 1 << 18;
 
 // Texture 0 of the test scene: one texel, a tangent-space normal tilted by kTilt degrees
 // toward +x (the tangent), as RGBA8
@@ -104,98 +96,39 @@ struct LayerScene {
   }
 };
 
-void set_scene(cl::Kernel& k, int* a, const cl::Buffer& mat, const LayerScene& s, cl_uint use_ggx) {
-  k.setArg((*a)++, mat);
-  k.setArg((*a)++, s.textures);
-  k.setArg((*a)++, s.texels);
-  k.setArg((*a)++, s.ggx);
-  k.setArg((*a)++, use_ggx);
-}
-
-// test_layers_sample: 3 float4 per sample
+// test_layers_sample: 3 float4 per sample (test_bsdf_sample_record)
 std::vector<cl_float4> sample(KernelRig& r, const cl::Program& program, const LayerScene& sc, const dev::Material& m,
                               cl_uint use_ggx, glm::dvec3 wo, size_t n, cl_uint seed) {
-  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
-  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, 3 * n * sizeof(cl_float4));
-  cl::Kernel k(program, "test_layers_sample");
-  int a = 0;
-  set_scene(k, &a, mat, sc, use_ggx);
-  k.setArg(a++, f4(wo));
-  k.setArg(a++, seed);
-  k.setArg(a++, out);
-  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> o(3 * n);
-  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, o.size() * sizeof(cl_float4), o.data());
-  return o;
+  return flat_sample(r, program, "test_layers_sample", wo, n, seed, r.input(std::vector<dev::Material>{m}), sc.textures,
+                     sc.texels, sc.ggx, use_ggx);
 }
 
 // test_layers_eval: (f, pdf) per pair
 std::vector<cl_float4> eval(KernelRig& r, const cl::Program& program, const LayerScene& sc, const dev::Material& m,
                             cl_uint use_ggx, const std::vector<cl_float4>& pairs) {
-  size_t n = pairs.size() / 2;
-  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
-  cl::Buffer in(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pairs.size() * sizeof(cl_float4),
-                const_cast<cl_float4*>(pairs.data()));
-  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(program, "test_layers_eval");
-  int a = 0;
-  set_scene(k, &a, mat, sc, use_ggx);
-  k.setArg(a++, in);
-  k.setArg(a++, out);
-  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> o(n);
-  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, o.size() * sizeof(cl_float4), o.data());
-  return o;
+  return flat_eval(r, program, "test_layers_eval", pairs, r.input(std::vector<dev::Material>{m}), sc.textures,
+                   sc.texels, sc.ggx, use_ggx);
 }
 
-// bsdf_sample agrees with bsdf_eval and bsdf_pdf; the pdf integrates to 1 over the sphere less
-// what fails; chi-square of the sampled directions against the pdf in cells of equal solid
-// angle (z uniform in [-1, 1] x phi), each integrated on sub x sub midpoints
-void check_sampling(KernelRig& r, const LayerScene& sc, const dev::Material& m, glm::dvec3 wo, size_t n, bool fast,
-                    double alpha) {
-  const int nz = 32, nphi = 64, sub = fast ? 6 : 12;
-  std::vector<cl_float4> s = sample(r, r.program, sc, m, 1u, wo, n, 11u);
-  std::vector<double> observed(nz * nphi + 1, 0.0);
-  size_t mismatched = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const cl_float4 &a = s[3 * i], &f = s[3 * i + 1], &e = s[3 * i + 2];
-    if (a.s[3] == 0.0f) {
-      observed[nz * nphi] += 1.0;
-      continue;
+// For each case seen from each wo (cosine z, azimuth phi): bsdf_sample agrees with bsdf_eval
+// and bsdf_pdf; the pdf integrates to 1 over the sphere less what fails; chi-square of the
+// sampled directions against the pdf (check_sphere_sampling, each cell integrated on 12 x 12
+// midpoints, 6 x 6 on rusticl), alpha = 1e-3 over all of them with the Sidak correction
+void check_sampling(KernelRig& r, const std::string& device, const std::vector<Layer>& cases,
+                    const std::vector<double>& wo_z, double phi) {
+  LayerScene sc(r, r.program, r.program_cache_file);
+  bool fast = device == "rusticl";
+  double alpha = sidak_alpha(1e-3, int(cases.size() * wo_z.size()));
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (double z : wo_z) {
+      SCOPED_TRACE("case " + std::to_string(c) + ", wo.z " + std::to_string(z));
+      dev::Material m = material(cases[c]);
+      glm::dvec3 wo = sphere_direction(z, phi);
+      check_sphere_sampling(
+          sample(r, r.program, sc, m, 1u, wo, samples_on(device, kLayerSamples), 11u), wo,
+          [&](const std::vector<cl_float4>& pairs) { return eval(r, r.program, sc, m, 1u, pairs); }, fast ? 6 : 12,
+          alpha);
     }
-    ASSERT_EQ(f.s[3], 0.0f) << "no delta lobe here";
-    for (int ch = 0; ch < 3; ++ch)
-      if (std::fabs(f.s[ch] - e.s[ch]) > 1e-3 * std::fabs(e.s[ch]) + 1e-6) ++mismatched;
-    if (std::fabs(a.s[3] - e.s[3]) > 1e-3 * e.s[3]) ++mismatched;
-    int iz = std::clamp(int((a.s[2] + 1.0) * 0.5 * nz), 0, nz - 1);
-    double phi = std::atan2(a.s[1], a.s[0]);
-    if (phi < 0.0) phi += 2.0 * kPi;
-    int ip = std::clamp(int(phi / (2.0 * kPi) * nphi), 0, nphi - 1);
-    observed[iz * nphi + ip] += 1.0;
-  }
-  EXPECT_EQ(mismatched, 0u);
-  std::vector<cl_float4> pairs;
-  for (int iz = 0; iz < nz; ++iz)
-    for (int ip = 0; ip < nphi; ++ip)
-      for (int a = 0; a < sub; ++a)
-        for (int b = 0; b < sub; ++b) {
-          pairs.push_back(f4(wo));
-          pairs.push_back(
-              f4(direction(-1.0 + 2.0 * (iz + (a + 0.5) / sub) / nz, 2.0 * kPi * (ip + (b + 0.5) / sub) / nphi)));
-        }
-  std::vector<cl_float4> ev = eval(r, r.program, sc, m, 1u, pairs);
-  std::vector<double> expected(nz * nphi + 1, 0.0);
-  double d_omega = 4.0 * kPi / (double(nz) * nphi * sub * sub), total = 0.0;
-  for (size_t i = 0; i < ev.size(); ++i) expected[i / (sub * sub)] += ev[i].s[3] * d_omega;
-  for (int i = 0; i < nz * nphi; ++i) total += expected[i];
-  EXPECT_LE(total, 1.0 + 2e-3);
-  EXPECT_NEAR(total, 1.0 - observed[nz * nphi] / n, 5e-3);
-  expected[nz * nphi] = std::max(0.0, 1.0 - total);
-  double sum = 0.0;
-  for (double& x : expected) sum += x;
-  for (double& x : expected) x *= n / sum;
-  ChiSquare cs = chi_square_test(observed, expected);
-  EXPECT_GT(cs.p_value, alpha) << "chi-square " << cs.statistic << " on " << cs.dof << " dof";
 }
 
 // Mean and standard error of the sample weights f |cos| / pdf per channel, split by the side
@@ -307,8 +240,6 @@ TEST_P(ClearcoatNormal, CoatPeakFollowsTheCoatNormalAndTheBaseStays) {
 // coat): chi-square against the pdf, sampled f and pdf equal to bsdf_eval's
 TEST_P(ClearcoatNormal, SamplingMatchesThePdfWithDistinctNormals) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  LayerScene sc(r, r.program, r.program_cache_file);
-  bool fast = std::string(GetParam()) == "rusticl";
   std::vector<Layer> cases(4);
   cases[0].coat = 1.0;
   cases[0].coat_roughness = 0.3;
@@ -323,19 +254,11 @@ TEST_P(ClearcoatNormal, SamplingMatchesThePdfWithDistinctNormals) {
   cases[3] = cases[0];
   cases[3].diffuse_transmission = 0.6;
   cases[3].coat = 0.7;
-  std::vector<double> wo_z = {0.8, 0.35};
-  double alpha = sidak_alpha(1e-3, int(cases.size() * wo_z.size()));
-  for (size_t c = 0; c < cases.size(); ++c)
-    for (double z : wo_z) {
-      SCOPED_TRACE("case " + std::to_string(c) + ", wo.z " + std::to_string(z));
-      check_sampling(r, sc, material(cases[c]), direction(z, 2.8), samples_on(GetParam()), fast, alpha);
-    }
+  check_sampling(r, GetParam(), cases, {0.8, 0.35}, 2.8);
 }
 
 TEST_P(DiffuseTransmission, SamplingMatchesThePdf) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  LayerScene sc(r, r.program, r.program_cache_file);
-  bool fast = std::string(GetParam()) == "rusticl";
   std::vector<Layer> cases(4);
   cases[0].diffuse_transmission = 0.5;
   cases[0].dt_color = glm::dvec3(0.9, 0.5, 0.2);
@@ -349,13 +272,8 @@ TEST_P(DiffuseTransmission, SamplingMatchesThePdf) {
   cases[3].sheen = glm::dvec3(0.8, 0.7, 0.6);
   cases[3].coat = 0.5;
   std::vector<double> wo_z = {0.8, 0.3};
-  if (!fast) wo_z.push_back(0.05);
-  double alpha = sidak_alpha(1e-3, int(cases.size() * wo_z.size()));
-  for (size_t c = 0; c < cases.size(); ++c)
-    for (double z : wo_z) {
-      SCOPED_TRACE("case " + std::to_string(c) + ", wo.z " + std::to_string(z));
-      check_sampling(r, sc, material(cases[c]), direction(z, 0.4), samples_on(GetParam()), fast, alpha);
-    }
+  if (std::string(GetParam()) != "rusticl") wo_z.push_back(0.05);
+  check_sampling(r, GetParam(), cases, wo_z, 0.4);
 }
 
 // White furnace: white base, factor 0.5, colour white, with the specular layer (the GGX
@@ -363,7 +281,7 @@ TEST_P(DiffuseTransmission, SamplingMatchesThePdf) {
 TEST_P(DiffuseTransmission, WhiteFurnaceIntegratesToOne) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
   LayerScene sc(r, r.program, r.program_cache_file);
-  size_t n = samples_on(GetParam());
+  size_t n = samples_on(GetParam(), kLayerSamples);
   for (double specular : {0.0, 1.0})
     for (double rough : {0.2, 0.7})
       for (double z : {0.9, 0.5, 0.15}) {
@@ -373,7 +291,7 @@ TEST_P(DiffuseTransmission, WhiteFurnaceIntegratesToOne) {
         l.diffuse_transmission = 0.5;
         l.specular = specular;
         l.roughness = rough;
-        Split s = split(sample(r, r.program, sc, material(l), 1u, direction(z, 1.0), n, 5u));
+        Split s = split(sample(r, r.program, sc, material(l), 1u, sphere_direction(z, 1.0), n, 5u));
         for (int c = 0; c < 3; ++c) {
           double total = s.reflected[c] + s.transmitted[c], err = s.r_err[c] + s.t_err[c];
           // Without a specular layer every weight is exactly 1; the albedo table's
@@ -388,10 +306,10 @@ TEST_P(DiffuseTransmission, WhiteFurnaceIntegratesToOne) {
 TEST_P(DiffuseTransmission, ReflectionAndTransmissionSplitByTheFactor) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
   LayerScene sc(r, r.program, r.program_cache_file);
-  size_t n = samples_on(GetParam());
+  size_t n = samples_on(GetParam(), kLayerSamples);
   glm::dvec3 color(1.0, 0.5, 0.25);
   for (double z : {0.9, 0.3}) {
-    glm::dvec3 wo = direction(z, 2.0);
+    glm::dvec3 wo = sphere_direction(z, 2.0);
     for (double d : {0.25, 0.5, 0.8}) {
       SCOPED_TRACE("factor " + std::to_string(d) + ", wo.z " + std::to_string(z));
       Layer l;
@@ -427,19 +345,19 @@ TEST_P(DiffuseTransmission, FactorZeroIsTheMaterialWithoutTheFeature) {
   cases[2].roughness = 0.1;
   cases[3].coat = 1.0;
   cases[3].coat_normal = true;
-  size_t n = samples_on(GetParam()) / 8;
+  size_t n = samples_on(GetParam(), kLayerSamples) / 8;
   for (size_t ci = 0; ci < cases.size(); ++ci) {
     dev::Material m = material(cases[ci]);
     for (double z : {0.9, 0.3, 0.01}) {
       SCOPED_TRACE("case " + std::to_string(ci) + ", wo.z " + std::to_string(z));
-      glm::dvec3 wo = direction(z, 0.6);
+      glm::dvec3 wo = sphere_direction(z, 0.6);
       std::vector<cl_float4> a = sample(r, r.program, sc, m, 1u, wo, n, 5u),
                              b = sample(r, plain.program, sp, m, 1u, wo, n, 5u);
       EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(cl_float4)), 0);
       std::vector<cl_float4> pairs;
       for (size_t i = 0; i < n; ++i) {
         pairs.push_back(f4(wo));
-        pairs.push_back(a[3 * i].s[3] > 0.0f ? a[3 * i] : f4(direction(-0.5, 0.1 * double(i))));
+        pairs.push_back(a[3 * i].s[3] > 0.0f ? a[3 * i] : f4(sphere_direction(-0.5, 0.1 * double(i))));
       }
       std::vector<cl_float4> ea = eval(r, r.program, sc, m, 1u, pairs), eb = eval(r, plain.program, sp, m, 1u, pairs);
       EXPECT_EQ(std::memcmp(ea.data(), eb.data(), ea.size() * sizeof(cl_float4)), 0);

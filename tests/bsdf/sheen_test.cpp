@@ -12,20 +12,18 @@
 #include <cstring>
 #include <glm/glm.hpp>
 
+#include "bsdf/bsdf_checks.hpp"
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
 #include "device/sheen_albedo.hpp"
-#include "support/kernels.hpp"
-#include "support/stats.hpp"
 
 namespace candela::test {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-// Samples per configuration: rusticl (llvmpipe) runs a quarter of PoCL's, being about 5x slower
-constexpr size_t kSamples = 1 << 18;
-size_t samples_on(const std::string& device) { return device == "rusticl" ? kSamples / 4 : kSamples; }
+// Samples per configuration on PoCL: rusticl (llvmpipe) runs a quarter of them (samples_on),
+// being about 5x slower
+constexpr size_t kSheenSamples = 1 << 18;
 
 // Host Charlie lobe with colour 1 (Estevez & Kulla 2017; the extension's visibility term)
 double ref_l(double x, double alpha) {
@@ -60,12 +58,6 @@ double ref_albedo(double mu, double r, int n) {
   }
   return sum * 2.0 * kPi / (double(n) * 4 * n);
 }
-
-glm::dvec3 direction(double z, double phi) {
-  double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-cl_float4 f4(glm::dvec3 v, double w = 0.0) { return {{float(v.x), float(v.y), float(v.z), float(w)}}; }
 
 // A glTF material: white base colour unless given, specular 1, ior 1.5, the sheen colour and roughness
 dev::Material material(double metallic, double roughness, glm::dvec3 sheen, double sheen_roughness,
@@ -107,45 +99,18 @@ struct Sampled {
   std::vector<cl_float4> out;  // 3 per sample (test_sheen_sample)
 };
 
+// test_sheen_sample: 3 float4 per sample (test_bsdf_sample_record)
 Sampled sample(KernelRig& r, const cl::Program& program, const Tables& t, const dev::Material& m, cl_uint tables,
                glm::dvec3 wo, size_t n, cl_uint seed) {
-  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
-  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, 3 * n * sizeof(cl_float4));
-  cl::Kernel k(program, "test_sheen_sample");
-  int a = 0;
-  k.setArg(a++, mat);
-  k.setArg(a++, t.ggx);
-  k.setArg(a++, t.sheen);
-  k.setArg(a++, tables);
-  k.setArg(a++, f4(wo));
-  k.setArg(a++, seed);
-  k.setArg(a++, out);
-  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  Sampled s;
-  s.out.resize(3 * n);
-  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, s.out.size() * sizeof(cl_float4), s.out.data());
-  return s;
+  return {flat_sample(r, program, "test_sheen_sample", wo, n, seed, r.input(std::vector<dev::Material>{m}), t.ggx,
+                      t.sheen, tables)};
 }
 
+// test_sheen_eval: (f, pdf) per pair
 std::vector<cl_float4> eval(KernelRig& r, const cl::Program& program, const Tables& t, const dev::Material& m,
                             cl_uint tables, const std::vector<cl_float4>& pairs) {
-  size_t n = pairs.size() / 2;
-  cl::Buffer mat(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof m, const_cast<dev::Material*>(&m));
-  cl::Buffer in(r.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pairs.size() * sizeof(cl_float4),
-                const_cast<cl_float4*>(pairs.data()));
-  cl::Buffer out(r.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-  cl::Kernel k(program, "test_sheen_eval");
-  int a = 0;
-  k.setArg(a++, mat);
-  k.setArg(a++, t.ggx);
-  k.setArg(a++, t.sheen);
-  k.setArg(a++, tables);
-  k.setArg(a++, in);
-  k.setArg(a++, out);
-  r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
-  std::vector<cl_float4> o(n);
-  r.queue.enqueueReadBuffer(out, CL_TRUE, 0, o.size() * sizeof(cl_float4), o.data());
-  return o;
+  return flat_eval(r, program, "test_sheen_eval", pairs, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen,
+                   tables);
 }
 
 class Sheen : public ::testing::TestWithParam<const char*> {};
@@ -158,7 +123,7 @@ TEST_P(Sheen, LobeMatchesTheFormula) {
     for (double zo : {0.95, 0.6, 0.2, 0.02})
       for (double zi : {0.9, 0.5, 0.1, 0.01})
         for (double phi : {0.0, 1.3, 2.9}) {
-          glm::dvec3 wo = direction(zo, 0.0), wi = direction(zi, phi);
+          glm::dvec3 wo = sphere_direction(zo, 0.0), wi = sphere_direction(zi, phi);
           pairs.push_back(f4(wo, ref_alpha(rough)));
           pairs.push_back(f4(wi));
           want.push_back(ref_sheen(ref_alpha(rough), wo, wi));
@@ -235,8 +200,7 @@ TEST_P(Sheen, SamplingMatchesThePdf) {
   // rusticl (llvmpipe) integrates the pdf on a coarser grid and leaves out grazing wo, whose
   // narrow lobes need the fine one
   bool fast = std::string(GetParam()) == "rusticl";
-  const int nz = 32, nphi = 64, sub = fast ? 6 : 16;
-  std::vector<cl_float4> pairs;
+  const int sub = fast ? 6 : 16;
   std::vector<SampledCase> cases = sampled_cases();
   std::vector<double> wo_z = {0.8, 0.3};
   if (!fast) wo_z.push_back(0.05);
@@ -244,51 +208,11 @@ TEST_P(Sheen, SamplingMatchesThePdf) {
   for (const SampledCase& c : cases)
     for (double z : wo_z) {
       SCOPED_TRACE(std::string(c.name) + ", wo.z " + std::to_string(z));
-      glm::dvec3 wo = direction(z, 0.4);
-      size_t n = samples_on(GetParam());
-      Sampled s = sample(r, r.program, t, c.m, 3u, wo, n, 7u);
-      std::vector<double> observed(nz * nphi + 1, 0.0);
-      size_t mismatched = 0;
-      for (size_t i = 0; i < n; ++i) {
-        const cl_float4 &a = s.out[3 * i], &f = s.out[3 * i + 1], &e = s.out[3 * i + 2];
-        if (a.s[3] == 0.0f) {
-          observed[nz * nphi] += 1.0;
-          continue;
-        }
-        ASSERT_EQ(f.s[3], 0.0f) << "no delta lobe here";
-        for (int ch = 0; ch < 3; ++ch)
-          if (std::fabs(f.s[ch] - e.s[ch]) > 1e-3 * std::fabs(e.s[ch]) + 1e-6) ++mismatched;
-        if (std::fabs(a.s[3] - e.s[3]) > 1e-3 * e.s[3]) ++mismatched;
-        int iz = std::clamp(int((a.s[2] + 1.0) * 0.5 * nz), 0, nz - 1);
-        double phi = std::atan2(a.s[1], a.s[0]);
-        if (phi < 0.0) phi += 2.0 * kPi;
-        int ip = std::clamp(int(phi / (2.0 * kPi) * nphi), 0, nphi - 1);
-        observed[iz * nphi + ip] += 1.0;
-      }
-      EXPECT_EQ(mismatched, 0u);
-      // Cells equal in solid angle: z uniform in [-1, 1], phi uniform; sub x sub midpoints each
-      pairs.clear();
-      for (int iz = 0; iz < nz; ++iz)
-        for (int ip = 0; ip < nphi; ++ip)
-          for (int a = 0; a < sub; ++a)
-            for (int b = 0; b < sub; ++b) {
-              pairs.push_back(f4(wo));
-              pairs.push_back(
-                  f4(direction(-1.0 + 2.0 * (iz + (a + 0.5) / sub) / nz, 2.0 * kPi * (ip + (b + 0.5) / sub) / nphi)));
-            }
-      std::vector<cl_float4> ev = eval(r, r.program, t, c.m, 3u, pairs);
-      std::vector<double> expected(nz * nphi + 1, 0.0);
-      double d_omega = 4.0 * kPi / (double(nz) * nphi * sub * sub), total = 0.0;
-      for (size_t i = 0; i < ev.size(); ++i) expected[i / (sub * sub)] += ev[i].s[3] * d_omega;
-      for (int i = 0; i < nz * nphi; ++i) total += expected[i];
-      EXPECT_LE(total, 1.0 + 2e-3);
-      EXPECT_NEAR(total, 1.0 - observed[nz * nphi] / n, 5e-3);
-      expected[nz * nphi] = std::max(0.0, 1.0 - total);
-      double sum = 0.0;
-      for (double& x : expected) sum += x;
-      for (double& x : expected) x *= n / sum;
-      ChiSquare cs = chi_square_test(observed, expected);
-      EXPECT_GT(cs.p_value, alpha) << "chi-square " << cs.statistic << " on " << cs.dof << " dof";
+      glm::dvec3 wo = sphere_direction(z, 0.4);
+      size_t n = samples_on(GetParam(), kSheenSamples);
+      check_sphere_sampling(
+          sample(r, r.program, t, c.m, 3u, wo, n, 7u).out, wo,
+          [&](const std::vector<cl_float4>& pairs) { return eval(r, r.program, t, c.m, 3u, pairs); }, sub, alpha);
     }
 }
 
@@ -324,10 +248,10 @@ Albedo albedo(const Sampled& s) {
 TEST_P(Sheen, WhiteFurnaceStaysAtMostOne) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
   Tables t(r, r.program, r.program_cache_file);
-  size_t n = samples_on(GetParam()) / 4;
+  size_t n = samples_on(GetParam(), kSheenSamples) / 4;
   for (double sr : {0.0, 0.3, 0.7, 1.0})
     for (double z : {0.9, 0.4, 0.1, 0.02}) {
-      glm::dvec3 wo = direction(z, 1.0);
+      glm::dvec3 wo = sphere_direction(z, 1.0);
       struct {
         const char* name;
         dev::Material m;
@@ -362,18 +286,18 @@ TEST_P(Sheen, ColourZeroIsTheMaterialWithoutTheFeature) {
       material(0.0, 0.0, glm::dvec3(0.0), 0.5),           material(0.0, 0.1, glm::dvec3(0.0), 0.5, 1.0),
       material(0.0, 0.5, glm::dvec3(0.0), 0.5, 0.0, 1.0),
   };
-  size_t n = samples_on(GetParam()) / 8;
+  size_t n = samples_on(GetParam(), kSheenSamples) / 8;
   for (size_t ci = 0; ci < std::size(cases); ++ci) {
     const dev::Material& m = cases[ci];
     for (double z : {0.9, 0.3, 0.01}) {
       SCOPED_TRACE("case " + std::to_string(ci) + ", wo.z " + std::to_string(z));
-      glm::dvec3 wo = direction(z, 0.6);
+      glm::dvec3 wo = sphere_direction(z, 0.6);
       Sampled a = sample(r, r.program, t, m, 3u, wo, n, 5u), b = sample(r, plain.program, tp, m, 3u, wo, n, 5u);
       EXPECT_EQ(std::memcmp(a.out.data(), b.out.data(), a.out.size() * sizeof(cl_float4)), 0);
       std::vector<cl_float4> pairs;
       for (size_t i = 0; i < n; ++i) {
         pairs.push_back(f4(wo));
-        pairs.push_back(a.out[3 * i].s[3] > 0.0f ? a.out[3 * i] : f4(direction(-0.5, 0.1 * double(i))));
+        pairs.push_back(a.out[3 * i].s[3] > 0.0f ? a.out[3 * i] : f4(sphere_direction(-0.5, 0.1 * double(i))));
       }
       std::vector<cl_float4> ea = eval(r, r.program, t, m, 3u, pairs), eb = eval(r, plain.program, tp, m, 3u, pairs);
       EXPECT_EQ(std::memcmp(ea.data(), eb.data(), ea.size() * sizeof(cl_float4)), 0);

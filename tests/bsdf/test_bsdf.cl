@@ -56,16 +56,43 @@ bool test_bsdf_sample_i(const Bsdf* b, float3 wo, uint i, uint seed, BsdfSample*
   return bsdf_sample(b, wo, uc, u, bs);
 }
 
-// Sample i of bsdf_sample with (uc, u.x, u.y) drawn in that order from rng_init(i, 0, seed).
-// out[3i..3i+2]: (wi, pdf), (f, eta), (bsdf_eval, bsdf_pdf) at the sampled wi, all zero
-// when sampling fails; info[i]: (returned, BSDF_DELTA set, BSDF_REFLECTION set, flags valid:
-// within bsdf_flags and exactly one of reflection and transmission), 0 where not returned
-__kernel void test_bsdf_sample(__global const Material* materials, float4 ng, float4 ns, float4 tangent, float4 wo,
-                               uint seed, __global float4* out, __global uint4* info) {
+// bsdf_at of material 0 at the flat point (test_bsdf_flat_hit) of scene sc
+Bsdf test_bsdf_flat_at(const SceneData* sc, bool front, float4 uvs) {
+  SurfaceHit s = test_bsdf_flat_hit(front, uvs);
+  return bsdf_at(sc, &s);
+}
+
+// (bsdf_eval, bsdf_pdf) at (wo, wi), from one bsdf_eval_pdf
+float4 test_bsdf_eval_pdf(const Bsdf* b, float3 wo, float3 wi) {
+  float pdf;
+  float3 f = bsdf_eval_pdf(b, wo, wi, &pdf);
+  return (float4)(f, pdf);
+}
+
+// Sample i of bsdf_sample (test_bsdf_sample_i) into out[3i..3i+2] = (wi, pdf), (f, 1 for a
+// delta sample, else 0), (bsdf_eval, bsdf_pdf) at wi, as the flat-point test kernels write
+// it; all zero, and false, where sampling fails
+bool test_bsdf_sample_record(const Bsdf* b, float3 wo, uint i, uint seed, __global float4* out, BsdfSample* bs) {
+  if (!test_bsdf_sample_i(b, wo, i, seed, bs)) {
+    out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = (float4)(0.0f);
+    return false;
+  }
+  out[3 * i] = (float4)(bs->wi, bs->pdf);
+  out[3 * i + 1] = (float4)(bs->f, (bs->flags & BSDF_DELTA) ? 1.0f : 0.0f);
+  out[3 * i + 2] = test_bsdf_eval_pdf(b, wo, bs->wi);
+  return true;
+}
+
+// Sample i of bsdf_sample of material 0 of sc with (uc, u.x, u.y) drawn in that order from
+// rng_init(i, 0, seed). out[3i..3i+2]: (wi, pdf), (f, eta), (bsdf_eval, bsdf_pdf) at the
+// sampled wi, all zero when sampling fails; info[i]: (returned, BSDF_DELTA set,
+// BSDF_REFLECTION set, flags valid: within bsdf_flags and exactly one of reflection and
+// transmission), 0 where not returned
+void test_bsdf_sample_at(const SceneData* sc, float4 ng, float4 ns, float4 tangent, float4 wo, uint seed,
+                         __global float4* out, __global uint4* info) {
   uint i = get_global_id(0);
-  SceneData sc = test_bsdf_scene(materials);
   SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz, 0u);
-  Bsdf b = bsdf_at(&sc, &s);
+  Bsdf b = bsdf_at(sc, &s);
   BsdfSample bs;
   bool ok = test_bsdf_sample_i(&b, wo.xyz, i, seed, &bs);
   if (!ok) {
@@ -81,17 +108,48 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
   info[i] = (uint4)(1u, (bs.flags & BSDF_DELTA) != 0u ? 1u : 0u, side == BSDF_REFLECTION ? 1u : 0u, valid ? 1u : 0u);
 }
 
-// f and pdf for the pair (wo, wi) = (pairs[2i], pairs[2i+1]) at a hit oriented by that wo;
-// out[i] = (f, pdf), from one bsdf_eval_pdf (test_bsdf_sample covers bsdf_eval and bsdf_pdf)
-__kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns, float4 tangent,
-                             __global const float4* pairs, __global float4* out) {
+// f and pdf of material 0 of sc for the pair (wo, wi) = (pairs[2i], pairs[2i+1]) at a hit
+// oriented by that wo; out[i] = (f, pdf), from one bsdf_eval_pdf (test_bsdf_sample covers
+// bsdf_eval and bsdf_pdf)
+void test_bsdf_eval_at(const SceneData* sc, float4 ng, float4 ns, float4 tangent, __global const float4* pairs,
+                       __global float4* out) {
   uint i = get_global_id(0);
-  SceneData sc = test_bsdf_scene(materials);
   float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
   SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo, 0u);
-  Bsdf b = bsdf_at(&sc, &s);
-  float pdf;
-  out[i] = (float4)(bsdf_eval_pdf(&b, wo, wi, &pdf), pdf);
+  Bsdf b = bsdf_at(sc, &s);
+  out[i] = test_bsdf_eval_pdf(&b, wo, wi);
+}
+
+// test_bsdf_sample_at in a scene of the material table alone (no energy compensation)
+__kernel void test_bsdf_sample(__global const Material* materials, float4 ng, float4 ns, float4 tangent, float4 wo,
+                               uint seed, __global float4* out, __global uint4* info) {
+  SceneData sc = test_bsdf_scene(materials);
+  test_bsdf_sample_at(&sc, ng, ns, tangent, wo, seed, out, info);
+}
+
+// test_bsdf_eval_at in a scene of the material table alone
+__kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns, float4 tangent,
+                             __global const float4* pairs, __global float4* out) {
+  SceneData sc = test_bsdf_scene(materials);
+  test_bsdf_eval_at(&sc, ng, ns, tangent, pairs, out);
+}
+
+// test_bsdf_sample_at with the GGX albedo table bound (cl/bsdf/energy.cl,
+// energy_dielectric.cl: the lobes' energy compensation on)
+__kernel void test_bsdf_sample_ggx(__global const Material* materials, __global const float* ggx_albedo, float4 ng,
+                                   float4 ns, float4 tangent, float4 wo, uint seed, __global float4* out,
+                                   __global uint4* info) {
+  SceneData sc = test_bsdf_scene(materials);
+  sc.ggx_albedo = ggx_albedo;
+  test_bsdf_sample_at(&sc, ng, ns, tangent, wo, seed, out, info);
+}
+
+// test_bsdf_eval_at with the GGX albedo table bound
+__kernel void test_bsdf_eval_ggx(__global const Material* materials, __global const float* ggx_albedo, float4 ng,
+                                 float4 ns, float4 tangent, __global const float4* pairs, __global float4* out) {
+  SceneData sc = test_bsdf_scene(materials);
+  sc.ggx_albedo = ggx_albedo;
+  test_bsdf_eval_at(&sc, ng, ns, tangent, pairs, out);
 }
 
 // Albedo samples: work-item i estimates configuration c = i / per_config, material

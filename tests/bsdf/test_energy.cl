@@ -42,16 +42,12 @@ __kernel void test_energy_albedo_mc(float mu, float roughness, uint fresnel5, ui
   out[i] = sums;
 }
 
-#define TEST_ENERGY_NO_BUFFER(type, name) 0,
-
 // Material 0 at a point of normal +z and tangent +x seen from wo (above), with the table
 // if asked: a scene of the material table alone
 Bsdf test_energy_bsdf(__global const Material* materials, __global const float* table, uint with_table, float3 wo) {
-  SceneData sc = {CD_SCENE_BUFFERS(TEST_ENERGY_NO_BUFFER) 0};
-  sc.materials = materials;
+  SceneData sc = test_bsdf_scene(materials);
   if (with_table) sc.ggx_albedo = table;
-  SurfaceHit s = test_bsdf_flat_hit(true, (float4)(0.0f));
-  return bsdf_at(&sc, &s);
+  return test_bsdf_flat_at(&sc, true, (float4)(0.0f));
 }
 
 // Sample i of bsdf_sample from wo, (uc, u.x, u.y) from rng_init(i, 0, seed): out[3i..3i+2] =
@@ -62,16 +58,9 @@ __kernel void test_energy_sample(__global const Material* materials, __global co
   uint i = get_global_id(0);
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo.xyz);
   BsdfSample bs;
-  if (!test_bsdf_sample_i(&b, wo.xyz, i, seed, &bs)) {
-    out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = (float4)(0.0f);
-    return;
-  }
-  float pdf;
-  float3 f = bsdf_eval_pdf(&b, wo.xyz, bs.wi, &pdf);
-  out[3 * i] = (float4)(bs.wi, bs.pdf);
+  if (!test_bsdf_sample_record(&b, wo.xyz, i, seed, out, &bs)) return;
   bool valid = (bs.flags & ~bsdf_flags(&b)) == 0u && (bs.flags & BSDF_REFLECTION) && !(bs.flags & BSDF_DELTA);
-  out[3 * i + 1] = (float4)(bs.f, valid ? 1.0f : 0.0f);
-  out[3 * i + 2] = (float4)(f, pdf);
+  out[3 * i + 1].w = valid ? 1.0f : 0.0f;
 }
 
 // The weight f |cos| / pdf of sample i of bsdf_sample from wo (0 where sampling fails)
@@ -90,7 +79,5 @@ __kernel void test_energy_eval(__global const Material* materials, __global cons
   uint i = get_global_id(0);
   float3 wo = pairs[2 * i].xyz, wi = pairs[2 * i + 1].xyz;
   Bsdf b = test_energy_bsdf(materials, table, with_table, wo);
-  float pdf;
-  float3 f = bsdf_eval_pdf(&b, wo, wi, &pdf);
-  out[i] = (float4)(f, pdf);
+  out[i] = test_bsdf_eval_pdf(&b, wo, wi);
 }

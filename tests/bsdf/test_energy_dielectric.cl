@@ -18,16 +18,12 @@ __kernel void test_energy_dielectric_quadrature(__global const float4* queries, 
   out[i] = energy_dielectric_quadrature(ggx_from_roughness(q.y, 0.0f), q.z, q.x, n);
 }
 
-#define TEST_ENERGY_DIELECTRIC_NO_BUFFER(type, name) 0,
-
 // Material 0 at a point of normal +z and tangent +x, hit from its front (entering) or back
 Bsdf test_energy_dielectric_bsdf(__global const Material* materials, __global const float* table, uint with_table,
                                  uint front) {
-  SceneData sc = {CD_SCENE_BUFFERS(TEST_ENERGY_DIELECTRIC_NO_BUFFER) 0};
-  sc.materials = materials;
+  SceneData sc = test_bsdf_scene(materials);
   if (with_table) sc.ggx_albedo = table;
-  SurfaceHit s = test_bsdf_flat_hit(front != 0u, (float4)(0.0f));
-  return bsdf_at(&sc, &s);
+  return test_bsdf_flat_at(&sc, front != 0u, (float4)(0.0f));
 }
 
 // Sample i from wo: out[2i] = (X |cos_i| / pdf, 1 if f and pdf are bsdf_eval's and
