@@ -162,9 +162,8 @@ struct Builder {
 
   // Whether lights order[begin, end) make one planar emitter: triangles in one plane, all
   // single-sided facing one way or all double-sided, that cover at least kClusterCover of
-  // their convex hull. Importance
-  // barely tells such lights apart from any point the emitter lights, so the tree picks
-  // among them by power alone (LIGHT_TREE_CLUSTER nodes), without evaluating importance.
+  // their convex hull. Importance barely tells such lights apart from any point the emitter
+  // lights, so the tree picks among them by power alone (LIGHT_TREE_CLUSTER nodes).
   bool planar_emitter(size_t begin, size_t end) const {
     const dev::Light& first = buffers.lights[order[begin]];
     if (first.type != LIGHT_TRIANGLE) return false;
