@@ -224,7 +224,7 @@ RenderSettings check_render_args(const RenderArgs& a) {
   parse_tonemap(a.tonemap);  // a bad name fails before loading
   parse_enum(kDefaultLightNames, "--default-light", a.default_light);
   if (!a.light_units.empty()) parse_enum(kLightUnitNames, "--light-units", a.light_units);
-  if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number of stops");
+  if (a.exposure && !std::isfinite(*a.exposure)) throw Error("--exposure must be a finite number of stops");
   check_camera_options(a);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
@@ -301,7 +301,7 @@ bool write_outputs(const RenderArgs& a, const Film& film, const RenderReport& re
     }
   };
   for (const auto& out : a.outputs)
-    attempt(out, [&] { write_image(out, film, meta, {a.exposure, parse_tonemap(a.tonemap)}); });
+    attempt(out, [&] { write_image(out, film, meta, {a.exposure.value_or(0.0f), parse_tonemap(a.tonemap)}); });
   if (!a.variance.empty()) attempt(a.variance, [&] { write_variance_image(a.variance, film, meta); });
   return ok;
 }
@@ -358,7 +358,11 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   add_sampling_render_options(render, a);
   add_lighting_render_options(render, a);
   render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
-  render->add_option("--exposure", a.exposure, "Exposure of PNG/JPEG outputs in stops (default 0); EXR stays linear")
+  render
+      ->add_option(
+          "--exposure", a.exposure,
+          "Exposure of PNG/JPEG outputs in stops (default 0, or lower for a scene whose own lights are over 4x the "
+          "studio's); EXR stays linear")
       ->check(finite_number());
   render->add_option("--tonemap", a.tonemap,
                      "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true));

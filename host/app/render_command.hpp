@@ -28,7 +28,7 @@ struct RenderArgs {
   std::string light_units;             // --light-units photometric|radiometric; empty: the scene's
   std::string variant;                 // --variant NAME: a KHR_materials_variants variant; empty: the default
   std::string stats;
-  float exposure = 0.0f;
+  std::optional<float> exposure;  // --exposure EV; unset: 0, or the automatic exposure (render_scene.cpp)
   std::string tonemap = "neutral";
   std::optional<int> camera;  // --camera N: the scene's camera N (default its first)
   std::string look_from, look_at, up;

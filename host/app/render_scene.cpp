@@ -116,8 +116,9 @@ void apply_background_options(const RenderArgs& a, Scene* scene) {
   }
 }
 
-// The built-in studio, by --default-light's rule (scene/default_light.hpp), said in one line
-void add_default_light(const RenderArgs& a, Scene* scene) {
+// The built-in studio, by --default-light's rule (scene/default_light.hpp), said in one line;
+// the choice, with the share of light the scene's own lights give
+DefaultLightChoice add_default_light(const RenderArgs& a, Scene* scene) {
   DefaultLight mode = parse_enum(kDefaultLightNames, "--default-light", a.default_light);
   bool given = scene->lighting_given || scene->environment.has_value();
   EnvironmentDesc studio = builtin_environment();
@@ -133,6 +134,18 @@ void add_default_light(const RenderArgs& a, Scene* scene) {
     std::fprintf(stderr, "note: the scene's own lights light it: %s (--default-light on adds the built-in studio)\n",
                  c.reason.c_str());
   }
+  return c;
+}
+
+// Without --exposure, the automatic exposure (scene/default_light.hpp), said in one line
+void choose_exposure(const DefaultLightChoice& c, RenderArgs* a) {
+  if (a->exposure) return;
+  a->exposure = automatic_exposure(c);
+  if (a->exposure)
+    std::fprintf(stderr,
+                 "note: exposing PNG/JPEG outputs at %.1f stops: the scene's own lights give %.3g times the studio's "
+                 "light on its surfaces (--exposure 0 keeps them as they are; EXR stays linear)\n",
+                 double(*a->exposure), c.own_share);
 }
 
 // --env-strength, --env-rotation
@@ -176,7 +189,7 @@ Scene load_render_scene(RenderArgs* args) {
   apply_background_options(a, &scene);
   apply_camera_options(a, &scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  add_default_light(a, &scene);
+  choose_exposure(add_default_light(a, &scene), &a);
   apply_environment_options(a, &scene);
   warn_unreachable_lights(a, scene);
   if (!scene.camera)

@@ -195,4 +195,9 @@ DefaultLightChoice choose_default_light(const Scene& scene, DefaultLight mode, b
   return c;
 }
 
+std::optional<float> automatic_exposure(const DefaultLightChoice& c) {
+  if (c.use_environment || !(c.own_share > kAutoExposureShare) || !std::isfinite(c.own_share)) return std::nullopt;
+  return float(std::round(-10.0 * std::log2(c.own_share)) / 10.0);
+}
+
 }  // namespace candela

@@ -3,6 +3,7 @@
 // visors) are not meant to light them.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "base/enum_names.hpp"
@@ -44,6 +45,15 @@ OwnLight own_light_share(const Scene& scene, double environment_radiance);
 // Below this share the scene's own lights are decorative and the environment lights it
 // (docs/lights.md, Default lighting, has the measurements behind it)
 constexpr double kOwnLightShareThreshold = 0.10;
+
+// The automatic exposure of PNG/JPEG outputs (render without --exposure): a scene lit by
+// its own lights far brighter than the studio (a sun given in lux, read photometrically) is
+// exposed as if its surfaces had the studio's light: -log2(own_share) stops, to 0.1 stop,
+// when its own lights give over kAutoExposureShare times the studio's light (two stops
+// over); nullopt (exposure 0) otherwise, and whenever the studio or the scene's own
+// environment lights it.
+constexpr double kAutoExposureShare = 4.0;
+std::optional<float> automatic_exposure(const DefaultLightChoice& c);
 
 // The rule of --default-light (docs/lights.md): a scene that sets its own environment or
 // background (scene extras, --env, --background) keeps it; otherwise Off keeps it as it is,

@@ -152,6 +152,30 @@ else
   fail "--no-default-light keeps it black"; cat "$tmp/err"
 fi
 
+# Automatic exposure: the Cornell box without its background, its light 1000 times brighter,
+# is exposed down for PNG (announced) and is no white frame (8-bit means); --exposure 0 keeps it
+# as it is
+python3 - "$scene" "$tmp/bright.gltf" <<'PY'
+import json, sys
+doc = json.load(open(sys.argv[1]))
+for m in doc["materials"]:
+    ext = m.get("extensions", {}).get("KHR_materials_emissive_strength")
+    if ext: ext["emissiveStrength"] *= 1000.0
+doc["scenes"][0].pop("extras", None)
+json.dump(doc, open(sys.argv[2], "w"))
+PY
+if "$bin" render "$tmp/bright.gltf" -o "$tmp/auto.png" --spp 4 --width 24 --height 24 --device pocl -q >/dev/null 2>"$tmp/err" &&
+  grep -q "note: exposing PNG/JPEG outputs at -[0-9.]* stops" "$tmp/err" &&
+  "$bin" render "$tmp/bright.gltf" -o "$tmp/plain.png" --spp 4 --width 24 --height 24 --device pocl -q --exposure 0 \
+    >/dev/null 2>"$tmp/err2" && ! grep -q "exposing" "$tmp/err2" &&
+  { ! command -v oiiotool >/dev/null ||
+    python3 -c "import sys; a, p = float(sys.argv[1]), float(sys.argv[2]); assert 20 < a < 210 and p > 230, (a, p)" \
+      "$(mean_of "$tmp/auto.png")" "$(mean_of "$tmp/plain.png")"; }; then
+  pass "a scene lit far brighter than the studio is exposed down"
+else
+  fail "a scene lit far brighter than the studio is exposed down"; cat "$tmp/err"; mean_of "$tmp/auto.png"; mean_of "$tmp/plain.png"
+fi
+
 # --device rusticl finds Mesa's CPU device without RUSTICL_ENABLE in the environment
 if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
   if env -u RUSTICL_ENABLE "$bin" render "$scene" -o "$tmp/r.png" --spp 1 --width 16 --height 16 \

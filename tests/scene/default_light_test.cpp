@@ -105,6 +105,30 @@ TEST(DefaultLight, ModesAndGivenLighting) {
   EXPECT_TRUE(choose_default_light(lit, DefaultLight::On, false, 0.5).use_environment);
 }
 
+TEST(DefaultLight, AutomaticExposureBringsBrightOwnLightsToTheStudiosLevel) {
+  // The share grows with the emitter's radiance, one to one (no occlusion in it): 64 times
+  // the radiance is 6 stops darker, and the exposure is -log2(share) to 0.1 stop
+  double base = choose_default_light(floor_under_light(100.0f, 0.1f), DefaultLight::Auto, false, 1.0).own_share;
+  ASSERT_GT(base, 0.05);
+  ASSERT_LT(base, 0.3);
+  EXPECT_FALSE(
+      automatic_exposure(choose_default_light(floor_under_light(100.0f, 0.1f), DefaultLight::Auto, false, 1.0)));
+  for (float k : {64.0f, 256.0f, 4096.0f}) {
+    DefaultLightChoice c = choose_default_light(floor_under_light(100.0f * k, 0.1f), DefaultLight::Auto, false, 1.0);
+    EXPECT_NEAR(c.own_share, base * k, 1e-6 * base * k);
+    std::optional<float> ev = automatic_exposure(c);
+    ASSERT_TRUE(ev) << "share " << c.own_share;
+    EXPECT_NEAR(*ev, -std::log2(base * k), 0.05 + 1e-6);
+  }
+  // Not above 4 times the studio (two stops over): the exposure stays 0
+  float at_four = float(100.0 * 3.9 / base);
+  EXPECT_FALSE(
+      automatic_exposure(choose_default_light(floor_under_light(at_four, 0.1f), DefaultLight::Auto, false, 1.0)));
+  // Nor when the scene's own environment, or the studio, lights it
+  EXPECT_FALSE(automatic_exposure(choose_default_light(floor_under_light(1e6f, 0.1f), DefaultLight::Auto, true, 1.0)));
+  EXPECT_FALSE(automatic_exposure(choose_default_light(floor_under_light(1e6f, 0.1f), DefaultLight::On, false, 1.0)));
+}
+
 // Where the eight corners of b project in the camera's image (x right, y up, in units of
 // the half-extent of the view: inside the frame is |x|, |y| <= 1)
 std::vector<glm::vec2> projected_corners(const CameraDesc& cam, const Bounds& b, float aspect) {
