@@ -19,9 +19,8 @@ float dispersion_ior(float ior, float dispersion, float lambda) {
   return fmax(ior + (ior - 1.0f) * (dispersion / 20.0f) * (523655.0f / (lambda * lambda) - 1.5168f), 1.0f);
 }
 
-// The material disperses: a glTF material refracting through a volume with dispersion > 0
-// (the host leaves GltfMaterial.dispersion 0 on every other material)
-bool dispersion_material(__global const Material* m) {
-  return m->type == MATERIAL_GLTF && m->params.gltf.dispersion > 0.0f;
-}
+// The material disperses: a glTF material refracting through a volume with dispersion > 0.
+// The host leaves GltfMaterial.dispersion 0 on every other material, and the bytes of the
+// parameter union there 0 for the other types (compile_materials zero-fills the record)
+bool dispersion_material(__global const Material* m) { return m->params.gltf.dispersion > 0.0f; }
 #endif
