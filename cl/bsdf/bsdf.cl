@@ -22,8 +22,9 @@ Frame bsdf_shading_frame(const SceneData* sc, __global const Material* m, const 
   return f;
 }
 
-// The BSDF at a shading point: what every type has, then the type's params
-Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
+// The BSDF at a shading point: what every type has, then the type's params. `channel`
+// (CD_FEATURE_DISPERSION): the RGB channel a dispersive material takes its ior at, -1 none
+Bsdf bsdf_at_channel(const SceneData* sc, const SurfaceHit* s, int channel) {
   __global const Material* m = &sc->materials[s->material];
   const uint type = m->type;
   Bsdf b;
@@ -33,12 +34,17 @@ Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) {
   b.type = type;
   b.base_color = load3(m->base_color) * bsdf_texture(sc, m, TEX_BASE_COLOR, s).xyz * s->vertex_color;
   b.ggx_albedo = sc->ggx_albedo;
+#if CD_FEATURE_DISPERSION
+  b.channel = channel;
+#endif
 #define BSDF_PARAMS(id, name, feature) \
   if (feature && type == id) bsdf_##name##_params(sc, m, s, &b);
   CD_MATERIALS(BSDF_PARAMS)
 #undef BSDF_PARAMS
   return b;
 }
+
+Bsdf bsdf_at(const SceneData* sc, const SurfaceHit* s) { return bsdf_at_channel(sc, s, -1); }
 
 // The kinds of lobe this BSDF has (BSDF_* flags); light sampling and the integrator ask
 uint bsdf_flags(const Bsdf* b) {

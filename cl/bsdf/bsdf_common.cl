@@ -56,6 +56,9 @@ typedef struct {
   uint type;                         // MATERIAL_*
   float3 base_color;                 // diffuse albedo, metal F0, transmission tint
   __global const float* ggx_albedo;  // GGX albedo table (energy.cl); 0: no energy compensation
+#if CD_FEATURE_DISPERSION
+  int channel;  // the RGB channel whose wavelength a dispersive material refracts (dispersion.cl); -1: none
+#endif
   union {
     GltfBsdf gltf;
     ConductorBsdf conductor;

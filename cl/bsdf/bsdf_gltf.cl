@@ -95,12 +95,17 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   lobe->transmission = g->transmission * bsdf_texture(sc, m, TEX_TRANSMISSION, s).x;
   lobe->thin = (m->flags & MATERIAL_THIN_WALLED) != 0u;
   float spec = g->specular_color[3] * bsdf_texture(sc, m, TEX_SPECULAR, s).w;
-  float r = (g->ior - 1.0f) / (g->ior + 1.0f);
+  float ior = g->ior;
+#if CD_FEATURE_DISPERSION
+  if (b->channel >= 0 && g->dispersion > 0.0f)
+    ior = dispersion_ior(ior, g->dispersion, dispersion_wavelength(b->channel));
+#endif
+  float r = (ior - 1.0f) / (ior + 1.0f);
   float3 tint = load3(g->specular_color) * bsdf_texture(sc, m, TEX_SPECULAR_COLOR, s).xyz;
   lobe->spec_f0 = fmin(r * r * tint, (float3)(1.0f)) * spec;
   lobe->spec_f90 = spec;
   // A thin sheet has air on both sides: light meets air -> glass from either face
-  lobe->eta = b->entering || lobe->thin ? g->ior : 1.0f / g->ior;
+  lobe->eta = b->entering || lobe->thin ? ior : 1.0f / ior;
   lobe->coat = g->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
   float coat_rough = g->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
   lobe->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);

@@ -41,6 +41,9 @@ typedef struct {
   float eta_scale;          // product of eta^2 over transmissions, so roulette sees radiance scale
   int medium;               // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
   MediumStack media;        // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+#if CD_FEATURE_DISPERSION
+  int channel;  // the one RGB channel it carries since its first dispersive surface (dispersion.cl); -1: all
+#endif
 } PathState;
 
 PathState path_start(const SceneData* sc, Ray ray) {
@@ -53,6 +56,9 @@ PathState path_start(const SceneData* sc, Ray ray) {
   ps.decide = false;
   ps.eta_scale = 1.0f;
   ps.medium = NO_MEDIUM;
+#if CD_FEATURE_DISPERSION
+  ps.channel = -1;
+#endif
 #if CD_FEATURE_MEDIA
   ps.media = media_at_origin(sc, ray);
   ps.medium = media_current(&ps.media);
@@ -276,7 +282,17 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
     if (ps.depth >= params->max_depth) break;
 
     float3 wo = -ps.ray.dir;
+#if CD_FEATURE_DISPERSION
+    // The first dispersive surface picks the channel the path carries from here: uniformly,
+    // its throughput x 3 x the channel's one-hot
+    if (ps.channel < 0 && dispersion_material(&sc->materials[s.material])) {
+      ps.channel = min((int)(rng_next(rng) * 3.0f), 2);
+      ps.beta *= (float3)(ps.channel == 0 ? 3.0f : 0.0f, ps.channel == 1 ? 3.0f : 0.0f, ps.channel == 2 ? 3.0f : 0.0f);
+    }
+    Bsdf bsdf = bsdf_at_channel(sc, &s, ps.channel);
+#else
     Bsdf bsdf = bsdf_at(sc, &s);
+#endif
     bsdf_face_wo(&bsdf, wo);  // no black fringes where shading normals tilt away from wo
     uint flags = bsdf_flags(&bsdf);
     // Light sampling, except at lobes that are all delta (no light sample can find them);

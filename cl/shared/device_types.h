@@ -28,6 +28,7 @@
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
   X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
   X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
+  X(dispersion, CD_FEATURE_DISPERSION, 1, "a refracting glTF material with dispersion > 0")         \
   X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")        \
@@ -223,7 +224,8 @@ typedef struct {
   float sheen[4];                 // KHR_materials_sheen: rgb colour factor, w = sheen roughness factor
   float diffuse_transmission[4];  // KHR_materials_diffuse_transmission: rgb colour factor, w = factor
   float clearcoat_normal_scale;   // KHR_materials_clearcoat clearcoatNormalTexture.scale
-  unsigned int pad[3];
+  float dispersion;               // KHR_materials_dispersion: 20 / Abbe number (0: none)
+  unsigned int pad[2];
 } GltfMaterial;
 
 // Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
@@ -472,7 +474,8 @@ typedef struct {
   SIZE(GltfMaterial, 96) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
     FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
     FIELD(GltfMaterial, sheen, 48) FIELD(GltfMaterial, diffuse_transmission, 64)                              \
-    FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, pad, 84)                              \
+    FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, dispersion, 84)                       \
+    FIELD(GltfMaterial, pad, 88)                                                                              \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
   SIZE(MaterialParams, 96)                                                                                    \

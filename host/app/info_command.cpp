@@ -105,10 +105,12 @@ void print_materials(const Scene& s) {
     std::string textures;
     for (int k = 0; k < TEX_SLOTS; ++k)
       if (m.texture(k).index != NO_TEXTURE) textures += std::string(textures.empty() ? "" : ", ") + kSlots[k];
-    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
+    char dispersion[48] = "";
+    if (m.has_dispersion()) std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
+    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
                 m.type == MATERIAL_CONDUCTOR ? "measured conductor" : "glTF metallic-roughness", m.metallic,
                 m.roughness, m.transmission > 0.0f ? ", transmissive" : "", m.clearcoat > 0.0f ? ", clearcoat" : "",
-                m.diffuse_transmission > 0.0f ? ", diffuse transmission" : "",
+                m.diffuse_transmission > 0.0f ? ", diffuse transmission" : "", dispersion,
                 textures.empty() ? "" : ("; textures: " + textures).c_str());
   }
 }

@@ -89,6 +89,7 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = m.diffuse_transmission_color[c];
   g.diffuse_transmission[3] = m.diffuse_transmission;
   g.clearcoat_normal_scale = m.clearcoat_normal_scale;
+  g.dispersion = m.has_dispersion() ? m.dispersion : 0.0f;  // only a refracting volume disperses
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {

@@ -122,6 +122,11 @@ void read_sheen(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m)
   set_texture_slot(ctx, m, TEX_SHEEN_ROUGHNESS, sh, "sheenRoughnessTexture", false);
 }
 
+// KHR_materials_dispersion: 20 / Abbe number, acting on the volume's refraction
+void read_dispersion(const tinygltf::Material& gm, MaterialDesc* m) {
+  m->dispersion = float(number_or(extension(gm, "KHR_materials_dispersion"), "dispersion", -1, 0.0));
+}
+
 // KHR_materials_diffuse_transmission: the factor (texture A) and the colour (sRGB texture RGB)
 void read_diffuse_transmission(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
   const tinygltf::Value& dt = extension(gm, "KHR_materials_diffuse_transmission");
@@ -212,6 +217,7 @@ void check_ranges(const std::string& name, MaterialDesc* m) {
   in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
   in(m->diffuse_transmission, 0.0f, 1.0f, "diffuseTransmissionFactor");
   in(m->ior, 0.0f, 10.0f, "ior");
+  in(m->dispersion, 0.0f, 1e6f, "dispersion");
   for (int c = 0; c < 3; ++c) {
     in(m->specular_color[c], 0.0f, 1e6f, "specularColorFactor");
     in(m->sheen_color[c], 0.0f, 1.0f, "sheenColorFactor");
@@ -252,6 +258,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_anisotropy(ctx, gm, &m);
   read_sheen(ctx, gm, &m);
   read_diffuse_transmission(ctx, gm, &m);
+  read_dispersion(gm, &m);
   read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);

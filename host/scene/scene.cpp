@@ -21,6 +21,10 @@ bool MaterialDesc::has_diffuse_transmission() const {
   return kernel_type() == MATERIAL_GLTF && diffuse_transmission > 0.0f;
 }
 
+bool MaterialDesc::has_dispersion() const {
+  return kernel_type() == MATERIAL_GLTF && dispersion > 0.0f && transmission > 0.0f && !thin_walled;
+}
+
 bool MaterialDesc::alpha_tested() const {
   bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
   if (alpha_mode == AlphaMode::Mask) return textured || base_color.a < alpha_cutoff;
@@ -85,6 +89,7 @@ SceneFeatures Scene::features() const {
     f.media |= materials.at(m.material).medium >= 0;
     f.sheen |= materials.at(m.material).has_sheen();
     f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
+    f.dispersion |= materials.at(m.material).has_dispersion();
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

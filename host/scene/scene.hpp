@@ -77,7 +77,8 @@ struct MaterialDesc {
   float sheen_roughness = 0.0f;
   float diffuse_transmission = 0.0f;  // KHR_materials_diffuse_transmission
   glm::vec3 diffuse_transmission_color{1.0f};
-  bool unlit = false;  // KHR_materials_unlit: shows base colour x vertex colour, no lighting
+  float dispersion = 0.0f;  // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
+  bool unlit = false;       // KHR_materials_unlit: shows base colour x vertex colour, no lighting
   float normal_scale = 1.0f;
   glm::vec3 conductor_eta{0.0f}, conductor_k{0.0f};  // MATERIAL_CONDUCTOR
   bool double_sided = false;
@@ -101,6 +102,8 @@ struct MaterialDesc {
   bool has_sheen() const;
   // A glTF-shaded material with a diffuse transmission (KHR_materials_diffuse_transmission)
   bool has_diffuse_transmission() const;
+  // A glTF-shaded refracting solid (transmission through a volume) with dispersion > 0
+  bool has_dispersion() const;
 };
 
 struct TextureDesc {
