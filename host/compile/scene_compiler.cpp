@@ -89,6 +89,10 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = m.diffuse_transmission_color[c];
   g.diffuse_transmission[3] = m.diffuse_transmission;
   g.clearcoat_normal_scale = m.clearcoat_normal_scale;
+  g.iridescence[0] = m.iridescence;
+  g.iridescence[1] = m.iridescence_ior;
+  g.iridescence[2] = m.iridescence_thickness_min;
+  g.iridescence[3] = m.iridescence_thickness_max;
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {

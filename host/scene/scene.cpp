@@ -21,6 +21,8 @@ bool MaterialDesc::has_diffuse_transmission() const {
   return kernel_type() == MATERIAL_GLTF && diffuse_transmission > 0.0f;
 }
 
+bool MaterialDesc::has_iridescence() const { return kernel_type() == MATERIAL_GLTF && iridescence > 0.0f; }
+
 bool MaterialDesc::alpha_tested() const {
   bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
   if (alpha_mode == AlphaMode::Mask) return textured || base_color.a < alpha_cutoff;
@@ -85,6 +87,7 @@ SceneFeatures Scene::features() const {
     f.media |= materials.at(m.material).medium >= 0;
     f.sheen |= materials.at(m.material).has_sheen();
     f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
+    f.iridescence |= materials.at(m.material).has_iridescence();
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

@@ -28,7 +28,7 @@ std::optional<DeviceEntry> device_by_name(const std::string& name) {
 KernelRig::KernelRig(const DeviceEntry& d) : device(d) {
   context = cl::Context(device.device);
   queue = cl::CommandQueue(context, device.device);
-  ProgramBuild build = build_program(context, device, test_program_source(), "-cl-std=CL1.2");
+  ProgramBuild build = build_program(context, device, test_program_source(), kTestProgramOptions);
   program = build.program;
   program_cache_file = build.cache_file;
 }
