@@ -130,7 +130,8 @@ std::vector<Rgb> device_film(KernelRig& r, const std::vector<FilmQuery>& qs) {
   }
   auto out = r.output<cl_float4>(qs.size());
   cl::Kernel k(iridescence_program(r).program, "test_iridescence_fresnel");
-  bind_args(k, 0, r.input(q), r.input(f0), out);
+  cl::Buffer qb = r.input(q), fb = r.input(f0);  // alive until the kernel is enqueued (which retains them)
+  bind_args(k, 0, qb, fb, out);
   r.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(qs.size()));
   std::vector<Rgb> v;
   for (const cl_float4& o : out.read()) v.push_back({o.s[0], o.s[1], o.s[2]});
@@ -182,8 +183,8 @@ std::vector<cl_float4> sample(KernelRig& r, const cl::Program& p, const Tables& 
   return flat_sample(r, p, "test_sheen_sample", wo, n, seed, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen,
                      tables);
 }
-std::vector<cl_float4> eval(KernelRig& r, const cl::Program& p, const Tables& t, const dev::Material& m,
-                            cl_uint tables, const std::vector<cl_float4>& pairs) {
+std::vector<cl_float4> eval(KernelRig& r, const cl::Program& p, const Tables& t, const dev::Material& m, cl_uint tables,
+                            const std::vector<cl_float4>& pairs) {
   return flat_eval(r, p, "test_sheen_eval", pairs, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen, tables);
 }
 
@@ -192,7 +193,7 @@ const Rgb kGold{0.944, 0.776, 0.373}, kGrey{0.04, 0.04, 0.04}, kBlack{0.0, 0.0, 
 // ---- The film ----------------------------------------------------------------------------------
 
 // The closed form (Gaussian fits of the colour matching functions in Fourier space) against the
-// spectral Airy sum: within 0.04 (the fits' error; the largest seen, 0.032, is a saturated gold
+// spectral Airy sum: within 0.04 (the fits' error; the largest seen, 0.036, is a saturated gold
 // film at grazing incidence), and the film coloured (its channels apart) where it should be
 TEST(Iridescence, FilmMatchesASpectralAiryReference) {
   KernelRig& r = kernel_rig("pocl");
@@ -237,11 +238,15 @@ TEST(Iridescence, VanishingFilmTendsToTheBase) {
     for (int c = 0; c < 3; ++c) {
       SCOPED_TRACE("n " + std::to_string(q.n) + ", cos " + std::to_string(q.cos) + ", channel " + std::to_string(c));
       Interfaces f = interfaces(q.n, q.f0[c], q.cos);
-      // The series stops where its amplitude falls under 1e-4: the tail is at most
-      // 2e-4 / (1 - sqrt(R12 R23)), and float rounding
-      double tol = 2e-4 / (1.0 - std::sqrt(f.r12 * f.r23)) + 2e-5;
+      // The series (orders m of amplitude |Rs - T121| r^m, r = sqrt(R12 R23)) stops where the
+      // amplitude falls under 1e-4, or after the 8th order: the tail left out is at most
+      // 2 max(1e-4, |Rs - T121| r^9) / (1 - r); and float rounding
+      double r = std::sqrt(f.r12 * f.r23), t121 = 1.0 - f.r12, rs = t121 * t121 * f.r23 / (1.0 - f.r12 * f.r23);
+      double tol = 2.0 * std::max(1e-4, std::fabs(rs - t121) * std::pow(r, 9.0)) / (1.0 - r) + 2e-5;
       EXPECT_NEAR(got[i][c], zero_phase(q.n, q.f0[c], q.cos), tol);
-      if (q.cos == 1.0) EXPECT_NEAR(got[i][c], q.f0[c], tol);
+      if (q.cos == 1.0) {
+        EXPECT_NEAR(got[i][c], q.f0[c], tol);
+      }
     }
   }
 }
@@ -305,7 +310,7 @@ TEST(Iridescence, FresnelIsTheFilmsMix) {
         double mixed = (1.0 - k.factor) * schlick_f + k.factor * f90 * films[i][c];
         ASSERT_GT(fb[i].s[c], 0.0f);
         EXPECT_NEAR(fa[i].s[c] / fb[i].s[c], mixed / schlick_f, 2e-4 * mixed / schlick_f) << "pair " << i;
-        EXPECT_EQ(fa[i].s[3], fb[i].s[3]);  // the pdf: the film changes no weight of these single-lobe mixtures
+        EXPECT_FLOAT_EQ(fa[i].s[3], fb[i].s[3]);  // the pdf: the film changes no weight of these single-lobe mixtures
       }
     // The mirror: every sample is the delta reflection, of weight f wo.z / pdf = the mix at wo.z
     for (double zo : {0.9, 0.4, 0.1}) {
@@ -336,7 +341,7 @@ TEST(Iridescence, SamplingMatchesThePdf) {
     dev::Material m;
   } cases[] = {
       {"film 1.3/380 nm over white plastic r0.3", material(0.0, 0.3, glm::dvec3(1.0), 1.0, 1.3, 380.0)},
-      {"film 1.8/250 nm over gold r0.25", material(1.0, 0.25, glm::dvec3(kGold[0], kGold[1], kGold[2]), 1.0, 1.8, 250.0)},
+      {"film 1.8/250 nm over gold r0.3", material(1.0, 0.3, glm::dvec3(kGold[0], kGold[1], kGold[2]), 1.0, 1.8, 250.0)},
       {"half film over half metal r0.5", material(0.5, 0.5, glm::dvec3(0.2, 0.5, 0.8), 0.5, 1.5, 500.0)},
       {"film under a coat r0.4", material(0.0, 0.4, glm::dvec3(0.7), 1.0, 1.3, 300.0, 0.0, 1.0)},
       {"film over rough glass r0.3", material(0.2, 0.3, glm::dvec3(1.0), 1.0, 1.4, 420.0, 1.0)},
@@ -374,7 +379,8 @@ TEST(Iridescence, NoFilmIsTheMaterialWithoutTheFeature) {
     for (double z : {0.9, 0.3, 0.01}) {
       SCOPED_TRACE("case " + std::to_string(ci) + ", wo.z " + std::to_string(z));
       glm::dvec3 wo = sphere_direction(z, 0.6);
-      std::vector<cl_float4> a = sample(r, p.program, t, m, 3u, wo, n, 5u), b = sample(r, r.program, tp, m, 3u, wo, n, 5u);
+      std::vector<cl_float4> a = sample(r, p.program, t, m, 3u, wo, n, 5u),
+                             b = sample(r, r.program, tp, m, 3u, wo, n, 5u);
       EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(cl_float4)), 0);
       std::vector<cl_float4> pairs;
       for (size_t i = 0; i < n; ++i) {

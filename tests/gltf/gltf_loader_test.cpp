@@ -569,11 +569,12 @@ TEST(GltfLoader, IridescenceIsRead) {
   j["textures"] = {{{"source", 0}}, {{"source", 1}}};
   j["images"] = {{{"uri", kPixelPng}}, {{"uri", kPixelPng}}};
   j["materials"][0]["extensions"]["KHR_materials_iridescence"] = {{"iridescenceFactor", 0.7},
-                                                                   {"iridescenceIor", 1.8},
-                                                                   {"iridescenceThicknessMinimum", 200.0},
-                                                                   {"iridescenceThicknessMaximum", 650.0},
-                                                                   {"iridescenceTexture", {{"index", 0}}},
-                                                                   {"iridescenceThicknessTexture", {{"index", 1}}}};
+                                                                  {"iridescenceIor", 1.8},
+                                                                  {"iridescenceThicknessMinimum", 200.0},
+                                                                  {"iridescenceThicknessMaximum", 650.0},
+                                                                  {"iridescenceTexture", {{"index", 0}}},
+                                                                  {"iridescenceThicknessTexture", {{"index", 1}}}};
+  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1.0;  // not the Lambertian short cut
   j["materials"].push_back(j["materials"][0]);
   j["materials"][1]["extensions"]["KHR_materials_iridescence"] = json::object();
   Scene s = load_gltf(dir.write("ir.gltf", j.dump()));
