@@ -578,8 +578,8 @@ def make_iridescence(path):
     square_floor(g, 6.0, g.pbr_material("floor", pbr((0.5, 0.5, 0.5), 0.0, 0.8),
                                         {"KHR_materials_specular": {"specularFactor": 0.0}}))
     ceiling_panel(g, [(-2.5, 3.0, -2.0), (-2.5, 3.0, 1.0), (2.5, 3.0, 1.0), (2.5, 3.0, -2.0)], 4.0)
-    eye = (0.0, 1.2, 4.2)
-    g.node("camera", camera=g.camera("camera", 0.5, 2.0), translation=list(eye),
+    eye = (0.0, 1.3, 4.6)
+    g.node("camera", camera=g.camera("camera", 0.62, 2.0), translation=list(eye),
            rotation=look_at_rotation(eye, (0.0, 0.4, 0.0)))
     g.set_background([0.25, 0.27, 0.3])
     g.write(path)

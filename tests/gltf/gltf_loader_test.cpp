@@ -258,8 +258,8 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf().document();
-  j["extensionsUsed"] = {"KHR_materials_iridescence"};
-  j["materials"][0]["extensions"] = {{"KHR_materials_iridescence", {{"iridescenceFactor", 1}}}};
+  j["extensionsUsed"] = {"ADOBE_materials_thin_transparency"};
+  j["materials"][0]["extensions"] = {{"ADOBE_materials_thin_transparency", {{"transmissionFactor", 1}}}};
   j["materials"].push_back(j["materials"][0]);
   j["materials"][0]["occlusionTexture"] = {{"index", 0}};
   j["materials"][1]["occlusionTexture"] = {{"index", 0}};
@@ -270,12 +270,12 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
         "png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg="
         "="}}};
   Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
-  int iridescence = 0, occlusion = 0;
+  int unsupported = 0, occlusion = 0;
   for (const auto& w : s.warnings) {
-    iridescence += w.find("KHR_materials_iridescence") != std::string::npos;
+    unsupported += w.find("ADOBE_materials_thin_transparency") != std::string::npos;
     occlusion += w.find("occlusionTexture") != std::string::npos;
   }
-  EXPECT_EQ(iridescence, 1);
+  EXPECT_EQ(unsupported, 1);
   EXPECT_EQ(occlusion, 1);
 }
 
