@@ -20,6 +20,7 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/energy.cl
   cl/bsdf/sheen.cl
   cl/bsdf/dispersion.cl
+  cl/bsdf/iridescence.cl
   cl/bsdf/bsdf_common.cl
   cl/bsdf/bsdf_diffuse.cl
   cl/bsdf/bsdf_conductor.cl

@@ -8,6 +8,7 @@ Outputs (deterministic, byte-identical on every run):
   scenes/furnace/closed-sphere.gltf     emissive+diffuse sphere seen from inside
   scenes/furnace/white-objects.gltf     albedo-1 objects under a white background
   scenes/materials/materials.gltf       grid of material spheres under an area light
+  scenes/materials/iridescence.gltf     thin films (KHR_materials_iridescence) on spheres
   scenes/lights/punctual.gltf           point, spot and directional lights (KHR_lights_punctual)
   scenes/lights/sky.hdr, tiny-sun.hdr   equirectangular maps (Radiance RGBE)
   scenes/lights/environment.gltf        spheres on a floor lit by sky.hdr
@@ -549,6 +550,38 @@ def make_materials(path):
     g.node("camera", camera=g.camera("camera", 0.55, 1.5), translation=list(eye),
            rotation=quat_from_basis(right, up, scale(f, -1.0)))
     g.set_background([0.08, 0.09, 0.11])
+    g.write(path)
+
+
+def make_iridescence(path):
+    """A row of spheres with thin films (KHR_materials_iridescence) under an area light:
+    a soap-bubble film over black plastic, its thickness varying from pole to pole (texture
+    G), a film over silver, over gold, and half a film over red plastic."""
+    g = GltfWriter(GENERATOR)
+    gradient = g.png_texture(4, 64, rgba_image(4, 64, lambda x, y: (1.0, y / 63.0, 1.0, 1.0)))
+
+    def film(ior, lo, hi, factor=1.0, texture=None):
+        ext = {"iridescenceFactor": factor, "iridescenceIor": ior,
+               "iridescenceThicknessMinimum": lo, "iridescenceThicknessMaximum": hi}
+        if texture is not None:
+            ext["iridescenceThicknessTexture"] = {"index": texture}
+        return {"KHR_materials_iridescence": ext}
+    materials = [
+        g.pbr_material("bubble", pbr((0.02, 0.02, 0.02), 0.0, 0.05), film(1.33, 100.0, 400.0)),
+        g.pbr_material("thickness-gradient", pbr((0.02, 0.02, 0.02), 0.0, 0.15),
+                       film(1.33, 100.0, 900.0, texture=gradient)),
+        g.pbr_material("film-silver", pbr((0.97, 0.96, 0.91), 1.0, 0.2), film(1.8, 300.0, 300.0)),
+        g.pbr_material("film-gold", pbr((1.0, 0.78, 0.34), 1.0, 0.3), film(1.5, 500.0, 500.0)),
+        g.pbr_material("half-film-red", pbr((0.6, 0.04, 0.03), 0.0, 0.3), film(1.3, 250.0, 250.0, 0.5)),
+    ]
+    sphere_row(g, materials, 0.4, 1.0, -2.0)
+    square_floor(g, 6.0, g.pbr_material("floor", pbr((0.5, 0.5, 0.5), 0.0, 0.8),
+                                        {"KHR_materials_specular": {"specularFactor": 0.0}}))
+    ceiling_panel(g, [(-2.5, 3.0, -2.0), (-2.5, 3.0, 1.0), (2.5, 3.0, 1.0), (2.5, 3.0, -2.0)], 4.0)
+    eye = (0.0, 1.3, 4.6)
+    g.node("camera", camera=g.camera("camera", 0.62, 2.0), translation=list(eye),
+           rotation=look_at_rotation(eye, (0.0, 0.4, 0.0)))
+    g.set_background([0.25, 0.27, 0.3])
     g.write(path)
 
 
@@ -1216,6 +1249,7 @@ SCENES = [
     ("scenes/furnace/closed-sphere.gltf", make_closed_sphere),
     ("scenes/furnace/white-objects.gltf", make_white_objects),
     ("scenes/materials/materials.gltf", make_materials),
+    ("scenes/materials/iridescence.gltf", make_iridescence),
     ("scenes/lights/punctual.gltf", make_punctual),
     ("scenes/lights/environment.gltf", make_environment),
     ("scenes/lights/veach.gltf", make_veach),

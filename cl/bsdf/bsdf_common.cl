@@ -38,6 +38,11 @@ typedef struct {
   float diffuse_transmission;         // KHR_materials_diffuse_transmission: the diffuse part's share transmitted
   float3 diffuse_transmission_color;  // its colour
 #endif
+#if CD_FEATURE_IRIDESCENCE
+  float iridescence;      // KHR_materials_iridescence: the film's share of the metal and specular Fresnel (0: none)
+  float iridescence_ior;  // the film's index
+  float iridescence_thickness;  // its thickness (nm)
+#endif
 } GltfBsdf;
 
 // Parameters of a MATERIAL_CONDUCTOR BSDF at a shading point (bsdf_conductor.cl)

@@ -12,9 +12,13 @@
 //            1 - c E(mu_i)) (the extension's albedo scaling, c = max3(sheen colour), E its
 //            albedo table, taken at most 1) and transmissions by 1 - c E at the outside
 //            direction's angle
-//   metal:   metallic * Schlick(base color, 1) * GGX
+//   metal:   metallic * F_m * GGX, F_m = Schlick(base color, 1)
 //   plastic: (1 - metallic)(1 - transmission) * [F_d * GGX + (1 - d) W(mu_o, mu_i) * base / pi],
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
+//   film:    (CD_FEATURE_IRIDESCENCE) KHR_materials_iridescence mixes a thin film's reflectance
+//            (iridescence.cl) into F_m and F_d: F = mix(F, film over that base, factor), the
+//            dielectric's film scaled by its specular factor (gltf_fresnel). The layering (W,
+//            the albedo weights) and the multiple scattering keep the base's Schlick terms
 //   difftrans: (CD_FEATURE_DIFFUSE_TRANSMISSION) (1 - metallic)(1 - transmission) *
 //            d W(mu_o, |mu_i|) * colour / pi into the other hemisphere
 //            (KHR_materials_diffuse_transmission: the factor d takes that share of the
@@ -130,6 +134,15 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   lobe->diffuse_transmission_color =
       load3(g->diffuse_transmission) * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION_COLOR, s).xyz;
   layered = layered || lobe->diffuse_transmission > 0.0f;
+#endif
+#if CD_FEATURE_IRIDESCENCE
+  // The film's factor (texture R) and thickness, from minimum to maximum by texture G; a
+  // film of thickness 0 is none
+  lobe->iridescence = g->iridescence[0] * bsdf_texture(sc, m, TEX_IRIDESCENCE, s).x;
+  lobe->iridescence_ior = g->iridescence[1];
+  lobe->iridescence_thickness =
+      mix(g->iridescence[2], g->iridescence[3], bsdf_texture(sc, m, TEX_IRIDESCENCE_THICKNESS, s).y);
+  if (!(lobe->iridescence_thickness > 0.0f)) lobe->iridescence = 0.0f;
 #endif
   if (lobe->metallic == 0.0f && lobe->spec_f90 == 0.0f && lobe->transmission == 0.0f && lobe->coat == 0.0f && !layered)
     b->type = MATERIAL_DIFFUSE;
@@ -250,6 +263,31 @@ float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
   return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i));
 }
 
+// The metal's and the plastic's specular Fresnel terms F_m and F_d at cosine cos_h (wo.h);
+// with KHR_materials_iridescence each is mixed with the film over its base, for the bases
+// present (the one place the film is evaluated: eval, sample and the weights at wo share it)
+void gltf_fresnel(const Bsdf* b, float cos_h, float3* metal, float3* spec) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  *metal = fresnel_schlick(b->base_color, (float3)(1.0f), cos_h);
+  *spec = fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_h);
+#if CD_FEATURE_IRIDESCENCE
+  if (lobe->iridescence > 0.0f) {
+    // The dielectric's F0 before the specular factor, which scales its film as it does F_d
+    float3 f0 = lobe->spec_f90 > 0.0f ? lobe->spec_f0 / lobe->spec_f90 : (float3)(0.0f);
+    bool dielectric = lobe->metallic < 1.0f && lobe->transmission < 1.0f && lobe->spec_f90 > 0.0f;
+    uint last = dielectric ? 2u : 1u;
+    for (uint k = lobe->metallic > 0.0f ? 0u : 1u; k < last; ++k) {  // 0: the metal, 1: the dielectric
+      float3 film =
+          iridescence_fresnel(lobe->iridescence_ior, lobe->iridescence_thickness, k ? f0 : b->base_color, cos_h);
+      if (k == 0u)
+        *metal = mix(*metal, film, lobe->iridescence);
+      else
+        *spec = mix(*spec, lobe->spec_f90 * film, lobe->iridescence);
+    }
+  }
+#endif
+}
+
 #if CD_FEATURE_SHEEN
 // The sheen's albedo E(mu) with colour 1 (0 without the table)
 float gltf_sheen_e(const Bsdf* b, float mu) {
@@ -277,11 +315,12 @@ float3 gltf_sheen_f(const Bsdf* b, float e_o, float3 wo, float3 wi) {
 typedef struct {
   GgxEnergy e;
   GltfLayer spec, coat;
-  float base_norm;   // gltf_coat_base_norm
-  bool coat_tilted;  // the coat has its own normal: its lobe works in coat_frame
-  Frame coat_frame;  // the coat's frame in the local (shading) frame, z = n_c
-  float coat_o;      // wo.n_c (wo.z when not tilted)
-  float outer;       // what the layers over the base (coat, sheen) leave it at wo
+  float base_norm;             // gltf_coat_base_norm
+  bool coat_tilted;            // the coat has its own normal: its lobe works in coat_frame
+  Frame coat_frame;            // the coat's frame in the local (shading) frame, z = n_c
+  float coat_o;                // wo.n_c (wo.z when not tilted)
+  float outer;                 // what the layers over the base (coat, sheen) leave it at wo
+  float3 f_metal_o, f_spec_o;  // gltf_fresnel at wo.z: the weights and the mirror reflections
 #if CD_FEATURE_SHEEN
   float sheen_e_o, sheen_o;  // gltf_sheen_e and gltf_sheen_below at wo
 #endif
@@ -308,7 +347,7 @@ float gltf_metal_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
 
 float gltf_spec_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  float fs = luminance(fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_o));
+  float fs = luminance(g->f_spec_o);
   return g->outer * (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fs * g->e.e_o;
 }
 
@@ -341,6 +380,7 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float3 wo) {
   GltfAtWo g;
   float cos_o = wo.z;
   g.e = gltf_energy(b, cos_o);
+  gltf_fresnel(b, cos_o, &g.f_metal_o, &g.f_spec_o);
   g.spec = gltf_spec_layer(b, &g.e, cos_o);
   g.coat_tilted = b->lobe.gltf.coat_own_normal;
   g.coat_o = cos_o;
@@ -395,12 +435,13 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
     bool glossy = m > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
     if (glossy) d = ggx_reflection_eval(lobe->ggx, wo, wi, &p, &cos_h);
-    float3 fd = glossy ? fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), cos_h) : (float3)(0.0f);
     under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) * gltf_below(&spec, wi.z) * g->base_norm *
             b->base_color * INV_PI_F;
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
-      under += (m * fresnel_schlick(b->base_color, (float3)(1.0f), cos_h) + (1.0f - m) * (1.0f - t) * fd) * d;
+      float3 fm, fd;
+      gltf_fresnel(b, cos_h, &fm, &fd);
+      under += (m * fm + (1.0f - m) * (1.0f - t) * fd) * d;
       *pdf += (w[GLTF_METAL] + w[GLTF_SPEC]) * p;
     }
     if (e.table) {
@@ -513,7 +554,7 @@ float3 gltf_mirror_below_sheen(const GltfAtWo* g, float3 weight) {
 int gltf_metal_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) {
-    float3 weight = gltf_mirror_below_sheen(g, lobe->metallic * fresnel_schlick(b->base_color, (float3)(1.0f), wo.z));
+    float3 weight = gltf_mirror_below_sheen(g, lobe->metallic * g->f_metal_o);
     return gltf_mirror(wo, gltf_coat_below(g, (float3)(-wo.x, -wo.y, wo.z)) * weight, g->w[GLTF_METAL], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);
@@ -522,8 +563,7 @@ int gltf_metal_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
 int gltf_spec_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) {
-    float3 fd = fresnel_schlick(lobe->spec_f0, (float3)(lobe->spec_f90), wo.z);
-    float3 weight = gltf_mirror_below_sheen(g, (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * fd);
+    float3 weight = gltf_mirror_below_sheen(g, (1.0f - lobe->metallic) * (1.0f - lobe->transmission) * g->f_spec_o);
     return gltf_mirror(wo, gltf_coat_below(g, (float3)(-wo.x, -wo.y, wo.z)) * weight, g->w[GLTF_SPEC], bs);
   }
   return gltf_ggx_direction(lobe->ggx, wo, u, bs);

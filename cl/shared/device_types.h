@@ -29,6 +29,7 @@
   X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
   X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
   X(dispersion, CD_FEATURE_DISPERSION, 1, "a refracting glTF material with dispersion > 0")         \
+  X(iridescence, CD_FEATURE_IRIDESCENCE, 1, "a glTF-shaded KHR_materials_iridescence")             \
   X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")        \
@@ -80,7 +81,9 @@
 #define TEX_CLEARCOAT_NORMAL 12            // tangent-space normal of the clearcoat layer
 #define TEX_DIFFUSE_TRANSMISSION 13        // A
 #define TEX_DIFFUSE_TRANSMISSION_COLOR 14  // RGB (sRGB)
-#define TEX_SLOTS 15
+#define TEX_IRIDESCENCE 15                 // R
+#define TEX_IRIDESCENCE_THICKNESS 16       // G
+#define TEX_SLOTS 17
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
 // on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
@@ -215,7 +218,7 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Parameters of a MATERIAL_GLTF material, 96 bytes; factors multiply their texture slots
+// Parameters of a MATERIAL_GLTF material, 112 bytes; factors multiply their texture slots
 typedef struct {
   float ior;  // KHR_materials_ior (1.5)
   float metallic, roughness, transmission;
@@ -226,6 +229,7 @@ typedef struct {
   float clearcoat_normal_scale;   // KHR_materials_clearcoat clearcoatNormalTexture.scale
   float dispersion;               // KHR_materials_dispersion: 20 / Abbe number (0: none)
   unsigned int pad[2];
+  float iridescence[4];  // KHR_materials_iridescence: factor, film ior, thickness minimum, maximum (nm)
 } GltfMaterial;
 
 // Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
@@ -237,13 +241,13 @@ typedef struct {
   unsigned int pad;
 } ConductorMaterial;
 
-// A material type's own parameters (Material.type selects the member), 96 bytes
+// A material type's own parameters (Material.type selects the member), 112 bytes
 typedef union {
   GltfMaterial gltf;
   ConductorMaterial conductor;
 } MaterialParams;
 
-// Material, 624 bytes: what every type has, then its type's parameters. Colours are linear
+// Material, 704 bytes: what every type has, then its type's parameters. Colours are linear
 // RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;   // MATERIAL_*
@@ -471,17 +475,18 @@ typedef struct {
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)                                 \
-  SIZE(GltfMaterial, 96) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)             \
+  SIZE(GltfMaterial, 112) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)            \
     FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
     FIELD(GltfMaterial, sheen, 48) FIELD(GltfMaterial, diffuse_transmission, 64)                              \
     FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, dispersion, 84)                       \
     FIELD(GltfMaterial, pad, 88)                                                                              \
+    FIELD(GltfMaterial, iridescence, 96)                                                                      \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
-  SIZE(MaterialParams, 96)                                                                                    \
-  SIZE(Material, 624) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
+  SIZE(MaterialParams, 112)                                                                                   \
+  SIZE(Material, 704) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
     FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
-    FIELD(Material, textures, 144)                                                                            \
+    FIELD(Material, textures, 160)                                                                            \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
   SIZE(TexelF, 16)                                                                                            \

@@ -97,7 +97,9 @@ void print_materials(const Scene& s) {
                                    "sheen roughness",
                                    "clearcoat normal",
                                    "diffuse transmission",
-                                   "diffuse transmission colour"};
+                                   "diffuse transmission colour",
+                                   "iridescence",
+                                   "iridescence thickness"};
   size_t n = s.materials.size() - 1;  // the last is the glTF default material
   std::printf("materials: %zu\n", n);
   for (size_t i = 0; i < n; ++i) {
@@ -107,10 +109,11 @@ void print_materials(const Scene& s) {
       if (m.texture(k).index != NO_TEXTURE) textures += std::string(textures.empty() ? "" : ", ") + kSlots[k];
     char dispersion[48] = "";
     if (m.has_dispersion()) std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
-    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
+    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
                 m.type == MATERIAL_CONDUCTOR ? "measured conductor" : "glTF metallic-roughness", m.metallic,
                 m.roughness, m.transmission > 0.0f ? ", transmissive" : "", m.clearcoat > 0.0f ? ", clearcoat" : "",
                 m.diffuse_transmission > 0.0f ? ", diffuse transmission" : "", dispersion,
+                m.iridescence > 0.0f ? ", iridescence" : "",
                 textures.empty() ? "" : ("; textures: " + textures).c_str());
   }
 }

@@ -90,6 +90,10 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   g.diffuse_transmission[3] = m.diffuse_transmission;
   g.clearcoat_normal_scale = m.clearcoat_normal_scale;
   g.dispersion = m.has_dispersion() ? m.dispersion : 0.0f;  // only a refracting volume disperses
+  g.iridescence[0] = m.iridescence;
+  g.iridescence[1] = m.iridescence_ior;
+  g.iridescence[2] = m.iridescence_thickness_min;
+  g.iridescence[3] = m.iridescence_thickness_max;
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {

@@ -137,6 +137,18 @@ void read_diffuse_transmission(ReadContext& ctx, const tinygltf::Material& gm, M
   set_texture_slot(ctx, m, TEX_DIFFUSE_TRANSMISSION_COLOR, dt, "diffuseTransmissionColorTexture", true);
 }
 
+// KHR_materials_iridescence: the film's factor (texture R), index, and thickness from minimum
+// to maximum (texture G; without it the maximum)
+void read_iridescence(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
+  const tinygltf::Value& ir = extension(gm, "KHR_materials_iridescence");
+  m->iridescence = float(number_or(ir, "iridescenceFactor", -1, 0.0));
+  m->iridescence_ior = float(number_or(ir, "iridescenceIor", -1, 1.3));
+  m->iridescence_thickness_min = float(number_or(ir, "iridescenceThicknessMinimum", -1, 100.0));
+  m->iridescence_thickness_max = float(number_or(ir, "iridescenceThicknessMaximum", -1, 400.0));
+  set_texture_slot(ctx, m, TEX_IRIDESCENCE, ir, "iridescenceTexture", false);
+  set_texture_slot(ctx, m, TEX_IRIDESCENCE_THICKNESS, ir, "iridescenceThicknessTexture", false);
+}
+
 // KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
 void read_unlit(const tinygltf::Material& gm, MaterialDesc* m) {
   m->unlit = gm.extensions.count("KHR_materials_unlit") > 0;
@@ -216,6 +228,10 @@ void check_ranges(const std::string& name, MaterialDesc* m) {
   in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
   in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
   in(m->diffuse_transmission, 0.0f, 1.0f, "diffuseTransmissionFactor");
+  in(m->iridescence, 0.0f, 1.0f, "iridescenceFactor");
+  in(m->iridescence_ior, 1.0f, 10.0f, "iridescenceIor");
+  in(m->iridescence_thickness_min, 0.0f, 1e5f, "iridescenceThicknessMinimum");
+  in(m->iridescence_thickness_max, 0.0f, 1e5f, "iridescenceThicknessMaximum");
   in(m->ior, 0.0f, 10.0f, "ior");
   in(m->dispersion, 0.0f, 1e6f, "dispersion");
   for (int c = 0; c < 3; ++c) {
@@ -259,6 +275,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_sheen(ctx, gm, &m);
   read_diffuse_transmission(ctx, gm, &m);
   read_dispersion(gm, &m);
+  read_iridescence(ctx, gm, &m);
   read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);

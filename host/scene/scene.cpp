@@ -24,6 +24,7 @@ bool MaterialDesc::has_diffuse_transmission() const {
 bool MaterialDesc::has_dispersion() const {
   return kernel_type() == MATERIAL_GLTF && dispersion > 0.0f && transmission > 0.0f && !thin_walled;
 }
+bool MaterialDesc::has_iridescence() const { return kernel_type() == MATERIAL_GLTF && iridescence > 0.0f; }
 
 bool MaterialDesc::alpha_tested() const {
   bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
@@ -90,6 +91,7 @@ SceneFeatures Scene::features() const {
     f.sheen |= materials.at(m.material).has_sheen();
     f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
     f.dispersion |= materials.at(m.material).has_dispersion();
+    f.iridescence |= materials.at(m.material).has_iridescence();
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

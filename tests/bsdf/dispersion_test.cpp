@@ -38,7 +38,7 @@ KernelRig& dispersion_rig() {
   if (!rig) {
     KernelRig& shared = kernel_rig("pocl");
     ProgramBuild b =
-        build_program(shared.context, shared.device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=1");
+        build_program(shared.context, shared.device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=1 -DCD_FEATURE_IRIDESCENCE=0");
     rig = std::make_unique<KernelRig>(shared.device, shared.context, b.program);
   }
   return *rig;
@@ -131,8 +131,8 @@ TEST(Dispersion, ChannelsRefractBySnellsLawAtTheirIor) {
       SCOPED_TRACE(std::string(entering ? "entering" : "leaving") + ", channel " + std::to_string(c));
       double ior_c = c < 0 ? ior : ref_ior(ior, disp, kLambda[c]);
       double eta_want = entering ? ior_c : 1.0 / ior_c;
-      glm::dvec3 wi;
-      double eta;
+      glm::dvec3 wi(0.0);
+      double eta = 0.0;
       ASSERT_TRUE(refraction(sample(r, m, c, n, wo, 256, 7u), wo, n, &wi, &eta));
       EXPECT_NEAR(eta, eta_want, 1e-6 * eta_want);
       // Snell: the tangential part of wi is -wo's / eta, in the plane of incidence

@@ -336,8 +336,8 @@ TEST_P(DiffuseTransmission, ReflectionAndTransmissionSplitByTheFactor) {
 // CD_FEATURE_DIFFUSE_TRANSMISSION=0 (the kernel of a scene without it) gives
 TEST_P(DiffuseTransmission, FactorZeroIsTheMaterialWithoutTheFeature) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  ProgramBuild plain =
-      build_program(r.context, r.device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_DIFFUSE_TRANSMISSION=0");
+  ProgramBuild plain = build_program(r.context, r.device, test_program_source(),
+                                     std::string(kTestProgramOptions) + " -DCD_FEATURE_DIFFUSE_TRANSMISSION=0");
   LayerScene sc(r, r.program, r.program_cache_file), sp(r, plain.program, plain.cache_file);
   std::vector<Layer> cases(4);
   cases[1].metallic = 1.0;

@@ -279,7 +279,8 @@ TEST_P(Sheen, WhiteFurnaceStaysAtMostOne) {
 // CD_FEATURE_SHEEN=0 (the kernel of a scene without sheen) gives
 TEST_P(Sheen, ColourZeroIsTheMaterialWithoutTheFeature) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  ProgramBuild plain = build_program(r.context, r.device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_SHEEN=0");
+  ProgramBuild plain = build_program(r.context, r.device, test_program_source(),
+                                     std::string(kTestProgramOptions) + " -DCD_FEATURE_SHEEN=0");
   Tables t(r, r.program, r.program_cache_file), tp(r, plain.program, plain.cache_file);
   dev::Material cases[] = {
       material(0.0, 0.4, glm::dvec3(0.0), 0.5),           material(1.0, 0.2, glm::dvec3(0.0), 0.5),

@@ -258,8 +258,8 @@ TEST(GltfLoader, VertexColorsMultiplyTheBaseColor) {
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
   TempDir dir;
   json j = quad_gltf().document();
-  j["extensionsUsed"] = {"KHR_materials_iridescence"};
-  j["materials"][0]["extensions"] = {{"KHR_materials_iridescence", {{"iridescenceFactor", 1}}}};
+  j["extensionsUsed"] = {"ADOBE_materials_thin_transparency"};
+  j["materials"][0]["extensions"] = {{"ADOBE_materials_thin_transparency", {{"transmissionFactor", 1}}}};
   j["materials"].push_back(j["materials"][0]);
   j["materials"][0]["occlusionTexture"] = {{"index", 0}};
   j["materials"][1]["occlusionTexture"] = {{"index", 0}};
@@ -270,12 +270,12 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnceEach) {
         "png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg="
         "="}}};
   Scene s = load_gltf(dir.write("unsupported.gltf", j.dump()));
-  int iridescence = 0, occlusion = 0;
+  int unsupported = 0, occlusion = 0;
   for (const auto& w : s.warnings) {
-    iridescence += w.find("KHR_materials_iridescence") != std::string::npos;
+    unsupported += w.find("ADOBE_materials_thin_transparency") != std::string::npos;
     occlusion += w.find("occlusionTexture") != std::string::npos;
   }
-  EXPECT_EQ(iridescence, 1);
+  EXPECT_EQ(unsupported, 1);
   EXPECT_EQ(occlusion, 1);
 }
 
@@ -558,6 +558,59 @@ TEST(GltfLoader, DiffuseTransmissionIsRead) {
     j["materials"][0]["extensions"]["KHR_materials_diffuse_transmission"]["diffuseTransmissionFactor"] = bad;
     EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
   }
+}
+
+// KHR_materials_iridescence: factor (texture R), film ior, thickness range (texture G), both
+// textures linear, the extension's defaults, its range checks, and the kernel feature it turns on
+TEST(GltfLoader, IridescenceIsRead) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  j["extensionsUsed"] = {"KHR_materials_iridescence"};
+  j["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  j["images"] = {{{"uri", kPixelPng}}, {{"uri", kPixelPng}}};
+  j["materials"][0]["extensions"]["KHR_materials_iridescence"] = {{"iridescenceFactor", 0.7},
+                                                                  {"iridescenceIor", 1.8},
+                                                                  {"iridescenceThicknessMinimum", 200.0},
+                                                                  {"iridescenceThicknessMaximum", 650.0},
+                                                                  {"iridescenceTexture", {{"index", 0}}},
+                                                                  {"iridescenceThicknessTexture", {{"index", 1}}}};
+  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1.0;  // not the Lambertian short cut
+  j["materials"].push_back(j["materials"][0]);
+  j["materials"][1]["extensions"]["KHR_materials_iridescence"] = json::object();
+  Scene s = load_gltf(dir.write("ir.gltf", j.dump()));
+  const MaterialDesc& m = s.materials[0];
+  EXPECT_FLOAT_EQ(m.iridescence, 0.7f);
+  EXPECT_FLOAT_EQ(m.iridescence_ior, 1.8f);
+  EXPECT_FLOAT_EQ(m.iridescence_thickness_min, 200.0f);
+  EXPECT_FLOAT_EQ(m.iridescence_thickness_max, 650.0f);
+  const TextureSlot &factor = m.texture(TEX_IRIDESCENCE), &thickness = m.texture(TEX_IRIDESCENCE_THICKNESS);
+  ASSERT_NE(factor.index, NO_TEXTURE);
+  ASSERT_NE(thickness.index, NO_TEXTURE);
+  EXPECT_FALSE(s.textures.at(size_t(factor.index)).srgb);
+  EXPECT_FALSE(s.textures.at(size_t(thickness.index)).srgb);
+  EXPECT_TRUE(m.has_iridescence());
+  EXPECT_TRUE(s.features().iridescence);
+  EXPECT_EQ(join(s.warnings).find("KHR_materials_iridescence"), std::string::npos) << join(s.warnings);
+  // Defaults: factor 0 (no film), ior 1.3, 100 to 400 nm
+  EXPECT_FLOAT_EQ(s.materials[1].iridescence, 0.0f);
+  EXPECT_FLOAT_EQ(s.materials[1].iridescence_ior, 1.3f);
+  EXPECT_FLOAT_EQ(s.materials[1].iridescence_thickness_min, 100.0f);
+  EXPECT_FLOAT_EQ(s.materials[1].iridescence_thickness_max, 400.0f);
+  EXPECT_FALSE(s.materials[1].has_iridescence());
+  CompiledScene c = compile_scene(s);
+  const dev::GltfMaterial& g = c.buffers.materials[0].params.gltf;
+  EXPECT_FLOAT_EQ(g.iridescence[0], 0.7f);
+  EXPECT_FLOAT_EQ(g.iridescence[1], 1.8f);
+  EXPECT_FLOAT_EQ(g.iridescence[2], 200.0f);
+  EXPECT_FLOAT_EQ(g.iridescence[3], 650.0f);
+  // Without a film the scene's kernel compiles none of it
+  j["materials"][0]["extensions"]["KHR_materials_iridescence"]["iridescenceFactor"] = 0.0;
+  EXPECT_FALSE(load_gltf(dir.write("none.gltf", j.dump())).features().iridescence);
+  j["materials"][0]["extensions"]["KHR_materials_iridescence"]["iridescenceFactor"] = 1.5;
+  EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
+  j["materials"][0]["extensions"]["KHR_materials_iridescence"]["iridescenceFactor"] = 1.0;
+  j["materials"][0]["extensions"]["KHR_materials_iridescence"]["iridescenceIor"] = 0.5;
+  EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
 }
 
 }  // namespace candela::test

@@ -28,8 +28,8 @@ std::optional<DeviceEntry> device_by_name(const std::string& name) {
 KernelRig::KernelRig(const DeviceEntry& d) : device(d) {
   context = cl::Context(device.device);
   queue = cl::CommandQueue(context, device.device);
-  // Without KHR_materials_dispersion: its tests build their own program (dispersion_test.cpp)
-  ProgramBuild build = build_program(context, device, test_program_source(), "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=0");
+  // Without KHR_materials_dispersion and _iridescence: their tests build their own programs
+  ProgramBuild build = build_program(context, device, test_program_source(), kTestProgramOptions);
   program = build.program;
   program_cache_file = build.cache_file;
 }
