@@ -71,7 +71,6 @@ void bsdf_lobes_local(const Bsdf* b, float3 wo, BsdfLobes* l) {
 BsdfLobes bsdf_lobes(const Bsdf* b, float3 wo) {
   BsdfLobes l;
   l.count = 0u;
-  l.reflect_only = (bsdf_flags(b) & BSDF_TRANSMISSION) == 0u;
   bsdf_lobes_local(b, frame_to_local(&b->frame, wo), &l);
   for (uint k = 0u; k < l.count; ++k) l.dir[k] = frame_from_local(&b->frame, l.dir[k]);
   return l;

@@ -82,7 +82,6 @@ typedef struct {
   float omega[BSDF_MAX_LOBES];   // solid angle, > 0
   float weight[BSDF_MAX_LOBES];  // selection probability at wo
   uint count;
-  bool reflect_only;  // no transmission: light samples below the surface are wasted
 } BsdfLobes;
 
 void bsdf_lobes_add(BsdfLobes* l, float3 dir, float omega, float weight) {

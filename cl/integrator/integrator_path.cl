@@ -27,6 +27,19 @@
 #define AUTO_SHADOW_COST 1.0f
 #endif
 
+// STRATEGY_AUTO: a factor on a cosine lobe's part of light sampling's second moment under
+// the Sobol sampler, whose stratification helps light sampling there more than BSDF
+// sampling (the one's integrand, f cos / light pdf, is smooth over the sample square; the
+// other's is the light's radiance, edges and all); measured (docs/integrator.md, "The
+// choice"). 1 under the independent sampler, where the second moments are the variances.
+#ifndef AUTO_COSINE_SOBOL
+#if CD_SAMPLER_SOBOL
+#define AUTO_COSINE_SOBOL 0.5f
+#else
+#define AUTO_COSINE_SOBOL 1.0f
+#endif
+#endif
+
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
   Ray ray;
@@ -98,6 +111,12 @@ float path_lobe_pdf(float omega, float d) {
   return 1.0f / (omega * x * x);
 }
 
+// The integral of path_lobe_pdf(omega, d)^2 over the sphere: 2 / (3 pi) for the cosine
+// lobe, 1 / (3 omega) for the GGX-shaped one
+float path_lobe_pdf_squared(float omega) {
+  return omega >= PI_F ? 2.0f / (3.0f * PI_F) : 1.0f / (3.0f * omega);
+}
+
 // STRATEGY_AUTO's choice for light `index` at a vertex at p with lobes `lobes`: true when
 // light sampling takes it. The second moments of the two estimators of the light's
 // contribution, for a BSDF whose f cos is proportional to its sampling pdf sum_c w_c p_c
@@ -105,15 +124,21 @@ float path_lobe_pdf(float omega, float d) {
 // (docs/integrator.md, "The choice"):
 //   M_nee = W_L / pmf * integral over the light of (sum_c w_c p_c)^2 L^2,
 //   M_bsdf = integral over the light of sum_c w_c p_c L^2.
-// Per lobe (cross terms dropped), p_c over the light is bounded by its value q_c at the
+// Per lobe, p_c over the light is bounded by its value q_c at the
 // point of the light's bounding cone nearest to the lobe's centre, and its mass there is
-// P_c = min(1, W_L q_c), so for an emitter of constant L
-//   M_nee ~ W_L / pmf * sum_c w_c^2 q_c P_c,   M_bsdf ~ sum_c w_c P_c.
-// An environment is sampled in proportion to L (its integral E over the sphere): its bright
-// part, a cone of its effective solid angle W_E = E^2 / integral L^2 and radiance E / W_E,
-// enters as a light does, and the radiance L_c it shows at each lobe's centre adds
-// M_nee += E / pmf * w_c^2 L_c / W_c and M_bsdf += w_c L_c^2; light sampling of a map from
-// a reflect-only surface wastes half its samples below it (M_nee x 2). Light sampling
+// P_c = min(1, W_L q_c); the integral of p_c^2 over the light is at most q_c P_c and at
+// most S_c, that over the whole sphere (path_lobe_pdf_squared), so for an emitter of
+// constant L
+//   M_nee ~ W_L / pmf * sum_ab w_a w_b r_ab sqrt(J_a J_b),   M_bsdf ~ sum_c w_c P_c,
+// J_c = min(q_c P_c, S_c), with the cross terms of overlapping lobes: r_ab, their
+// correlation over the sphere, is 1 for a = b, else min(1, X_ab / sqrt(S_a S_b)), X_ab
+// (the integral of p_a p_b) about the wider lobe's pdf at the narrower one's centre.
+// Under the Sobol sampler a cosine lobe's J_c is scaled by AUTO_COSINE_SOBOL.
+// An environment is sampled in proportion to L (its integral E over the sphere, so the
+// samples below a surface are in E already): its bright part, a cone of its effective
+// solid angle W_E = E^2 / integral L^2 and radiance E / W_E, enters as a light does, and
+// a lobe whose centre lies outside that cone sees the radiance L_c there over its whole
+// extent: J_c += L_c S_c and M_bsdf += w_c L_c^2. Light sampling
 // takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
 // path, at the light sample and where the sampled ray finds the light, on the same inputs:
 // no contraction, so both give the same answer. `pmf`: the light's selection probability
@@ -125,23 +150,35 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
   if (!(e.omega > 0.0f)) return true;  // a delta light
   e.pmf = pmf >= 0.0f ? pmf : lights_select_pmf(sc, ctx, index);
   float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
-  float m_nee = 0.0f, m_bsdf = 0.0f;
+  float m_bsdf = 0.0f, j[BSDF_MAX_LOBES];
   for (uint k = 0u; k < lobes->count; ++k) {
     float w = lobes->weight[k], omega = lobes->omega[k];
     float d = e.radius >= PI_F ? 0.0f : fmax(acos(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
     float q = path_lobe_pdf(omega, d);
     float mass = fmin(e.omega * q, 1.0f);
-    m_nee += w * w * q * mass * l_bright;
+    float whole = path_lobe_pdf_squared(omega);
+    j[k] = fmin(q * mass, whole) * l_bright;
     m_bsdf += w * mass * l_bright * l_bright;
-    if (e.everywhere) {
+    if (e.everywhere && d > 0.0f) {
       float l = luminance(lights_environment_radiance(sc, lobes->dir[k]));
-      m_nee += w * w * l / omega;
+      j[k] += l * whole;
       m_bsdf += w * l * l;
+    }
+    if (omega >= PI_F) j[k] *= AUTO_COSINE_SOBOL;
+  }
+  float m_nee = 0.0f;
+  for (uint a = 0u; a < lobes->count; ++a) {
+    float wa = lobes->weight[a];
+    m_nee += wa * wa * j[a];
+    for (uint b = a + 1u; b < lobes->count; ++b) {
+      float wide = fmax(lobes->omega[a], lobes->omega[b]);
+      float x = path_lobe_pdf(wide, acos(clamp(dot(lobes->dir[a], lobes->dir[b]), -1.0f, 1.0f)));
+      float sab = sqrt(path_lobe_pdf_squared(lobes->omega[a]) * path_lobe_pdf_squared(lobes->omega[b]));
+      m_nee += 2.0f * wa * lobes->weight[b] * fmin(x / sab, 1.0f) * sqrt(j[a] * j[b]);
     }
   }
   float scale = e.everywhere ? e.integral / e.pmf : e.omega / e.pmf;
-  float waste = e.map && lobes->reflect_only ? 2.0f : 1.0f;
-  return AUTO_SHADOW_COST * scale * waste * m_nee <= m_bsdf;
+  return AUTO_SHADOW_COST * scale * m_nee <= m_bsdf;
 }
 
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with

@@ -35,7 +35,6 @@ typedef struct {
   float pmf;        // selection probability (set by path_nee_takes, not lights_extent)
   float integral;   // an environment: integral of its luminance over the sphere
   bool everywhere;  // an environment: it surrounds the point, overlapping every lobe
-  bool map;         // an environment map: sampled over the whole sphere, even at reflect-only surfaces
 } LightExtent;
 
 LightSampleContext light_context_at_surface(const SurfaceHit* s, const Bsdf* b) {
@@ -110,10 +109,10 @@ uint lights_environment_prim(__global const Light* light) { return UINT_MAX; }
 void lights_environment_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {
   e->omega = light->params[3];
   e->everywhere = true;
-  e->map = environment_map(light) != NO_TEXTURE;
   e->dir = (float3)(light->params[4], light->params[5], light->params[6]);
   e->radius = dot(e->dir, e->dir) > 0.0f ? acos(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
-  e->integral = light->params[7] * (e->map ? light->params[1] : luminance(load3(light->radiance)));
+  bool map = environment_map(light) != NO_TEXTURE;
+  e->integral = light->params[7] * (map ? light->params[1] : luminance(load3(light->radiance)));
 }
 
 // Triangle lights are sampled uniformly in the solid angle they subtend at ctx.p (Arvo
@@ -587,7 +586,6 @@ LightExtent lights_extent(const SceneData* sc, uint index, float3 p) {
   e.integral = 0.0f;
   e.pmf = 0.0f;
   e.everywhere = false;
-  e.map = false;
 #define LIGHTS_EXTENT(id, name, feature) \
   if (feature && light->type == id) lights_##name##_extent(sc, light, p, &e);
   CD_LIGHTS(LIGHTS_EXTENT)
