@@ -113,9 +113,7 @@ float path_lobe_pdf(float omega, float d) {
 
 // The integral of path_lobe_pdf(omega, d)^2 over the sphere: 2 / (3 pi) for the cosine
 // lobe, 1 / (3 omega) for the GGX-shaped one
-float path_lobe_pdf_squared(float omega) {
-  return omega >= PI_F ? 2.0f / (3.0f * PI_F) : 1.0f / (3.0f * omega);
-}
+float path_lobe_pdf_squared(float omega) { return omega >= PI_F ? 2.0f / (3.0f * PI_F) : 1.0f / (3.0f * omega); }
 
 // STRATEGY_AUTO's choice for light `index` at a vertex at p with lobes `lobes`: true when
 // light sampling takes it. The second moments of the two estimators of the light's

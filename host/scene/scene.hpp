@@ -77,11 +77,11 @@ struct MaterialDesc {
   float sheen_roughness = 0.0f;
   float diffuse_transmission = 0.0f;  // KHR_materials_diffuse_transmission
   glm::vec3 diffuse_transmission_color{1.0f};
-  float dispersion = 0.0f;  // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
+  float dispersion = 0.0f;   // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
   float iridescence = 0.0f;  // KHR_materials_iridescence: the film's share of the Fresnel term
   float iridescence_ior = 1.3f;
   float iridescence_thickness_min = 100.0f, iridescence_thickness_max = 400.0f;  // nm
-  bool unlit = false;       // KHR_materials_unlit: shows base colour x vertex colour, no lighting
+  bool unlit = false;  // KHR_materials_unlit: shows base colour x vertex colour, no lighting
   float normal_scale = 1.0f;
   glm::vec3 conductor_eta{0.0f}, conductor_k{0.0f};  // MATERIAL_CONDUCTOR
   bool double_sided = false;

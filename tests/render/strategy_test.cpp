@@ -111,8 +111,8 @@ TEST(Strategies, AutoLightSamplesTheStudioOnRoughSurfaces) {
   g.add_camera({1.2f, 1.6f, 2.8f}, {0.0f, 0.3f, 0.0f}, 0.8f);
   Scene scene = load_scene(g, "studio_floor.gltf");
   scene.environment = builtin_environment();
-  Errors e = compare(scene, "studio floor", 4, 16, 2, Strategy::Auto, 1024,
-                     {Strategy::Nee, Strategy::Bsdf, Strategy::Auto});
+  Errors e =
+      compare(scene, "studio floor", 4, 16, 2, Strategy::Auto, 1024, {Strategy::Nee, Strategy::Bsdf, Strategy::Auto});
   EXPECT_LT(1.5 * e.nee, e.bsdf);
   EXPECT_LT(e.automatic, 1.15 * std::min(e.nee, e.bsdf));
 }

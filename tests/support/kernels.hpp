@@ -50,7 +50,8 @@ struct KernelRig;
 
 // The build options of the shared test program: OpenCL C 1.2, with the features whose code
 // only their own tests need left out (CD_FEATURE_DISPERSION and CD_FEATURE_IRIDESCENCE:
-// dispersion_test.cpp and iridescence_test.cpp build their programs with them), so that rusticl's slow compile of it does not grow with them
+// dispersion_test.cpp and iridescence_test.cpp build their programs with them), so that rusticl's slow compile of it
+// does not grow with them
 inline const char* const kTestProgramOptions = "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=0 -DCD_FEATURE_IRIDESCENCE=0";
 
 // A write-only device buffer of `size` T that a kernel fills; read() copies it back
