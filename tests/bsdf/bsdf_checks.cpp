@@ -4,6 +4,9 @@
 #include <cmath>
 #include <random>
 
+#include "device/energy.hpp"
+#include "device/sheen_albedo.hpp"
+
 namespace candela::test {
 
 size_t samples_on(const std::string& device, size_t n) { return device == "rusticl" ? n / 4 : n; }
@@ -146,6 +149,11 @@ dev::Material gltf(glm::dvec3 base, double metallic, double roughness, double tr
   m.params.gltf.transmission = float(transmission);
   if (thin) m.flags |= MATERIAL_THIN_WALLED;
   return m;
+}
+
+AlbedoTables::AlbedoTables(KernelRig& r, const cl::Program& program, const std::string& cache_file) {
+  ggx = ggx_albedo_table(r.context, r.queue, program, cache_file).buffer;
+  sheen = sheen_albedo_table(r.context, r.queue, program, cache_file).buffer;
 }
 
 dev::Material gold(double roughness, double anisotropy) {

@@ -153,6 +153,12 @@ const std::vector<MaterialCase>& all_materials();
 const std::vector<EnergyLobe>& all_energy_lobes();
 const MaterialCase& material_case(const std::string& name);
 
+// A program's GGX and sheen albedo tables (energy.hpp, sheen_albedo.hpp), cached beside it
+struct AlbedoTables {
+  cl::Buffer ggx, sheen;
+  AlbedoTables(KernelRig& r, const cl::Program& program, const std::string& cache_file);
+};
+
 // ---- Shading geometry -----------------------------------------------------------------------
 
 // A shading point as a mesh gives it: normals unoriented, tangent not orthogonal to ns

@@ -46,19 +46,9 @@ KernelRig& dispersion_rig() {
 
 // A glTF material: white, dielectric, of roughness r, transmission t, ior and dispersion
 dev::Material material(double roughness, double transmission, double ior, double dispersion) {
-  dev::Material m{};
-  m.type = MATERIAL_GLTF;
-  for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
-  m.normal_scale = 1.0f;
-  for (dev::TextureRef& t : m.textures) {
-    t.index = NO_TEXTURE;
-    t.m[0] = t.m[4] = 1.0f;
-  }
+  dev::Material m = gltf(glm::dvec3(1.0), 0.0, roughness, transmission);
   dev::GltfMaterial& g = m.params.gltf;
   g.ior = float(ior);
-  for (int c = 0; c < 4; ++c) g.specular_color[c] = 1.0f;
-  g.roughness = float(roughness);
-  g.transmission = float(transmission);
   g.clearcoat_normal_scale = 1.0f;
   g.dispersion = float(dispersion);
   return m;

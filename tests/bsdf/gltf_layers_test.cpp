@@ -40,24 +40,11 @@ struct Layer {
 };
 
 dev::Material material(const Layer& l) {
-  dev::Material m{};
-  m.type = MATERIAL_GLTF;
-  for (int c = 0; c < 3; ++c) m.base_color[c] = float(l.base[c]);
-  m.base_color[3] = 1.0f;
-  m.normal_scale = 1.0f;
-  for (dev::TextureRef& t : m.textures) {
-    t.index = NO_TEXTURE;
-    t.m[0] = t.m[4] = 1.0f;
-  }
+  dev::Material m = gltf(l.base, l.metallic, l.roughness, l.transmission);
   if (l.coat_normal) m.textures[TEX_CLEARCOAT_NORMAL].index = 0;
   if (l.base_normal) m.textures[TEX_NORMAL].index = 0;
   dev::GltfMaterial& g = m.params.gltf;
-  g.ior = 1.5f;
-  for (int c = 0; c < 3; ++c) g.specular_color[c] = 1.0f;
   g.specular_color[3] = float(l.specular);
-  g.metallic = float(l.metallic);
-  g.roughness = float(l.roughness);
-  g.transmission = float(l.transmission);
   g.clearcoat = float(l.coat);
   g.clearcoat_roughness = float(l.coat_roughness);
   g.clearcoat_normal_scale = 1.0f;

@@ -142,22 +142,9 @@ std::vector<Rgb> device_film(KernelRig& r, const std::vector<FilmQuery>& qs) {
 // (the maximum; no thickness texture)
 dev::Material material(double metallic, double roughness, glm::dvec3 base, double film, double n, double d,
                        double transmission = 0.0, double coat = 0.0, double specular = 1.0) {
-  dev::Material m{};
-  m.type = MATERIAL_GLTF;
-  for (int c = 0; c < 3; ++c) m.base_color[c] = float(base[c]);
-  m.base_color[3] = 1.0f;
-  m.normal_scale = 1.0f;
-  for (dev::TextureRef& t : m.textures) {
-    t.index = NO_TEXTURE;
-    t.m[0] = t.m[4] = 1.0f;
-  }
+  dev::Material m = gltf(base, metallic, roughness, transmission);
   dev::GltfMaterial& g = m.params.gltf;
-  g.ior = 1.5f;
-  for (int c = 0; c < 3; ++c) g.specular_color[c] = 1.0f;
   g.specular_color[3] = float(specular);
-  g.metallic = float(metallic);
-  g.roughness = float(roughness);
-  g.transmission = float(transmission);
   g.clearcoat = float(coat);
   g.clearcoat_roughness = 0.3f;
   g.iridescence[0] = float(film);
@@ -167,24 +154,15 @@ dev::Material material(double metallic, double roughness, glm::dvec3 base, doubl
   return m;
 }
 
-// A program's GGX and sheen albedo tables
-struct Tables {
-  cl::Buffer ggx, sheen;
-  Tables(KernelRig& r, const cl::Program& program, const std::string& cache_file) {
-    ggx = ggx_albedo_table(r.context, r.queue, program, cache_file).buffer;
-    sheen = sheen_albedo_table(r.context, r.queue, program, cache_file).buffer;
-  }
-};
-
 // bsdf_sample and bsdf_eval of material m through test_sheen_sample / test_sheen_eval (tables:
 // bit 0 binds the GGX albedo table, bit 1 the sheen table)
-std::vector<cl_float4> sample(KernelRig& r, const cl::Program& p, const Tables& t, const dev::Material& m,
+std::vector<cl_float4> sample(KernelRig& r, const cl::Program& p, const AlbedoTables& t, const dev::Material& m,
                               cl_uint tables, glm::dvec3 wo, size_t n, cl_uint seed) {
   return flat_sample(r, p, "test_sheen_sample", wo, n, seed, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen,
                      tables);
 }
-std::vector<cl_float4> eval(KernelRig& r, const cl::Program& p, const Tables& t, const dev::Material& m, cl_uint tables,
-                            const std::vector<cl_float4>& pairs) {
+std::vector<cl_float4> eval(KernelRig& r, const cl::Program& p, const AlbedoTables& t, const dev::Material& m,
+                            cl_uint tables, const std::vector<cl_float4>& pairs) {
   return flat_eval(r, p, "test_sheen_eval", pairs, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen, tables);
 }
 
@@ -277,7 +255,7 @@ TEST(Iridescence, FilmStaysInTheUnitRange) {
 TEST(Iridescence, FresnelIsTheFilmsMix) {
   KernelRig& r = kernel_rig("pocl");
   const ProgramBuild& p = iridescence_program(r);
-  Tables t(r, p.program, p.cache_file);
+  AlbedoTables t(r, p.program, p.cache_file);
   const double n = 1.4, d = 350.0;
   struct Case {
     const char* name;
@@ -335,7 +313,7 @@ TEST(Iridescence, FresnelIsTheFilmsMix) {
 TEST(Iridescence, SamplingMatchesThePdf) {
   KernelRig& r = kernel_rig("pocl");
   const ProgramBuild& p = iridescence_program(r);
-  Tables t(r, p.program, p.cache_file);
+  AlbedoTables t(r, p.program, p.cache_file);
   struct Case {
     const char* name;
     dev::Material m;
@@ -364,7 +342,7 @@ TEST(Iridescence, SamplingMatchesThePdf) {
 TEST(Iridescence, NoFilmIsTheMaterialWithoutTheFeature) {
   KernelRig& r = kernel_rig("pocl");
   const ProgramBuild& p = iridescence_program(r);
-  Tables t(r, p.program, p.cache_file), tp(r, r.program, r.program_cache_file);
+  AlbedoTables t(r, p.program, p.cache_file), tp(r, r.program, r.program_cache_file);
   dev::Material cases[] = {
       material(0.0, 0.4, glm::dvec3(0.8), 0.0, 1.6, 300.0),
       material(1.0, 0.2, glm::dvec3(0.9, 0.6, 0.3), 0.0, 1.6, 300.0),

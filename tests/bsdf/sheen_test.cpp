@@ -63,22 +63,9 @@ double ref_albedo(double mu, double r, int n) {
 dev::Material material(double metallic, double roughness, glm::dvec3 sheen, double sheen_roughness,
                        double transmission = 0.0, double coat = 0.0, glm::dvec3 base = glm::dvec3(1.0),
                        double specular = 1.0) {
-  dev::Material m{};
-  m.type = MATERIAL_GLTF;
-  for (int c = 0; c < 3; ++c) m.base_color[c] = float(base[c]);
-  m.base_color[3] = 1.0f;
-  m.normal_scale = 1.0f;
-  for (dev::TextureRef& t : m.textures) {
-    t.index = NO_TEXTURE;
-    t.m[0] = t.m[4] = 1.0f;
-  }
+  dev::Material m = gltf(base, metallic, roughness, transmission);
   dev::GltfMaterial& g = m.params.gltf;
-  g.ior = 1.5f;
-  for (int c = 0; c < 3; ++c) g.specular_color[c] = 1.0f;
   g.specular_color[3] = float(specular);
-  g.metallic = float(metallic);
-  g.roughness = float(roughness);
-  g.transmission = float(transmission);
   g.clearcoat = float(coat);
   g.clearcoat_roughness = 0.3f;
   for (int c = 0; c < 3; ++c) g.sheen[c] = float(sheen[c]);
@@ -86,28 +73,19 @@ dev::Material material(double metallic, double roughness, glm::dvec3 sheen, doub
   return m;
 }
 
-// A program's GGX and sheen albedo tables (cached beside it)
-struct Tables {
-  cl::Buffer ggx, sheen;
-  Tables(KernelRig& r, const cl::Program& program, const std::string& cache_file) {
-    ggx = ggx_albedo_table(r.context, r.queue, program, cache_file).buffer;
-    sheen = sheen_albedo_table(r.context, r.queue, program, cache_file).buffer;
-  }
-};
-
 struct Sampled {
   std::vector<cl_float4> out;  // 3 per sample (test_sheen_sample)
 };
 
 // test_sheen_sample: 3 float4 per sample (test_bsdf_sample_record)
-Sampled sample(KernelRig& r, const cl::Program& program, const Tables& t, const dev::Material& m, cl_uint tables,
+Sampled sample(KernelRig& r, const cl::Program& program, const AlbedoTables& t, const dev::Material& m, cl_uint tables,
                glm::dvec3 wo, size_t n, cl_uint seed) {
   return {flat_sample(r, program, "test_sheen_sample", wo, n, seed, r.input(std::vector<dev::Material>{m}), t.ggx,
                       t.sheen, tables)};
 }
 
 // test_sheen_eval: (f, pdf) per pair
-std::vector<cl_float4> eval(KernelRig& r, const cl::Program& program, const Tables& t, const dev::Material& m,
+std::vector<cl_float4> eval(KernelRig& r, const cl::Program& program, const AlbedoTables& t, const dev::Material& m,
                             cl_uint tables, const std::vector<cl_float4>& pairs) {
   return flat_eval(r, program, "test_sheen_eval", pairs, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen,
                    tables);
@@ -196,7 +174,7 @@ std::vector<SampledCase> sampled_cases() {
 // of the sampled directions against the pdf in equal-area cells
 TEST_P(Sheen, SamplingMatchesThePdf) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  Tables t(r, r.program, r.program_cache_file);
+  AlbedoTables t(r, r.program, r.program_cache_file);
   // rusticl (llvmpipe) integrates the pdf on a coarser grid and leaves out grazing wo, whose
   // narrow lobes need the fine one
   bool fast = std::string(GetParam()) == "rusticl";
@@ -247,7 +225,7 @@ Albedo albedo(const Sampled& s) {
 // with it
 TEST_P(Sheen, WhiteFurnaceStaysAtMostOne) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
-  Tables t(r, r.program, r.program_cache_file);
+  AlbedoTables t(r, r.program, r.program_cache_file);
   size_t n = samples_on(GetParam(), kSheenSamples) / 4;
   for (double sr : {0.0, 0.3, 0.7, 1.0})
     for (double z : {0.9, 0.4, 0.1, 0.02}) {
@@ -281,7 +259,7 @@ TEST_P(Sheen, ColourZeroIsTheMaterialWithoutTheFeature) {
   CANDELA_RIG_OR_SKIP(GetParam(), r);
   ProgramBuild plain = build_program(r.context, r.device, test_program_source(),
                                      std::string(kTestProgramOptions) + " -DCD_FEATURE_SHEEN=0");
-  Tables t(r, r.program, r.program_cache_file), tp(r, plain.program, plain.cache_file);
+  AlbedoTables t(r, r.program, r.program_cache_file), tp(r, plain.program, plain.cache_file);
   dev::Material cases[] = {
       material(0.0, 0.4, glm::dvec3(0.0), 0.5),           material(1.0, 0.2, glm::dvec3(0.0), 0.5),
       material(0.0, 0.0, glm::dvec3(0.0), 0.5),           material(0.0, 0.1, glm::dvec3(0.0), 0.5, 1.0),
