@@ -28,6 +28,12 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   diel_average.setArg(0, *buffer);
   queue.enqueueNDRangeKernel(diel, cl::NullRange, cl::NDRange(DIEL_ALBEDO_N, DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
   queue.enqueueNDRangeKernel(diel_average, cl::NullRange, cl::NDRange(DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
+  cl::Kernel aniso(program, "energy_ggx_aniso_table"), aniso_average(program, "energy_ggx_aniso_average_table");
+  aniso.setArg(0, *buffer);
+  aniso.setArg(1, cl_uint(GGX_ANISO_QUADRATURE));
+  aniso_average.setArg(0, *buffer);
+  queue.enqueueNDRangeKernel(aniso, cl::NullRange, cl::NDRange(GGX_ANISO_N, GGX_ANISO_P, GGX_ANISO_R * GGX_ANISO_Q));
+  queue.enqueueNDRangeKernel(aniso_average, cl::NullRange, cl::NDRange(GGX_ANISO_R * GGX_ANISO_Q, 2));
   std::vector<float> table(GGX_ALBEDO_SIZE);
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
   return table;
