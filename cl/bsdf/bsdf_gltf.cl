@@ -426,7 +426,8 @@ float gltf_coat_below(const GltfAtWo* g, float3 wi) { return gltf_below(&g->coat
 
 // What the coat leaves of light transmitted into wi: one crossing, at the outside direction's angle
 float gltf_coat_across(const Bsdf* b, const GltfAtWo* g, float3 wi) {
-  return 1.0f - gltf_layer_albedo(&g->coat, energy_dir(b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi)));
+  return 1.0f -
+         gltf_layer_albedo(&g->coat, energy_dir(b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi)));
 }
 
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
@@ -461,8 +462,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   float3 dtrans = (float3)(0.0f);  // the diffuse transmission, layered as a reflection
 #if CD_FEATURE_DIFFUSE_TRANSMISSION
   if (wi.z < 0.0f && lobe->diffuse_transmission > 0.0f) {
-    dtrans = (1.0f - m) * (1.0f - t) * lobe->diffuse_transmission * gltf_below(&spec, (float3)(wi.x, wi.y, -wi.z)) * g->base_norm *
-             lobe->diffuse_transmission_color * INV_PI_F;
+    dtrans = (1.0f - m) * (1.0f - t) * lobe->diffuse_transmission * gltf_below(&spec, (float3)(wi.x, wi.y, -wi.z)) *
+             g->base_norm * lobe->diffuse_transmission_color * INV_PI_F;
     *pdf += w[GLTF_DIFFTRANS] * sample_cosine_hemisphere_pdf(-wi.z);
   }
 #endif

@@ -92,8 +92,8 @@ typedef struct {
   float alpha;                  // isotropic alpha of the lobe
   int row;                      // roughness cell [row, row + 1] and the weight of row + 1
   float t;
-  bool aniso;   // ax != ay: the anisotropic table, cells (row, t) in sqrt(a1) and (qrow, tq)
-  bool swap;    // its major axis is the frame's y
+  bool aniso;    // ax != ay: the anisotropic table, cells (row, t) in sqrt(a1) and (qrow, tq)
+  bool swap;     // its major axis is the frame's y
   float a1, a0;  // major and minor alpha
   int qrow;      // ratio cell in sqrt(a0 / a1)
   float tq;
@@ -125,8 +125,8 @@ __global const float* energy_aniso_average(__global const float* table, int part
 // E (part 0) or E5 (part 1) at (t, mu): bilinear in (coordinate, t) at each of the four
 // (roughness, ratio) corners, weighted by the lobe's cells
 float energy_aniso_lookup_at(const GgxEnergy* e, int part, float t, float mu) {
-  float x = clamp(energy_coordinate(part, mu, energy_aniso_alpha(e->a1, e->a0, t)), 0.0f, 1.0f) *
-            (float)(GGX_ANISO_N - 1);
+  float x =
+      clamp(energy_coordinate(part, mu, energy_aniso_alpha(e->a1, e->a0, t)), 0.0f, 1.0f) * (float)(GGX_ANISO_N - 1);
   int i = min((int)x, GGX_ANISO_N - 2);
   float s = x - (float)i;
   float xp = clamp(t, 0.0f, 1.0f) * (float)(GGX_ANISO_P - 1);
@@ -179,8 +179,10 @@ GgxEnergy energy_row(__global const float* table, int j) {
 }
 
 // 8-point Gauss-Legendre nodes and weights on [-1, 1] (half of them: +-x)
-#define ENERGY_GL_X {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f}
-#define ENERGY_GL_W {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f}
+#define ENERGY_GL_X \
+  { 0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f }
+#define ENERGY_GL_W \
+  { 0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f }
 
 // E_avg(r_j) = 2 integral of E mu dmu over the E that energy_albedo interpolates, so that
 // f_ms gives back 1 - E(mu_o) as looked up (exactly at the nodes of r, closely between
@@ -280,7 +282,8 @@ __kernel void energy_ggx_aniso_average_table(__global float* table) {
         float c = 0.5f * (a + b), h = 0.5f * (b - a), segment = 0.0f;
         for (int q = 0; q < 4; ++q) {
           float lo = c - h * x[q], hi = c + h * x[q];
-          segment += w[q] * (lo * energy_aniso_lookup_at(&e, part, t, lo) + hi * energy_aniso_lookup_at(&e, part, t, hi));
+          segment +=
+              w[q] * (lo * energy_aniso_lookup_at(&e, part, t, lo) + hi * energy_aniso_lookup_at(&e, part, t, hi));
         }
         sum += 2.0f * h * segment;
       }

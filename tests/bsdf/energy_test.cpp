@@ -305,10 +305,11 @@ TEST(Energy, WhiteAnisotropicLobesKeepTheirAlbedoAtEveryAzimuth) {
           auto with = r.albedo(m, true, wo, seed++, kSamples / 4);
           auto plastic_with = r.albedo(pl, true, wo, seed++, kSamples / 4);
           auto without = r.albedo(m, false, wo, seed++, kSamples / 8);
-          std::printf("  strength %.1f roughness %.1f theta %2.0f phi %2.0f: metal %.5f (SE %.5f), plastic %.5f (SE %.5f); "
-                      "metal without table %.4f\n",
-                      strength, roughness, theta, phi, with[1].mean, with[1].se, plastic_with[1].mean,
-                      plastic_with[1].se, without[1].mean);
+          std::printf(
+              "  strength %.1f roughness %.1f theta %2.0f phi %2.0f: metal %.5f (SE %.5f), plastic %.5f (SE %.5f); "
+              "metal without table %.4f\n",
+              strength, roughness, theta, phi, with[1].mean, with[1].se, plastic_with[1].mean, plastic_with[1].se,
+              without[1].mean);
           lowest = std::min({lowest, with[1].mean, plastic_with[1].mean});
           lowest_without = std::min(lowest_without, without[1].mean);
           for (const auto& a : {with[1], plastic_with[1]})
