@@ -209,6 +209,55 @@ __kernel void energy_ggx_average_table(__global float* table) {
   table[part * GGX_ALBEDO_HALF + GGX_ALBEDO_N * GGX_ALBEDO_N + j] = fmin(sum, 1.0f);
 }
 
+// The anisotropic cells of a lobe with ax != ay
+GgxEnergy energy_ggx_aniso(GgxEnergy e, Ggx g, float3 wo) {
+  e.aniso = true;
+  e.swap = g.ay > g.ax;
+  e.a1 = fmax(g.ax, g.ay);
+  e.a0 = fmin(g.ax, g.ay);
+  float x = clamp(sqrt(e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_R - 1);
+  e.row = min((int)x, GGX_ANISO_R - 2);
+  e.t = x - (float)e.row;
+  float xq = clamp(sqrt(e.a0 / e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_Q - 1);
+  e.qrow = min((int)xq, GGX_ANISO_Q - 2);
+  e.tq = xq - (float)e.qrow;
+  float avg[2];
+  for (int part = 0; part < 2; ++part) {
+    __global const float* lo = energy_aniso_average(e.table, part, e.row, e.qrow);
+    __global const float* hi = lo + GGX_ANISO_R;
+    avg[part] = mix(mix(lo[0], lo[1], e.t), mix(hi[0], hi[1], e.t), e.tq);
+  }
+  e.e_avg = avg[0];
+  e.e5_avg = avg[1];
+  e.e_o = energy_lookup(&e, 0, wo);
+  e.e5_o = energy_lookup(&e, 1, wo);
+  return e;
+}
+
+GgxEnergy energy_ggx(__global const float* table, Ggx g, float3 wo) {
+  GgxEnergy e;
+  e.table = ggx_is_delta(g) ? 0 : table;
+  e.alpha = sqrt(g.ax * g.ay);
+  e.row = 0;
+  e.t = 0.0f;
+  e.aniso = e.swap = false;
+  e.a1 = e.a0 = e.alpha;
+  e.qrow = 0;
+  e.tq = 0.0f;
+  e.e_o = e.e_avg = e.e5_o = e.e5_avg = 1.0f;
+  if (!e.table) return e;
+  if (g.ax != g.ay) return energy_ggx_aniso(e, g, wo);
+  float x = clamp(sqrt(e.alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
+  e.row = min((int)x, GGX_ALBEDO_N - 2);
+  e.t = x - (float)e.row;
+  __global const float* avg = table + GGX_ALBEDO_N * GGX_ALBEDO_N + e.row;
+  e.e_avg = mix(avg[0], avg[1], e.t);
+  e.e5_avg = mix(avg[GGX_ALBEDO_HALF], avg[GGX_ALBEDO_HALF + 1], e.t);
+  e.e_o = energy_albedo(&e, wo);
+  e.e5_o = energy_lookup(&e, 1, wo);
+  return e;
+}
+
 // The anisotropic lobe at node (j, k): major alpha a1 = r_j^2 along x, minor
 // a0 = max(q_k^2 a1, GGX_DELTA_ALPHA); j = 0 is the delta lobe
 Ggx energy_aniso_node_ggx(int j, int k) {
@@ -220,8 +269,9 @@ Ggx energy_aniso_node_ggx(int j, int k) {
 }
 
 // Table entries (i, l, j, k) as energy_ggx_albedo_table's, seen from the azimuth with
-// sin^2 = t_l; global size (N, P, R Q)
-__kernel void energy_ggx_aniso_table(__global float* table, uint n) {
+// sin^2 = t_l; global size (N, P, R Q). Without `exact`, the isotropic table's values at
+// alpha = sqrt(ax ay) instead of the quadrature (runs after the isotropic table and its averages).
+__kernel void energy_ggx_aniso_table(__global float* table, uint n, uint exact) {
   int i = (int)get_global_id(0), l = (int)get_global_id(1), jk = (int)get_global_id(2);
   if (i >= GGX_ANISO_N || l >= GGX_ANISO_P || jk >= GGX_ANISO_R * GGX_ANISO_Q) return;
   int j = jk % GGX_ANISO_R, k = jk / GGX_ANISO_R;
@@ -229,7 +279,13 @@ __kernel void energy_ggx_aniso_table(__global float* table, uint n) {
   float t = (float)l / (float)(GGX_ANISO_P - 1), c = sqrt(1.0f - t), sn = sqrt(t);
   float y = (float)i / (float)(GGX_ANISO_N - 1);
   float e = 1.0f, mu5 = y, m = 1.0f - mu5, e5 = m * m * m * m * m;
-  if (!ggx_is_delta(g)) {
+  if (!ggx_is_delta(g) && !exact) {
+    Ggx iso;
+    iso.ax = iso.ay = sqrt(g.ax * g.ay);
+    GgxEnergy approx = energy_ggx(table, iso, energy_dir(1.0f));
+    if (i > 0) e = energy_albedo(&approx, energy_dir(energy_mu(y, energy_aniso_alpha(g.ax, g.ay, t))));
+    e5 = energy_lookup(&approx, 1, energy_dir(mu5));
+  } else if (!ggx_is_delta(g)) {
     if (i > 0) {
       float mu = energy_mu(y, energy_aniso_alpha(g.ax, g.ay, t)), st = sqrt(fmax(0.0f, 1.0f - mu * mu));
       e = energy_ggx_albedo_quadrature_wo(g, (float3)(st * c, st * sn, mu), n).x;
@@ -293,55 +349,6 @@ __kernel void energy_ggx_aniso_average_table(__global float* table) {
   total /= 0.5f * PI_F;
   if (j == 0 && part == 0) total = 1.0f;
   *(__global float*)energy_aniso_average(table, part, j, k) = fmin(total, 1.0f);
-}
-
-// The anisotropic cells of a lobe with ax != ay
-GgxEnergy energy_ggx_aniso(GgxEnergy e, Ggx g, float3 wo) {
-  e.aniso = true;
-  e.swap = g.ay > g.ax;
-  e.a1 = fmax(g.ax, g.ay);
-  e.a0 = fmin(g.ax, g.ay);
-  float x = clamp(sqrt(e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_R - 1);
-  e.row = min((int)x, GGX_ANISO_R - 2);
-  e.t = x - (float)e.row;
-  float xq = clamp(sqrt(e.a0 / e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_Q - 1);
-  e.qrow = min((int)xq, GGX_ANISO_Q - 2);
-  e.tq = xq - (float)e.qrow;
-  float avg[2];
-  for (int part = 0; part < 2; ++part) {
-    __global const float* lo = energy_aniso_average(e.table, part, e.row, e.qrow);
-    __global const float* hi = lo + GGX_ANISO_R;
-    avg[part] = mix(mix(lo[0], lo[1], e.t), mix(hi[0], hi[1], e.t), e.tq);
-  }
-  e.e_avg = avg[0];
-  e.e5_avg = avg[1];
-  e.e_o = energy_lookup(&e, 0, wo);
-  e.e5_o = energy_lookup(&e, 1, wo);
-  return e;
-}
-
-GgxEnergy energy_ggx(__global const float* table, Ggx g, float3 wo) {
-  GgxEnergy e;
-  e.table = ggx_is_delta(g) ? 0 : table;
-  e.alpha = sqrt(g.ax * g.ay);
-  e.row = 0;
-  e.t = 0.0f;
-  e.aniso = e.swap = false;
-  e.a1 = e.a0 = e.alpha;
-  e.qrow = 0;
-  e.tq = 0.0f;
-  e.e_o = e.e_avg = e.e5_o = e.e5_avg = 1.0f;
-  if (!e.table) return e;
-  if (g.ax != g.ay) return energy_ggx_aniso(e, g, wo);
-  float x = clamp(sqrt(e.alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
-  e.row = min((int)x, GGX_ALBEDO_N - 2);
-  e.t = x - (float)e.row;
-  __global const float* avg = table + GGX_ALBEDO_N * GGX_ALBEDO_N + e.row;
-  e.e_avg = mix(avg[0], avg[1], e.t);
-  e.e5_avg = mix(avg[GGX_ALBEDO_HALF], avg[GGX_ALBEDO_HALF + 1], e.t);
-  e.e_o = energy_albedo(&e, wo);
-  e.e5_o = energy_lookup(&e, 1, wo);
-  return e;
 }
 
 // f_ms without its colour: (1 - E(wo)) (1 - E(wi)) / (pi (1 - E_avg)), wi above

@@ -91,7 +91,7 @@ dev::Material conductor(glm::dvec3 eta, glm::dvec3 k, double roughness) {
 // test process; EnergyDielectric.TableMatchesConvergedQuadrature checks a fresh computation)
 struct EnergyRig {
   const KernelRig& rig = kernel_rig("pocl");
-  GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file);
+  GgxAlbedoTable table = ggx_albedo_table(rig.context, rig.queue, rig.program, rig.program_cache_file, true);
 
   // (E(mu), E_avg, E5(mu), E5_avg) as the lobes look them up, for (mu, roughness) queries
   std::vector<cl_float4> lookup(const std::vector<cl_float2>& q) {
