@@ -5,9 +5,6 @@
 
 #include <CL/opencl.hpp>
 #include <string>
-#include <vector>
-
-#include "base/device_types.hpp"
 
 namespace candela {
 
@@ -20,13 +17,7 @@ struct GgxAlbedoTable {
 // The table for `program`, whose cache entry is `program_cache_file`
 // (ProgramBuild::cache_file; empty: no cache): loaded from beside it, else computed on the
 // device and stored there
-// The anisotropic part (lobes with ax != ay) is computed by quadrature only with `anisotropic`
-// (several minutes on rusticl); without it that part holds the isotropic table's values at
-// alpha = sqrt(ax ay), an approximation that costs next to nothing. The two are cached apart.
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
-                                const std::string& program_cache_file, bool anisotropic = false);
-
-// Whether some material has an anisotropic lobe (KHR_materials_anisotropy strength > 0)
-bool has_anisotropic_material(const std::vector<dev::Material>& materials);
+                                const std::string& program_cache_file);
 
 }  // namespace candela
