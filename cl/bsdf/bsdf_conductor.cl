@@ -31,12 +31,12 @@ float3 bsdf_conductor_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   float cos_oh;
   float f = ggx_reflection_eval(p->ggx, wo, wi, pdf, &cos_oh);
   float3 single = f * fresnel_conductor(cos_oh, p->eta, p->k);
-  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, wo.z);
+  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, energy_at(wo));
   if (!e.table || wo.z <= 0.0f || wi.z <= 0.0f) return single;
   float3 f_ms = energy_ms_fresnel(&e, p->f_avg);
   float q = bsdf_conductor_ms_share(p, &e, f_ms);
   *pdf = (1.0f - q) * *pdf + q * sample_cosine_hemisphere_pdf(wi.z);
-  return single + f_ms * energy_ms(&e, wi.z);
+  return single + f_ms * energy_ms(&e, energy_at(wi));
 }
 
 bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
@@ -51,7 +51,7 @@ bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSam
     return true;
   }
   if (wo.z <= 0.0f) return false;
-  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, wo.z);
+  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, energy_at(wo));
   float q = e.table ? bsdf_conductor_ms_share(p, &e, energy_ms_fresnel(&e, p->f_avg)) : 0.0f;
   if (uc < q)
     bs->wi = sample_cosine_hemisphere(u.x, u.y);
@@ -66,7 +66,7 @@ bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSam
 void bsdf_conductor_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
   const ConductorBsdf* p = &b->lobe.conductor;
   if (ggx_is_delta(p->ggx) || wo.z <= 0.0f) return;
-  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, wo.z);
+  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, energy_at(wo));
   float q = e.table ? bsdf_conductor_ms_share(p, &e, energy_ms_fresnel(&e, p->f_avg)) : 0.0f;
   bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(p->ggx), 1.0f - q);
   bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), q);

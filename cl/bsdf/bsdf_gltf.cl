@@ -164,10 +164,10 @@ float gltf_diffuse_transmission(const Bsdf* b) {
 }
 
 // The GGX albedo table looked up for the metal and plastic specular lobes, if any
-GgxEnergy gltf_energy(const Bsdf* b, float cos_o) {
+GgxEnergy gltf_energy(const Bsdf* b, EnergyDir wo) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   bool specular = lobe->metallic > 0.0f || (lobe->transmission < 1.0f && lobe->spec_f90 > 0.0f);
-  return energy_ggx(specular ? b->ggx_albedo : 0, lobe->ggx, cos_o);
+  return energy_ggx(specular ? b->ggx_albedo : 0, lobe->ggx, wo);
 }
 
 // A dielectric GGX layer with Schlick's Fresnel term (f0, f90) above something else
@@ -181,24 +181,32 @@ typedef struct {
   bool normalized;  // weight what lies below by W / (1 - a_avg)
 } GltfLayer;
 
-// A(mu) = f0 E(mu) + (f90 - f0) E5(mu) + (1 - E(mu)) F_ms, largest channel; a delta lobe
-// (or one without table) has E = 1 and E5 = (1 - mu)^5, so A = Schlick's F(mu)
-float gltf_layer_albedo(const GltfLayer* l, float mu) {
-  float e = 1.0f, e5 = schlick_weight(mu);
-  if (l->e.table) {
-    e = energy_lookup(&l->e, 0, mu);
-    e5 = energy_lookup(&l->e, 1, mu);
-  }
+// A(w) = f0 E(w) + (f90 - f0) E5(w) + (1 - E(w)) F_ms, largest channel, from E and E5
+float gltf_layer_albedo_of(const GltfLayer* l, float e, float e5) {
   return max_component(l->f0 * e + (l->f90 - l->f0) * e5 + (1.0f - e) * l->f_ms);
 }
 
-GltfLayer gltf_layer(GgxEnergy e, float3 f0, float f90, float3 f_ms, float cos_o, bool normalized) {
+// A(w); a delta lobe (or one without table) has E = 1 and E5 = (1 - mu)^5, so A = Schlick's
+// F(mu). Only w.z counts for isotropic lobes.
+float gltf_layer_albedo(const GltfLayer* l, EnergyDir w) {
+  if (!l->e.table) return gltf_layer_albedo_of(l, 1.0f, schlick_weight(energy_dir_mu(w)));
+  return gltf_layer_albedo_of(l, energy_lookup(&l->e, 0, w), energy_lookup(&l->e, 1, w));
+}
+
+// A(mu) of the clear coat, an isotropic layer: lookups by mu alone, so that kernels with
+// CD_FEATURE_ANISOTROPY do not compile the anisotropic lookup at each of the coat's
+float gltf_coat_albedo(const GltfLayer* l, float mu) {
+  if (!l->e.table) return gltf_layer_albedo_of(l, 1.0f, schlick_weight(mu));
+  return gltf_layer_albedo_of(l, energy_lookup_mu(&l->e, 0, mu), energy_lookup_mu(&l->e, 1, mu));
+}
+
+// The layer without its albedo at wo, a_o (the caller's)
+GltfLayer gltf_layer(GgxEnergy e, float3 f0, float f90, float3 f_ms, bool normalized) {
   GltfLayer l;
   l.e = e;
   l.f0 = f0;
   l.f90 = f90;
   l.f_ms = e.table ? f_ms : (float3)(0.0f);
-  l.a_o = gltf_layer_albedo(&l, cos_o);
   float3 avg = e.table ? f0 * e.e_avg + (f90 - f0) * e.e5_avg + (1.0f - e.e_avg) * l.f_ms
                        : energy_schlick_average(f0, (float3)(f90));
   l.a_avg = max_component(avg);
@@ -207,45 +215,62 @@ GltfLayer gltf_layer(GgxEnergy e, float3 f0, float f90, float3 f_ms, float cos_o
 }
 
 // The plastic's specular layer over its diffuse base, normalized where the table is bound
-GltfLayer gltf_spec_layer(const Bsdf* b, const GgxEnergy* e, float cos_o) {
+GltfLayer gltf_spec_layer(const Bsdf* b, const GgxEnergy* e, EnergyDir wo) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   float3 f_ms = energy_ms_fresnel(e, energy_schlick_average(lobe->spec_f0, (float3)(lobe->spec_f90)));
-  return gltf_layer(*e, lobe->spec_f0, lobe->spec_f90, f_ms, cos_o, b->ggx_albedo != 0);
+  GltfLayer l = gltf_layer(*e, lobe->spec_f0, lobe->spec_f90, f_ms, b->ggx_albedo != 0);
+  // A(wo) from E(wo) and E5(wo) as energy_ggx looked them up (Schlick's F without the table)
+  l.a_o = gltf_layer_albedo_of(&l, e->table ? e->e_o : 1.0f, e->table ? e->e5_o : schlick_weight(energy_dir_mu(wo)));
+  return l;
 }
 
 // The clearcoat: Schlick(0.04, 1) weighted by the coat factor, never normalized
 GltfLayer gltf_coat_layer(const Bsdf* b, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  GgxEnergy e = energy_ggx(lobe->coat > 0.0f ? b->ggx_albedo : 0, lobe->coat_ggx, cos_o);
-  return gltf_layer(e, (float3)(0.04f * lobe->coat), lobe->coat, (float3)(0.0f), cos_o, false);
+  GgxEnergy e = energy_ggx_mu(lobe->coat > 0.0f ? b->ggx_albedo : 0, lobe->coat_ggx, cos_o);
+  GltfLayer l = gltf_layer(e, (float3)(0.04f * lobe->coat), lobe->coat, (float3)(0.0f), false);
+  l.a_o = gltf_coat_albedo(&l, cos_o);
+  return l;
 }
 
-// W(mu_o, mu_i) of what lies below the layer, both directions above
-float gltf_below(const GltfLayer* l, float cos_i) {
-  float w = (1.0f - l->a_o) * (1.0f - gltf_layer_albedo(l, cos_i));
+// W(wo, wi) of what lies below the layer, both directions above, from its albedo a_i at wi
+float gltf_below_of(const GltfLayer* l, float a_i) {
+  float w = (1.0f - l->a_o) * (1.0f - a_i);
   return fmax(l->normalized ? w / (1.0f - l->a_avg) : w, 0.0f);
 }
+
+float gltf_below(const GltfLayer* l, EnergyDir wi) { return gltf_below_of(l, gltf_layer_albedo(l, wi)); }
 
 // The diffuse base under the coat and the specular layer gets their transmittance
 // T = (1 - A_c)(1 - A_s) at both directions, normalized by T_avg = 2 integral of T mu dmu
 // (as gltf_below does for one layer): a white base returns exactly T(mu_o), and the light
 // trapped under the coat is not lost. Returns the factor (1 - A_s,avg) / T_avg that turns the
 // specular layer's own normalization into this one; 1 without the table or the coat.
-// T_avg by 8-point Gauss-Legendre quadrature on [0, 1/4] and [1/4, 1] (A is steep at grazing).
+// T_avg by 8-point Gauss-Legendre quadrature on [0, 1/4] and [1/4, 1] (A is steep at grazing);
+// under an anisotropic specular layer also over four azimuths (midpoints in [0, pi / 2]).
 float gltf_coat_base_norm(const Bsdf* b, const GltfLayer* coat, const GltfLayer* spec) {
   if (b->lobe.gltf.coat <= 0.0f || !spec->normalized || !b->ggx_albedo) return 1.0f;
-  const float x[4] = {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f};
-  const float w[4] = {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f};
+  const float x[4] = ENERGY_GL_X;
+  const float w[4] = ENERGY_GL_W;
+#if CD_FEATURE_ANISOTROPY
+  int azimuths = spec->e.aniso ? 4 : 1;
+#else
+  const int azimuths = 1;
+#endif
+  // One loop over (azimuth, interval, node, sign), so that its body (the anisotropic lookup
+  // with CD_FEATURE_ANISOTROPY) is compiled once, not once per unrolled point
   float sum = 0.0f;
-  for (int part = 0; part < 2; ++part) {
+  for (int n = 0; n < 16 * azimuths; ++n) {
+    int a = n >> 4, part = (n >> 3) & 1, k = (n >> 1) & 3;
+    float phi = ((float)a + 0.5f) * (0.5f * PI_F) / (float)azimuths, c_phi = azimuths > 1 ? cos(phi) : 1.0f,
+          s_phi = azimuths > 1 ? sin(phi) : 0.0f;
     float c = part ? 0.625f : 0.125f, h = part ? 0.375f : 0.125f;
-    for (int k = 0; k < 4; ++k)
-      for (int sign = -1; sign <= 1; sign += 2) {
-        float mu = c + (float)sign * h * x[k];
-        float t = (1.0f - gltf_layer_albedo(coat, mu)) * (1.0f - gltf_layer_albedo(spec, mu));
-        sum += 2.0f * h * w[k] * mu * t;
-      }
+    float mu = c + (n & 1 ? h : -h) * x[k], st = sqrt(fmax(0.0f, 1.0f - mu * mu));
+    EnergyDir d = energy_at((float3)(st * c_phi, st * s_phi, mu));
+    float t = (1.0f - gltf_coat_albedo(coat, mu)) * (1.0f - gltf_layer_albedo(spec, d));
+    sum += 2.0f * h * w[k] * mu * t;
   }
+  sum /= (float)azimuths;
   return sum > 0.0f ? (1.0f - spec->a_avg) / sum : 1.0f;
 }
 
@@ -379,9 +404,9 @@ float gltf_glass_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
 GltfAtWo gltf_at_wo(const Bsdf* b, float3 wo) {
   GltfAtWo g;
   float cos_o = wo.z;
-  g.e = gltf_energy(b, cos_o);
+  g.e = gltf_energy(b, energy_at(wo));
   gltf_fresnel(b, cos_o, &g.f_metal_o, &g.f_spec_o);
-  g.spec = gltf_spec_layer(b, &g.e, cos_o);
+  g.spec = gltf_spec_layer(b, &g.e, energy_at(wo));
   g.coat_tilted = b->lobe.gltf.coat_own_normal;
   g.coat_o = cos_o;
   if (g.coat_tilted) {
@@ -413,11 +438,13 @@ float gltf_coat_mu(const GltfAtWo* g, float3 w) {
 }
 
 // What the coat leaves of light reflected below it into wi (both crossings)
-float gltf_coat_below(const GltfAtWo* g, float3 wi) { return gltf_below(&g->coat, gltf_coat_mu(g, wi)); }
+float gltf_coat_below(const GltfAtWo* g, float3 wi) {
+  return gltf_below_of(&g->coat, gltf_coat_albedo(&g->coat, gltf_coat_mu(g, wi)));
+}
 
 // What the coat leaves of light transmitted into wi: one crossing, at the outside direction's angle
 float gltf_coat_across(const Bsdf* b, const GltfAtWo* g, float3 wi) {
-  return 1.0f - gltf_layer_albedo(&g->coat, b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi));
+  return 1.0f - gltf_coat_albedo(&g->coat, b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi));
 }
 
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
@@ -435,8 +462,14 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
     bool glossy = m > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
     if (glossy) d = ggx_reflection_eval(lobe->ggx, wo, wi, &p, &cos_h);
-    under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) * gltf_below(&spec, wi.z) * g->base_norm *
-            b->base_color * INV_PI_F;
+    // E(wi) and E5(wi) of the specular lobe, looked up once for the layering and f_ms
+    float e_i = 1.0f, e5_i = schlick_weight(wi.z);
+    if (e.table) {
+      e_i = energy_lookup(&e, 0, energy_at(wi));
+      e5_i = energy_lookup(&e, 1, energy_at(wi));
+    }
+    under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) *
+            gltf_below_of(&spec, gltf_layer_albedo_of(&spec, e_i, e5_i)) * g->base_norm * b->base_color * INV_PI_F;
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
       float3 fm, fd;
@@ -445,14 +478,15 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
       *pdf += (w[GLTF_METAL] + w[GLTF_SPEC]) * p;
     }
     if (e.table) {
-      under += gltf_ms_fresnel(b, &e) * energy_ms(&e, wi.z);
+      if (e.e_avg < 1.0f) under += gltf_ms_fresnel(b, &e) * energy_ms_of(&e, e_i);
       *pdf += w[GLTF_MS] * sample_cosine_hemisphere_pdf(wi.z);
     }
   }
   float3 dtrans = (float3)(0.0f);  // the diffuse transmission, layered as a reflection
 #if CD_FEATURE_DIFFUSE_TRANSMISSION
   if (wi.z < 0.0f && lobe->diffuse_transmission > 0.0f) {
-    dtrans = (1.0f - m) * (1.0f - t) * lobe->diffuse_transmission * gltf_below(&spec, -wi.z) * g->base_norm *
+    dtrans = (1.0f - m) * (1.0f - t) * lobe->diffuse_transmission *
+             gltf_below(&spec, energy_at((float3)(wi.x, wi.y, -wi.z))) * g->base_norm *
              lobe->diffuse_transmission_color * INV_PI_F;
     *pdf += w[GLTF_DIFFTRANS] * sample_cosine_hemisphere_pdf(-wi.z);
   }

@@ -10,8 +10,12 @@
 // E and E_avg come from the table of the ggx_albedo scene buffer, computed on each device
 // by the two table kernels below, which integrate the lobe's own sampling and evaluation
 // (host/energy.cpp runs them before the first launch and caches the result beside the
-// program binary). The table covers isotropic lobes; anisotropic ones use it at alpha =
-// sqrt(ax ay), an approximation (albedo within a few percent of the exact compensation).
+// program binary). Anisotropic lobes (ax != ay) have E(wo) depending on the azimuth of wo as
+// well: a table of its own over (mu, azimuth, major roughness, ratio), whose lookups take
+// directions, so f_ms stays reciprocal and returns exactly the looked-up 1 - E(wo). That
+// table and its lookups are compiled in with CD_FEATURE_ANISOTROPY; a kernel without it
+// looks anisotropic lobes up in the isotropic table at alpha = sqrt(ax ay) (the test
+// program's lobes; a scene's kernel has the feature whenever a material is anisotropic).
 
 // The table's coordinates: glTF roughness r = sqrt(alpha), and y with y^2 = mu (1 + c) /
 // (mu + c), c = 4 alpha. Near grazing E depends on mu / alpha: it rises steeply to 1 at
@@ -35,8 +39,7 @@ float energy_mu(float y, float alpha) {
 // rim of the visible-normal disk, where GGX's long tail lies (within 2e-4 of the
 // converged integral at n = GGX_ALBEDO_QUADRATURE). Schlick's Fresnel term then gives the
 // lobe's albedo f0 E + (f90 - f0) E5.
-float2 energy_ggx_albedo_quadrature(Ggx g, float mu, uint n) {
-  float3 wo = (float3)(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+float2 energy_ggx_albedo_quadrature_wo(Ggx g, float3 wo, uint n) {
   float2 sum = (float2)(0.0f);
   float weights = 0.0f;
   for (uint a = 0u; a < n; ++a) {
@@ -60,6 +63,11 @@ float2 energy_ggx_albedo_quadrature(Ggx g, float mu, uint n) {
   return sum / weights;  // the weights' own sum, not their integral 1: no O(1 / n^2) bias
 }
 
+// The same seen from mu in the xz-plane
+float2 energy_ggx_albedo_quadrature(Ggx g, float mu, uint n) {
+  return energy_ggx_albedo_quadrature_wo(g, (float3)(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu), n);
+}
+
 // Table entries (i, j): E(mu(y_i), r_j) and E5(mu_i = i / (N - 1), r_j). E5 has its nodes
 // uniform in mu: for smooth lobes it is close to (1 - mu)^5 over the whole range of mu,
 // which y would crowd into its last cell. The delta lobe at r = 0 reflects about the
@@ -78,24 +86,90 @@ __kernel void energy_ggx_albedo_table(__global float* table, uint n) {
   table[GGX_ALBEDO_HALF + j * GGX_ALBEDO_N + i] = clamp(e5, 0.0f, 1.0f);
 }
 
-// The table looked up for one lobe seen from mu_o: the roughness cell, E(mu_o), E_avg and
-// the same for E5. No table (compensation off) or a delta lobe: nothing to compensate,
-// E = 1 (E5 is then unused).
+// The table looked up for one lobe seen from wo: the roughness cell, E(wo), E_avg and the
+// same for E5. No table (compensation off) or a delta lobe: nothing to compensate, E = 1
+// (E5 is then unused). An anisotropic lobe also has its ratio cell, and its lookups take
+// the azimuth from its major axis.
 typedef struct {
   __global const float* table;  // 0: no compensation
   float alpha;                  // isotropic alpha of the lobe
   int row;                      // roughness cell [row, row + 1] and the weight of row + 1
   float t;
+#if CD_FEATURE_ANISOTROPY
+  bool aniso;    // ax != ay: the anisotropic table, cells (row, t) in sqrt(a1) and (qrow, tq)
+  bool swap;     // its major axis is the frame's y
+  float a1, a0;  // major and minor alpha
+  int qrow;      // ratio cell in sqrt(a0 / a1)
+  float tq;
+#endif
   float e_o, e_avg;
   float e5_o, e5_avg;
 } GgxEnergy;
+
+// What a lookup needs of a direction w (local frame): the direction itself with
+// CD_FEATURE_ANISOTROPY, else only its cosine mu = w.z. energy_at(w) makes one from w,
+// energy_dir(mu) one at cosine mu (in the xz-plane), energy_dir_mu(d) gives back mu.
+#if CD_FEATURE_ANISOTROPY
+typedef float3 EnergyDir;
+#define energy_at(w) (w)
+#define energy_dir_mu(d) ((d).z)
+EnergyDir energy_dir(float mu) { return (float3)(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu); }
+#else
+typedef float EnergyDir;
+#define energy_at(w) ((w).z)
+#define energy_dir_mu(d) (d)
+#define energy_dir(mu) (mu)
+#endif
 
 // The coordinate of mu in part 0 (E: y) or part 1 (E5: mu itself), in [0, 1]
 float energy_coordinate(int part, float mu, float alpha) { return part ? mu : energy_y(mu, alpha); }
 float energy_coordinate_mu(int part, float x, float alpha) { return part ? x : energy_mu(x, alpha); }
 
-// E(mu) (part 0) or E5(mu) (part 1) interpolated bilinearly in (coordinate, r)
-float energy_lookup(const GgxEnergy* e, int part, float mu) {
+#if CD_FEATURE_ANISOTROPY
+// The anisotropic table: t = sin^2 of the azimuth from the major axis (nodes uniform in t:
+// E is a smooth even function of the azimuth, so a smooth function of cos 2 phi = 1 - 2 t)
+// and the alpha seen along it, sqrt(a1^2 cos^2 + a0^2 sin^2), which sets the y coordinate
+// as alpha does for isotropic lobes
+float energy_aniso_alpha(float a1, float a0, float t) { return sqrt(a1 * a1 * (1.0f - t) + a0 * a0 * t); }
+
+__global const float* energy_aniso_entry(__global const float* table, int part, int i, int l, int j, int k) {
+  return table + GGX_ANISO_OFFSET + part * GGX_ANISO_PART + ((k * GGX_ANISO_R + j) * GGX_ANISO_P + l) * GGX_ANISO_N + i;
+}
+
+__global const float* energy_aniso_average(__global const float* table, int part, int j, int k) {
+  return table + GGX_ANISO_OFFSET + part * GGX_ANISO_PART + GGX_ANISO_ROWS * GGX_ANISO_N + k * GGX_ANISO_R + j;
+}
+
+// E (part 0) or E5 (part 1) at (t, mu): bilinear in (coordinate, t) at each of the four
+// (roughness, ratio) corners, weighted by the lobe's cells
+float energy_aniso_lookup_at(const GgxEnergy* e, int part, float t, float mu) {
+  float x =
+      clamp(energy_coordinate(part, mu, energy_aniso_alpha(e->a1, e->a0, t)), 0.0f, 1.0f) * (float)(GGX_ANISO_N - 1);
+  int i = min((int)x, GGX_ANISO_N - 2);
+  float s = x - (float)i;
+  float xp = clamp(t, 0.0f, 1.0f) * (float)(GGX_ANISO_P - 1);
+  int l = min((int)xp, GGX_ANISO_P - 2);
+  float sp = xp - (float)l;
+  float sum = 0.0f;
+  for (int dk = 0; dk < 2; ++dk)
+    for (int dj = 0; dj < 2; ++dj) {
+      float w = (dk ? e->tq : 1.0f - e->tq) * (dj ? e->t : 1.0f - e->t);
+      __global const float* c = energy_aniso_entry(e->table, part, i, l, e->row + dj, e->qrow + dk);
+      sum += w * mix(mix(c[0], c[1], s), mix(c[GGX_ANISO_N], c[GGX_ANISO_N + 1], s), sp);
+    }
+  return sum;
+}
+
+// sin^2 of the azimuth of w from the lobe's major axis (0 at the normal)
+float energy_aniso_t(const GgxEnergy* e, float3 w) {
+  float c = e->swap ? w.y : w.x, s = e->swap ? w.x : w.y;
+  float r2 = c * c + s * s;
+  return r2 > 0.0f ? s * s / r2 : 0.0f;
+}
+#endif
+
+// E(mu) (part 0) or E5(mu) (part 1) of an isotropic lobe: bilinear in (coordinate, r)
+float energy_lookup_mu(const GgxEnergy* e, int part, float mu) {
   float x = clamp(energy_coordinate(part, mu, e->alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
   int i = min((int)x, GGX_ALBEDO_N - 2);
   float s = x - (float)i;
@@ -104,26 +178,52 @@ float energy_lookup(const GgxEnergy* e, int part, float mu) {
   return mix(mix(lo[0], lo[1], s), mix(hi[0], hi[1], s), e->t);
 }
 
-float energy_albedo(const GgxEnergy* e, float mu) { return energy_lookup(e, 0, mu); }
+// E(w) (part 0) or E5(w) (part 1) of any lobe
+float energy_lookup(const GgxEnergy* e, int part, EnergyDir w) {
+#if CD_FEATURE_ANISOTROPY
+  if (e->aniso) return energy_aniso_lookup_at(e, part, energy_aniso_t(e, w), w.z);
+#endif
+  return energy_lookup_mu(e, part, energy_dir_mu(w));
+}
 
-// The lookup at row j exactly (no interpolation in roughness)
-GgxEnergy energy_row(__global const float* table, int j) {
+float energy_albedo(const GgxEnergy* e, EnergyDir w) { return energy_lookup(e, 0, w); }
+
+// An isotropic lookup of alpha in roughness cell (row, t), nothing looked up yet (E = 1)
+GgxEnergy energy_cell(__global const float* table, float alpha, int row, float t) {
   GgxEnergy e;
   e.table = table;
-  e.alpha = energy_node(j) * energy_node(j);
-  e.row = min(j, GGX_ALBEDO_N - 2);
-  e.t = (float)(j - e.row);
+  e.alpha = alpha;
+  e.row = row;
+  e.t = t;
+#if CD_FEATURE_ANISOTROPY
+  e.aniso = e.swap = false;
+  e.a1 = e.a0 = e.alpha;
+  e.qrow = 0;
+  e.tq = 0.0f;
+#endif
   e.e_o = e.e_avg = e.e5_o = e.e5_avg = 1.0f;
   return e;
 }
+
+// The lookup at row j exactly (no interpolation in roughness)
+GgxEnergy energy_row(__global const float* table, int j) {
+  int row = min(j, GGX_ALBEDO_N - 2);
+  return energy_cell(table, energy_node(j) * energy_node(j), row, (float)(j - row));
+}
+
+// 8-point Gauss-Legendre nodes and weights on [-1, 1] (half of them: +-x)
+#define ENERGY_GL_X \
+  { 0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f }
+#define ENERGY_GL_W \
+  { 0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f }
 
 // E_avg(r_j) = 2 integral of E mu dmu over the E that energy_albedo interpolates, so that
 // f_ms gives back 1 - E(mu_o) as looked up (exactly at the nodes of r, closely between
 // them): 8-point Gauss-Legendre in mu between the mu of consecutive nodes; the same for E5.
 // E_avg of the delta row is 1. Runs after energy_ggx_albedo_table; global size (N, 2).
 __kernel void energy_ggx_average_table(__global float* table) {
-  const float x[4] = {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f};
-  const float w[4] = {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f};
+  const float x[4] = ENERGY_GL_X;
+  const float w[4] = ENERGY_GL_W;
   int j = (int)get_global_id(0), part = (int)get_global_id(1);
   if (j >= GGX_ALBEDO_N || part > 1) return;
   GgxEnergy e = energy_row(table, j);
@@ -134,7 +234,7 @@ __kernel void energy_ggx_average_table(__global float* table) {
     float c = 0.5f * (a + b), h = 0.5f * (b - a), segment = 0.0f;
     for (int k = 0; k < 4; ++k) {
       float lo = c - h * x[k], hi = c + h * x[k];
-      segment += w[k] * (lo * energy_lookup(&e, part, lo) + hi * energy_lookup(&e, part, hi));
+      segment += w[k] * (lo * energy_lookup(&e, part, energy_dir(lo)) + hi * energy_lookup(&e, part, energy_dir(hi)));
     }
     sum += 2.0f * h * segment;
   }
@@ -142,13 +242,37 @@ __kernel void energy_ggx_average_table(__global float* table) {
   table[part * GGX_ALBEDO_HALF + GGX_ALBEDO_N * GGX_ALBEDO_N + j] = fmin(sum, 1.0f);
 }
 
-GgxEnergy energy_ggx(__global const float* table, Ggx g, float mu_o) {
-  GgxEnergy e;
-  e.table = ggx_is_delta(g) ? 0 : table;
-  e.alpha = sqrt(g.ax * g.ay);
-  e.row = 0;
-  e.t = 0.0f;
-  e.e_o = e.e_avg = e.e5_o = e.e5_avg = 1.0f;
+#if CD_FEATURE_ANISOTROPY
+// The anisotropic cells of a lobe with ax != ay
+GgxEnergy energy_ggx_aniso(GgxEnergy e, Ggx g, float3 wo) {
+  e.aniso = true;
+  e.swap = g.ay > g.ax;
+  e.a1 = fmax(g.ax, g.ay);
+  e.a0 = fmin(g.ax, g.ay);
+  float x = clamp(sqrt(e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_R - 1);
+  e.row = min((int)x, GGX_ANISO_R - 2);
+  e.t = x - (float)e.row;
+  float xq = clamp(sqrt(e.a0 / e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_Q - 1);
+  e.qrow = min((int)xq, GGX_ANISO_Q - 2);
+  e.tq = xq - (float)e.qrow;
+  float avg[2];
+  for (int part = 0; part < 2; ++part) {
+    __global const float* lo = energy_aniso_average(e.table, part, e.row, e.qrow);
+    __global const float* hi = lo + GGX_ANISO_R;
+    avg[part] = mix(mix(lo[0], lo[1], e.t), mix(hi[0], hi[1], e.t), e.tq);
+  }
+  e.e_avg = avg[0];
+  e.e5_avg = avg[1];
+  e.e_o = energy_lookup(&e, 0, wo);
+  e.e5_o = energy_lookup(&e, 1, wo);
+  return e;
+}
+#endif
+
+// The table looked up for an isotropic lobe seen from mu_o (a lobe known to be isotropic, such
+// as the clear coat, whose lookups then take mu alone: energy_lookup_mu)
+GgxEnergy energy_ggx_mu(__global const float* table, Ggx g, float mu_o) {
+  GgxEnergy e = energy_cell(ggx_is_delta(g) ? 0 : table, sqrt(g.ax * g.ay), 0, 0.0f);
   if (!e.table) return e;
   float x = clamp(sqrt(e.alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
   e.row = min((int)x, GGX_ALBEDO_N - 2);
@@ -156,15 +280,124 @@ GgxEnergy energy_ggx(__global const float* table, Ggx g, float mu_o) {
   __global const float* avg = table + GGX_ALBEDO_N * GGX_ALBEDO_N + e.row;
   e.e_avg = mix(avg[0], avg[1], e.t);
   e.e5_avg = mix(avg[GGX_ALBEDO_HALF], avg[GGX_ALBEDO_HALF + 1], e.t);
-  e.e_o = energy_albedo(&e, mu_o);
-  e.e5_o = energy_lookup(&e, 1, mu_o);
+  e.e_o = energy_lookup_mu(&e, 0, mu_o);
+  e.e5_o = energy_lookup_mu(&e, 1, mu_o);
   return e;
 }
 
-// f_ms without its colour: (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)), wi above
-float energy_ms(const GgxEnergy* e, float mu_i) {
-  if (!e->table || mu_i <= 0.0f || e->e_avg >= 1.0f) return 0.0f;
-  return (1.0f - e->e_o) * (1.0f - energy_albedo(e, mu_i)) * INV_PI_F / (1.0f - e->e_avg);
+// The table looked up for any lobe seen from wo
+GgxEnergy energy_ggx(__global const float* table, Ggx g, EnergyDir wo) {
+  GgxEnergy e = energy_ggx_mu(table, g, energy_dir_mu(wo));
+#if CD_FEATURE_ANISOTROPY
+  if (e.table && g.ax != g.ay) return energy_ggx_aniso(e, g, wo);
+#endif
+  return e;
+}
+
+#if CD_FEATURE_ANISOTROPY
+// The anisotropic lobe at node (j, k): major alpha a1 = r_j^2 along x, minor
+// a0 = max(q_k^2 a1, GGX_DELTA_ALPHA); j = 0 is the delta lobe
+Ggx energy_aniso_node_ggx(int j, int k) {
+  float r = (float)j / (float)(GGX_ANISO_R - 1), q = (float)k / (float)(GGX_ANISO_Q - 1);
+  Ggx g;
+  g.ax = r * r;
+  g.ay = fmin(g.ax, fmax(q * q * g.ax, GGX_DELTA_ALPHA));
+  return g;
+}
+
+// Table entries (i, l, j, k) as energy_ggx_albedo_table's, seen from the azimuth with
+// sin^2 = t_l; global size (N, P, R Q). Without `exact`, the isotropic table's values at
+// alpha = sqrt(ax ay) instead of the quadrature (runs after the isotropic table and its averages).
+__kernel void energy_ggx_aniso_table(__global float* table, uint n, uint exact) {
+  int i = (int)get_global_id(0), l = (int)get_global_id(1), jk = (int)get_global_id(2);
+  if (i >= GGX_ANISO_N || l >= GGX_ANISO_P || jk >= GGX_ANISO_R * GGX_ANISO_Q) return;
+  int j = jk % GGX_ANISO_R, k = jk / GGX_ANISO_R;
+  Ggx g = energy_aniso_node_ggx(j, k);
+  float t = (float)l / (float)(GGX_ANISO_P - 1), c = sqrt(1.0f - t), sn = sqrt(t);
+  float y = (float)i / (float)(GGX_ANISO_N - 1);
+  float e = 1.0f, mu5 = y, m = 1.0f - mu5, e5 = m * m * m * m * m;
+  if (!ggx_is_delta(g) && !exact) {
+    Ggx iso;
+    iso.ax = iso.ay = sqrt(g.ax * g.ay);
+    GgxEnergy approx = energy_ggx(table, iso, energy_dir(1.0f));
+    if (i > 0) e = energy_albedo(&approx, energy_dir(energy_mu(y, energy_aniso_alpha(g.ax, g.ay, t))));
+    e5 = energy_lookup(&approx, 1, energy_dir(mu5));
+  } else if (!ggx_is_delta(g)) {
+    if (i > 0) {
+      float mu = energy_mu(y, energy_aniso_alpha(g.ax, g.ay, t)), st = sqrt(fmax(0.0f, 1.0f - mu * mu));
+      e = energy_ggx_albedo_quadrature_wo(g, (float3)(st * c, st * sn, mu), n).x;
+    }
+    float mu = fmax(mu5, 1e-4f), st = sqrt(fmax(0.0f, 1.0f - mu * mu));
+    e5 = energy_ggx_albedo_quadrature_wo(g, (float3)(st * c, st * sn, mu), n).y;
+  }
+  int at = ((k * GGX_ANISO_R + j) * GGX_ANISO_P + l) * GGX_ANISO_N + i;
+  table[GGX_ANISO_OFFSET + at] = fmin(e, 1.0f);
+  table[GGX_ANISO_OFFSET + GGX_ANISO_PART + at] = clamp(e5, 0.0f, 1.0f);
+}
+
+// The lookup at node (j, k) exactly
+GgxEnergy energy_aniso_row(__global const float* table, int j, int k) {
+  Ggx g = energy_aniso_node_ggx(j, k);
+  GgxEnergy e = energy_row(table, 0);
+  e.aniso = true;
+  e.a1 = g.ax;
+  e.a0 = g.ay;
+  e.alpha = sqrt(g.ax * g.ay);
+  e.row = min(j, GGX_ANISO_R - 2);
+  e.t = (float)(j - e.row);
+  e.qrow = min(k, GGX_ANISO_Q - 2);
+  e.tq = (float)(k - e.qrow);
+  return e;
+}
+
+// E_avg(j, k) = (1 / pi) integral of E cos over the hemisphere as energy_lookup interpolates
+// it: the mean over the azimuth phi in [0, pi / 2] of 2 integral of E mu dmu, by 8-point
+// Gauss-Legendre in phi within each cell of t = sin^2 phi and in mu between the mu of
+// consecutive nodes (as energy_ggx_average_table). Global size (R Q, 2).
+__kernel void energy_ggx_aniso_average_table(__global float* table) {
+  const float x[4] = ENERGY_GL_X;
+  const float w[4] = ENERGY_GL_W;
+  int jk = (int)get_global_id(0), part = (int)get_global_id(1);
+  if (jk >= GGX_ANISO_R * GGX_ANISO_Q || part > 1) return;
+  int j = jk % GGX_ANISO_R, k = jk / GGX_ANISO_R;
+  GgxEnergy e = energy_aniso_row(table, j, k);
+  float total = 0.0f;
+  for (int l = 0; l + 1 < GGX_ANISO_P; ++l) {
+    float p0 = asin(sqrt((float)l / (float)(GGX_ANISO_P - 1)));
+    float p1 = asin(sqrt((float)(l + 1) / (float)(GGX_ANISO_P - 1)));
+    float pc = 0.5f * (p0 + p1), ph = 0.5f * (p1 - p0);
+    for (int kp = 0; kp < 8; ++kp) {
+      float phi = pc + (kp < 4 ? -ph * x[kp] : ph * x[kp - 4]), wphi = w[kp & 3];
+      float sp = sin(phi), t = sp * sp, alpha = energy_aniso_alpha(e.a1, e.a0, t), sum = 0.0f;
+      for (int i = 0; i + 1 < GGX_ANISO_N; ++i) {
+        float a = energy_coordinate_mu(part, (float)i / (float)(GGX_ANISO_N - 1), alpha);
+        float b = energy_coordinate_mu(part, (float)(i + 1) / (float)(GGX_ANISO_N - 1), alpha);
+        float c = 0.5f * (a + b), h = 0.5f * (b - a), segment = 0.0f;
+        for (int q = 0; q < 4; ++q) {
+          float lo = c - h * x[q], hi = c + h * x[q];
+          segment +=
+              w[q] * (lo * energy_aniso_lookup_at(&e, part, t, lo) + hi * energy_aniso_lookup_at(&e, part, t, hi));
+        }
+        sum += 2.0f * h * segment;
+      }
+      total += ph * wphi * sum;
+    }
+  }
+  total /= 0.5f * PI_F;
+  if (j == 0 && part == 0) total = 1.0f;
+  *(__global float*)energy_aniso_average(table, part, j, k) = fmin(total, 1.0f);
+}
+#endif
+
+// f_ms without its colour from E(wi) = e_i already looked up (table bound, E_avg < 1, wi above)
+float energy_ms_of(const GgxEnergy* e, float e_i) {
+  return (1.0f - e->e_o) * (1.0f - e_i) * INV_PI_F / (1.0f - e->e_avg);
+}
+
+// f_ms without its colour: (1 - E(wo)) (1 - E(wi)) / (pi (1 - E_avg)), wi above
+float energy_ms(const GgxEnergy* e, EnergyDir wi) {
+  if (!e->table || energy_dir_mu(wi) <= 0.0f || e->e_avg >= 1.0f) return 0.0f;
+  return energy_ms_of(e, energy_albedo(e, wi));
 }
 
 // Albedo of f_ms from wo: (1 - E(mu_o)) (times the colour of energy_ms_fresnel)

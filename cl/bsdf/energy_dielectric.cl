@@ -187,7 +187,8 @@ typedef struct {
   float p_refl;           // within it, the share of reflection: a_s A_s
 } DielectricMs;
 
-DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta, bool thin, float mu_o) {
+DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta, bool thin, EnergyDir wo) {
+  float mu_o = energy_dir_mu(wo);
   DielectricMs m;
   m.on = false;
   m.thin = thin;
@@ -199,7 +200,7 @@ DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta,
   // A_0, A_1: the missing averages of the rarer and the denser side
   float a_same, a_other, a0, a1, x;
   if (thin) {
-    m.ggx = energy_ggx(table, g, mu_o);
+    m.ggx = energy_ggx(table, g, wo);
     m.e_o = m.ggx.e_o;
     a_same = a_other = a0 = a1 = 1.0f - m.ggx.e_avg;
     x = 1.0f - energy_dielectric_fresnel_average(eta, true);
@@ -226,7 +227,7 @@ DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta,
 // E of the side of wi (wi.z < 0: the other side) at |wi.z|
 float energy_dielectric_e_at(const DielectricMs* m, float3 wi) {
   float mu = fabs(wi.z);
-  if (m->thin) return energy_albedo(&m->ggx, mu);
+  if (m->thin) return energy_albedo(&m->ggx, energy_at((float3)(wi.x, wi.y, mu)));
   return energy_dielectric_lookup(&m->diel, wi.z > 0.0f ? m->diel.side : 1 - m->diel.side, mu);
 }
 
@@ -250,7 +251,7 @@ float3 energy_dielectric_ms(const DielectricMs* m, float3 tint, float3 wi, float
 float3 energy_dielectric_eval(__global const float* table, Ggx g, float eta, bool thin, float3 tint, float3 wo,
                               float3 wi, float* pdf) {
   float3 f = bsdf_dielectric_eval(g, eta, thin, tint, wo, wi, pdf);
-  DielectricMs m = energy_dielectric_at(table, g, eta, thin, wo.z);
+  DielectricMs m = energy_dielectric_at(table, g, eta, thin, energy_at(wo));
   if (!m.on) return f;
   float ms_pdf;
   f += energy_dielectric_ms(&m, tint, wi, &ms_pdf);
@@ -262,7 +263,7 @@ float3 energy_dielectric_eval(__global const float* table, Ggx g, float eta, boo
 // sampled by the cosine on the side that p_refl picks
 bool energy_dielectric_sample(__global const float* table, Ggx g, float eta, bool thin, float3 tint, float3 wo,
                               float uc, float2 u, BsdfSample* bs) {
-  DielectricMs m = energy_dielectric_at(table, g, eta, thin, wo.z);
+  DielectricMs m = energy_dielectric_at(table, g, eta, thin, energy_at(wo));
   if (!m.on) return bsdf_dielectric_sample(g, eta, thin, tint, wo, uc, u, bs);
   if (uc < m.q) {
     float v = uc / m.q;

@@ -30,6 +30,7 @@
   X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
   X(dispersion, CD_FEATURE_DISPERSION, 1, "a refracting glTF material with dispersion > 0")         \
   X(iridescence, CD_FEATURE_IRIDESCENCE, 1, "a glTF-shaded KHR_materials_iridescence")             \
+  X(anisotropy, CD_FEATURE_ANISOTROPY, 1, "a glTF or conductor lobe with anisotropy strength > 0")  \
   X(unlit, CD_FEATURE_UNLIT, 1, "a mesh's material is KHR_materials_unlit")                        \
   X(punctual, CD_FEATURE_PUNCTUAL, 1, "an emitting KHR_lights_punctual light")                     \
   X(environment, CD_FEATURE_ENVIRONMENT, 1, "an environment map or a constant background")        \
@@ -150,7 +151,19 @@
 #define DIEL_ALBEDO_QUADRATURE 48  // quadrature points per side of each entry
 #define DIEL_ALBEDO_ROWS (2 * DIEL_ALBEDO_F * DIEL_ALBEDO_R)
 #define DIEL_ALBEDO_SIZE (DIEL_ALBEDO_ROWS * (DIEL_ALBEDO_N + 1))
-#define GGX_ALBEDO_SIZE (DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_SIZE)  // the whole buffer
+// Then the anisotropic GGX lobe's E and E5 (ax != ay; cl/bsdf/energy.cl): two parts (E, then
+// E5), each GGX_ANISO_N x GGX_ANISO_P x GGX_ANISO_R x GGX_ANISO_Q nodes (y or mu, the
+// azimuth's t = sin^2 phi from the major axis, sqrt of the major alpha, the ratio
+// sqrt(minor / major alpha)), y fastest, then its hemispherical averages by (roughness, ratio)
+#define GGX_ANISO_OFFSET (DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_SIZE)
+#define GGX_ANISO_N 32
+#define GGX_ANISO_P 8
+#define GGX_ANISO_R 16
+#define GGX_ANISO_Q 8
+#define GGX_ANISO_QUADRATURE 32  // quadrature points per side of each entry
+#define GGX_ANISO_ROWS (GGX_ANISO_P * GGX_ANISO_R * GGX_ANISO_Q)
+#define GGX_ANISO_PART (GGX_ANISO_ROWS * GGX_ANISO_N + GGX_ANISO_R * GGX_ANISO_Q)
+#define GGX_ALBEDO_SIZE (GGX_ANISO_OFFSET + 2 * GGX_ANISO_PART)  // the whole buffer
 
 // Sheen albedo table (cl/bsdf/sheen.cl): the directional albedo E(mu) of the Charlie sheen
 // lobe with colour 1 at SHEEN_ALBEDO_N x SHEEN_ALBEDO_N nodes (mu, sheen roughness), mu fastest,

@@ -14,7 +14,7 @@ namespace {
 constexpr size_t kBytes = GGX_ALBEDO_SIZE * sizeof(float);
 
 std::vector<float> compute_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
-                                 cl::Buffer* buffer) {
+                                 AnisotropicAlbedo anisotropic, cl::Buffer* buffer) {
   *buffer = cl::Buffer(context, CL_MEM_READ_WRITE, kBytes);
   cl::Kernel albedo(program, "energy_ggx_albedo_table"), average(program, "energy_ggx_average_table");
   albedo.setArg(0, *buffer);
@@ -29,21 +29,44 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   queue.enqueueNDRangeKernel(diel, cl::NullRange, cl::NDRange(DIEL_ALBEDO_N, DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
   queue.enqueueNDRangeKernel(diel_average, cl::NullRange, cl::NDRange(DIEL_ALBEDO_R, 2 * DIEL_ALBEDO_F));
   std::vector<float> table(GGX_ALBEDO_SIZE);
+  if (anisotropic != AnisotropicAlbedo::none) {
+    cl::Kernel aniso(program, "energy_ggx_aniso_table"), aniso_average(program, "energy_ggx_aniso_average_table");
+    aniso.setArg(0, *buffer);
+    aniso.setArg(1, cl_uint(GGX_ANISO_QUADRATURE));
+    aniso.setArg(2, cl_uint(anisotropic == AnisotropicAlbedo::exact));
+    aniso_average.setArg(0, *buffer);
+    queue.enqueueNDRangeKernel(aniso, cl::NullRange, cl::NDRange(GGX_ANISO_N, GGX_ANISO_P, GGX_ANISO_R * GGX_ANISO_Q));
+    queue.enqueueNDRangeKernel(aniso_average, cl::NullRange, cl::NDRange(GGX_ANISO_R * GGX_ANISO_Q, 2));
+  } else {
+    // Unread by a kernel without the feature; zeros, so the cached table is well defined
+    queue.enqueueFillBuffer(*buffer, 0.0f, GGX_ANISO_OFFSET * sizeof(float),
+                            (GGX_ALBEDO_SIZE - GGX_ANISO_OFFSET) * sizeof(float));
+  }
   queue.enqueueReadBuffer(*buffer, CL_TRUE, 0, kBytes, table.data());
   return table;
 }
 
 }  // namespace
 
+AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials) {
+  if (!kernel_feature) return AnisotropicAlbedo::none;
+  for (const dev::Material& m : materials) {
+    if (m.type == MATERIAL_GLTF && m.params.gltf.anisotropy_strength > 0.0f) return AnisotropicAlbedo::exact;
+    if (m.type == MATERIAL_CONDUCTOR && m.params.conductor.anisotropy_strength > 0.0f) return AnisotropicAlbedo::exact;
+  }
+  return AnisotropicAlbedo::approximate;
+}
+
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
-                                const std::string& program_cache_file) {
+                                const std::string& program_cache_file, AnisotropicAlbedo anisotropic) {
   auto start = std::chrono::steady_clock::now();
   GgxAlbedoTable t;
-  std::string path = program_cache_file.empty() ? "" : program_cache_file + ".ggx_albedo";
+  const char* suffix = anisotropic == AnisotropicAlbedo::exact ? ".ggx_albedo_aniso" : ".ggx_albedo";
+  std::string path = program_cache_file.empty() ? "" : program_cache_file + suffix;
   try {
     t.buffer = cached_device_table(
         context, path, GGX_ALBEDO_SIZE, 0.0f, 1.0f, "GGX albedos",
-        [&](cl::Buffer* buffer) { return compute_table(context, queue, program, buffer); }, &t.from_cache);
+        [&](cl::Buffer* buffer) { return compute_table(context, queue, program, anisotropic, buffer); }, &t.from_cache);
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("computing the GGX albedo table", e.err()));
   }

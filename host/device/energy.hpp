@@ -5,6 +5,9 @@
 
 #include <CL/opencl.hpp>
 #include <string>
+#include <vector>
+
+#include "base/device_types.hpp"
 
 namespace candela {
 
@@ -14,10 +17,22 @@ struct GgxAlbedoTable {
   bool from_cache = false;
 };
 
+// What the table's anisotropic part (lobes with ax != ay) holds. Only a program built with
+// CD_FEATURE_ANISOTROPY has the kernels that fill it and reads it: `none` for any other.
+// `exact` integrates it by quadrature (several minutes on rusticl, so only for scenes with an
+// anisotropic material); `approximate` fills it with the isotropic table's values at
+// alpha = sqrt(ax ay) at next to no cost (the generic kernel of a scene without anisotropy).
+enum class AnisotropicAlbedo { none, approximate, exact };
+
+// The part a scene's kernel needs: `none` without the feature, `exact` when some material
+// has anisotropy strength > 0, else `approximate`
+AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials);
+
 // The table for `program`, whose cache entry is `program_cache_file`
 // (ProgramBuild::cache_file; empty: no cache): loaded from beside it, else computed on the
-// device and stored there
+// device and stored there. The exact and approximate anisotropic parts are cached apart.
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
-                                const std::string& program_cache_file);
+                                const std::string& program_cache_file,
+                                AnisotropicAlbedo anisotropic = AnisotropicAlbedo::none);
 
 }  // namespace candela

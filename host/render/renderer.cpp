@@ -76,6 +76,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
                 " (CD_SCENE_BUFFERS out of step with the kernel)");
   local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
 
+  const AnisotropicAlbedo anisotropic = anisotropic_albedo(scene.features.anisotropy, scene.buffers.materials);
 #define CD_UPLOAD(type, name)                                                     \
   scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name)); \
   if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);
@@ -83,7 +84,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
 #undef CD_UPLOAD
   if (settings.energy_compensation)
     scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
-        ggx_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
+        ggx_albedo_table(context_, queue_, build.program, build.cache_file, anisotropic).buffer;
   if (scene.features.sheen)
     scene_buffers_[unsigned(dev::SceneBuffer::sheen_albedo)] =
         sheen_albedo_table(context_, queue_, build.program, build.cache_file).buffer;

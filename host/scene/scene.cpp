@@ -26,6 +26,10 @@ bool MaterialDesc::has_dispersion() const {
 }
 bool MaterialDesc::has_iridescence() const { return kernel_type() == MATERIAL_GLTF && iridescence > 0.0f; }
 
+bool MaterialDesc::has_anisotropy() const {
+  return (kernel_type() == MATERIAL_GLTF || kernel_type() == MATERIAL_CONDUCTOR) && anisotropy_strength > 0.0f;
+}
+
 bool MaterialDesc::alpha_tested() const {
   bool textured = texture(TEX_BASE_COLOR).index != NO_TEXTURE;
   if (alpha_mode == AlphaMode::Mask) return textured || base_color.a < alpha_cutoff;
@@ -92,6 +96,7 @@ SceneFeatures Scene::features() const {
     f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
     f.dispersion |= materials.at(m.material).has_dispersion();
     f.iridescence |= materials.at(m.material).has_iridescence();
+    f.anisotropy |= materials.at(m.material).has_anisotropy();
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

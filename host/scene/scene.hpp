@@ -109,6 +109,8 @@ struct MaterialDesc {
   bool has_dispersion() const;
   // A glTF-shaded material with a thin film (KHR_materials_iridescence)
   bool has_iridescence() const;
+  // A glTF-shaded or conductor material with an anisotropic lobe (KHR_materials_anisotropy)
+  bool has_anisotropy() const;
 };
 
 struct TextureDesc {

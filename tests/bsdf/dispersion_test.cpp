@@ -37,8 +37,9 @@ KernelRig& dispersion_rig() {
   static std::unique_ptr<KernelRig> rig;
   if (!rig) {
     KernelRig& shared = kernel_rig("pocl");
-    ProgramBuild b = build_program(shared.context, shared.device, test_program_source(),
-                                   "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=1 -DCD_FEATURE_IRIDESCENCE=0");
+    ProgramBuild b =
+        build_program(shared.context, shared.device, test_program_source(),
+                      "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=1 -DCD_FEATURE_IRIDESCENCE=0 -DCD_FEATURE_ANISOTROPY=0");
     rig = std::make_unique<KernelRig>(shared.device, shared.context, b.program);
   }
   return *rig;

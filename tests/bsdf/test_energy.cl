@@ -5,7 +5,7 @@
 // (E(mu), E_avg, E5(mu), E5_avg) for queries (mu, glTF roughness) of an isotropic lobe
 __kernel void test_energy_lookup(__global const float* table, __global const float2* queries, __global float4* out) {
   uint i = get_global_id(0);
-  GgxEnergy e = energy_ggx(table, ggx_from_roughness(queries[i].y, 0.0f), queries[i].x);
+  GgxEnergy e = energy_ggx(table, ggx_from_roughness(queries[i].y, 0.0f), energy_dir(queries[i].x));
   out[i] = (float4)(e.e_o, e.e_avg, e.e5_o, e.e5_avg);
 }
 

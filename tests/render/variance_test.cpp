@@ -285,11 +285,12 @@ TEST(Specialization, FeaturesNameTheMaterialAndLightTypesInUse) {
   Scene cornell = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
   for (const MeshDesc& m : cornell.meshes) EXPECT_EQ(cornell.materials.at(m.material).kernel_type(), MATERIAL_DIFFUSE);
   SceneFeatures c = cornell.features();
-  EXPECT_FALSE(c.gltf_bsdf || c.conductor || c.punctual || c.environment);
+  EXPECT_FALSE(c.gltf_bsdf || c.conductor || c.punctual || c.environment || c.anisotropy);
 
   SceneFeatures materials = features_of("materials/materials.gltf");
   EXPECT_TRUE(materials.gltf_bsdf);
   EXPECT_TRUE(materials.conductor);
+  EXPECT_TRUE(materials.anisotropy);  // its brushed metal
   EXPECT_TRUE(features_of("lights/punctual.gltf").punctual);
   EXPECT_TRUE(features_of("lights/environment.gltf").environment);
   EXPECT_FALSE(features_of("lights/many-lights.gltf").punctual);

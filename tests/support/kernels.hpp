@@ -49,10 +49,16 @@ struct DeviceParamName {
 struct KernelRig;
 
 // The build options of the shared test program: OpenCL C 1.2, with the features whose code
-// only their own tests need left out (CD_FEATURE_DISPERSION and CD_FEATURE_IRIDESCENCE:
-// dispersion_test.cpp and iridescence_test.cpp build their programs with them), so that rusticl's slow compile of it
-// does not grow with them
-inline const char* const kTestProgramOptions = "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=0 -DCD_FEATURE_IRIDESCENCE=0";
+// only their own tests need left out (CD_FEATURE_DISPERSION, CD_FEATURE_IRIDESCENCE and
+// CD_FEATURE_ANISOTROPY's table: dispersion_test.cpp, iridescence_test.cpp and
+// energy_test.cpp build their programs with them), so that rusticl's slow compile of it
+// does not grow with them. Without CD_FEATURE_ANISOTROPY anisotropic lobes still render,
+// compensated by the isotropic table.
+inline const char* const kTestProgramOptions =
+    "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=0 -DCD_FEATURE_IRIDESCENCE=0 -DCD_FEATURE_ANISOTROPY=0";
+// The same with CD_FEATURE_ANISOTROPY (the kernel of a scene with an anisotropic material)
+inline const char* const kAnisotropicTestProgramOptions =
+    "-cl-std=CL1.2 -DCD_FEATURE_DISPERSION=0 -DCD_FEATURE_IRIDESCENCE=0 -DCD_FEATURE_ANISOTROPY=1";
 
 // A write-only device buffer of `size` T that a kernel fills; read() copies it back
 template <typename T>
