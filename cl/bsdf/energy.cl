@@ -243,8 +243,9 @@ __kernel void energy_ggx_average_table(__global float* table) {
 }
 
 #if CD_FEATURE_ANISOTROPY
-// The anisotropic cells of a lobe with ax != ay
-GgxEnergy energy_ggx_aniso(GgxEnergy e, Ggx g, float3 wo) {
+// The anisotropic cells of a lobe with ax != ay, from its isotropic lookup iso
+GgxEnergy energy_ggx_aniso(GgxEnergy iso, Ggx g, float3 wo) {
+  GgxEnergy e = iso;
   e.aniso = true;
   e.swap = g.ay > g.ax;
   e.a1 = fmax(g.ax, g.ay);
@@ -289,7 +290,7 @@ GgxEnergy energy_ggx_mu(__global const float* table, Ggx g, float mu_o) {
 GgxEnergy energy_ggx(__global const float* table, Ggx g, EnergyDir wo) {
   GgxEnergy e = energy_ggx_mu(table, g, energy_dir_mu(wo));
 #if CD_FEATURE_ANISOTROPY
-  if (e.table && g.ax != g.ay) return energy_ggx_aniso(e, g, wo);
+  if (g.ax != g.ay && e.table) return energy_ggx_aniso(e, g, wo);
 #endif
   return e;
 }
