@@ -243,7 +243,7 @@ __kernel void energy_ggx_average_table(__global float* table) {
 }
 
 #if CD_FEATURE_ANISOTROPY
-// The anisotropic cells of a lobe with ax != ay, from its isotropic lookup iso
+// The anisotropic cells of a lobe with ax != ay, from its cell `iso` (energy_cell: table and alpha)
 GgxEnergy energy_ggx_aniso(GgxEnergy iso, Ggx g, float3 wo) {
   GgxEnergy e = iso;
   e.aniso = true;
@@ -288,11 +288,12 @@ GgxEnergy energy_ggx_mu(__global const float* table, Ggx g, float mu_o) {
 
 // The table looked up for any lobe seen from wo
 GgxEnergy energy_ggx(__global const float* table, Ggx g, EnergyDir wo) {
-  GgxEnergy e = energy_ggx_mu(table, g, energy_dir_mu(wo));
 #if CD_FEATURE_ANISOTROPY
-  if (g.ax != g.ay && e.table) return energy_ggx_aniso(e, g, wo);
+  // An anisotropic lobe overwrites every value the isotropic lookup would compute
+  if (g.ax != g.ay && table && !ggx_is_delta(g))
+    return energy_ggx_aniso(energy_cell(table, sqrt(g.ax * g.ay), 0, 0.0f), g, wo);
 #endif
-  return e;
+  return energy_ggx_mu(table, g, energy_dir_mu(wo));
 }
 
 #if CD_FEATURE_ANISOTROPY

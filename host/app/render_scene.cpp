@@ -192,10 +192,19 @@ Scene load_render_scene(RenderArgs* args) {
   choose_exposure(add_default_light(a, &scene), &a);
   apply_environment_options(a, &scene);
   warn_unreachable_lights(a, scene);
-  if (!scene.camera)
+  if (!scene.camera) {
+    size_t backdrops = 0;
+    framing_bounds(scene, &backdrops);
+    std::string left_out = backdrops == 0 ? std::string()
+                           : backdrops == 1
+                               ? " without its ground plane or backdrop (a flat mesh over 4 times the rest's size)"
+                               : " without its " + std::to_string(backdrops) +
+                                     " ground planes or backdrops (flat meshes over 4 times the rest's size)";
     std::fprintf(stderr,
-                 "note: the scene has no camera; framing its bounds from an elevated three-quarter view "
-                 "(--look-from and --look-at choose another)\n");
+                 "note: the scene has no camera; framing its bounds%s from an elevated three-quarter view "
+                 "(--look-from and --look-at choose another)\n",
+                 left_out.c_str());
+  }
   return scene;
 }
 

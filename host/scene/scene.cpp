@@ -140,9 +140,43 @@ glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm
   return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
 }
 
+namespace {
+
+float largest_extent(const Bounds& b) {
+  glm::vec3 e = b.hi - b.lo;
+  return b.empty() ? 0.0f : std::max({e.x, e.y, e.z});
+}
+
+// A mesh that is nearly flat (its bounds' smallest side under 1 % of its largest)
+bool is_planar(const Bounds& b) {
+  glm::vec3 e = b.hi - b.lo;
+  return !b.empty() && std::min({e.x, e.y, e.z}) <= 0.01f * largest_extent(b);
+}
+
+}  // namespace
+
+Bounds framing_bounds(const Scene& scene, size_t* backdrops) {
+  const float kBackdrop = 4.0f;
+  std::vector<Bounds> mesh_bounds(scene.meshes.size());
+  Bounds solid, framed;
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    for (const auto& p : scene.meshes[i].positions) mesh_bounds[i].grow(p);
+    if (!is_planar(mesh_bounds[i])) solid.grow(mesh_bounds[i]);
+  }
+  size_t skipped = 0;
+  for (const Bounds& b : mesh_bounds) {
+    if (b.empty()) continue;
+    bool backdrop = !solid.empty() && is_planar(b) && largest_extent(b) > kBackdrop * largest_extent(solid);
+    skipped += backdrop;
+    if (!backdrop) framed.grow(b);
+  }
+  if (backdrops) *backdrops = skipped;
+  return framed;
+}
+
 CameraDesc framing_camera(const Scene& scene, float aspect) {
   const float kDegree = 3.14159265f / 180.0f, kMargin = 0.95f;
-  Bounds b = scene.bounds();
+  Bounds b = framing_bounds(scene);
   CameraDesc cam;
   if (b.empty()) return cam;
   glm::vec3 extent = b.hi - b.lo, centre = b.center();
@@ -172,7 +206,7 @@ CameraDesc resolve_camera(const Scene& scene, float aspect) {
   if (cam.aperture_radius > 0.0f && cam.projection == Projection::Orthographic)
     throw Error("an orthographic camera has no lens: depth of field (an aperture) needs a perspective camera");
   if (!cam.focus_distance) {
-    Bounds b = scene.bounds();
+    Bounds b = framing_bounds(scene);
     float along = b.empty() ? 0.0f : glm::dot(b.center() - cam.position, glm::normalize(cam.forward));
     cam.focus_distance = along > 0.0f ? along : std::max(b.empty() ? 1.0f : b.radius(), 1e-3f);
   }

@@ -230,15 +230,22 @@ struct Scene {
 // (the host twin of triangle_normal_area in cl/core/geometry.cl)
 glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, double* area);
 
+// The bounds a camera is framed on: every mesh's but a backdrop's. A backdrop is a planar
+// mesh (smallest side of its bounds under 1 % of its largest: a ground plane or a wall)
+// more than 4 times as large as the bounds of the scene's non-planar meshes, so that an
+// asset on a vast floor fills the frame rather than being a speck on it. Without
+// non-planar meshes nothing is a backdrop. *backdrops (if given) gets how many were left out.
+Bounds framing_bounds(const Scene& scene, size_t* backdrops = nullptr);
+
 // Without a camera of the scene's: a perspective camera (yfov 45 degrees) looking at the
-// centre of the scene's bounds from an elevated three-quarter view, 30 degrees to the right
+// centre of the scene's framing_bounds from an elevated three-quarter view, 30 degrees to the right
 // of +Z (glTF's front) and 20 degrees up, or 50 degrees up for a flat horizontal scene (its
 // height under 15 % of its width), so that no flat asset is seen edge-on and no box
 // face-on; as close as keeps all eight corners of the bounds inside the frame of an image
 // of width / height `aspect`, with 5 % to spare.
 CameraDesc framing_camera(const Scene& scene, float aspect = 1.0f);
 // The camera to render with: the scene's, else framing_camera. An unset focus distance
-// becomes the distance from the camera to the bounds' centre along the view axis (when
+// becomes the distance from the camera to the framing_bounds' centre along the view axis (when
 // that centre is not in front of the camera: the bounds' radius). Throws Error for an
 // invalid camera (negative aperture, non-positive focus distance, a lens on an
 // orthographic camera).

@@ -175,6 +175,47 @@ TEST(Framing, FlatScenesAreSeenFromHigherUp) {
   for (glm::vec2 p : projected_corners(cam, plane.bounds(), 1.0f)) EXPECT_LE(std::fabs(p.y), 0.951f);
 }
 
+// A tetrahedron (not planar) with its base corner at `lo` and sides `size`
+void add_tetrahedron(Scene* s, glm::vec3 lo, float size) {
+  MeshDesc m;
+  m.positions = {lo, lo + glm::vec3(size, 0, 0), lo + glm::vec3(0, size, 0), lo + glm::vec3(0, 0, size)};
+  m.indices = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  s->meshes.push_back(m);
+}
+
+TEST(Framing, AnAssetOnAVastFloorFillsTheFrame) {
+  // A 1-unit asset on a 100-unit ground plane: framed on the asset, the floor left out
+  Scene scene;
+  scene.materials = {MaterialDesc()};
+  add_quad(&scene, {-50, 0, -50}, {50, 0, 50}, {0, 1, 0}, 0);
+  add_tetrahedron(&scene, {0, 0, 0}, 1.0f);
+  add_quad(&scene, {-1, 0, -1}, {0, 0, 0}, {0, 1, 0}, 0);  // a small flat part of the asset stays in
+  size_t backdrops = 0;
+  Bounds framed = framing_bounds(scene, &backdrops);
+  EXPECT_EQ(backdrops, 1u);
+  EXPECT_EQ(framed.lo, glm::vec3(-1, 0, -1));
+  EXPECT_EQ(framed.hi, glm::vec3(1, 1, 1));
+  CameraDesc cam = framing_camera(scene);
+  float widest = 0.0f;
+  for (glm::vec2 p : projected_corners(cam, framed, 1.0f)) widest = std::max({widest, std::fabs(p.x), std::fabs(p.y)});
+  EXPECT_GT(widest, 0.94f) << "the asset should fill the frame";
+  EXPECT_NEAR(std::asin(-glm::normalize(cam.forward).y) * 180.0 / 3.14159265, 20.0, 0.01) << "the asset is not flat";
+
+  // A floor only 3 times the asset's size is part of the scene; so is a plane without a solid beside it
+  Scene small_floor;
+  small_floor.materials = {MaterialDesc()};
+  add_quad(&small_floor, {-1.5f, 0, -1.5f}, {1.5f, 0, 1.5f}, {0, 1, 0}, 0);
+  add_tetrahedron(&small_floor, {0, 0, 0}, 1.0f);
+  EXPECT_EQ(framing_bounds(small_floor, &backdrops).lo, glm::vec3(-1.5f, 0, -1.5f));
+  EXPECT_EQ(backdrops, 0u);
+  Scene planes;
+  planes.materials = {MaterialDesc()};
+  add_quad(&planes, {-50, 0, -50}, {50, 0, 50}, {0, 1, 0}, 0);
+  add_quad(&planes, {0, 0, 0}, {1, 0, 1}, {0, 1, 0}, 0);
+  EXPECT_EQ(framing_bounds(planes, &backdrops).lo, glm::vec3(-50, 0, -50));
+  EXPECT_EQ(backdrops, 0u);
+}
+
 // A glTF with one point light of `intensity` and, optionally, scene extras light_units
 std::string point_light_gltf(double intensity, const char* units) {
   GltfBuilder g;
