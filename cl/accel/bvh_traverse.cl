@@ -49,8 +49,9 @@ float4 bvh_min4(float4 a, float4 b) { return a < b ? a : b; }
   }
 
 // A ray's constants for the node test: origin and inverse direction splatted, and the
-// offsets (in bytes of BvhNode.q) of the slabs' near planes: lo_* where the direction is
-// positive, hi_* (4 bytes on) where it is negative; the far planes are the others.
+// offsets (in floats, within a node) of the slabs' near planes: lo_* where the direction is
+// positive, hi_* (4 floats on) where it is negative; the far planes are the others. Unused
+// slots (lo > hi) then give an entry beyond the exit.
 typedef struct {
   float4 ox, oy, oz, ix, iy, iz;
   int near_x, near_y, near_z;
@@ -67,29 +68,21 @@ CD_ALWAYS_INLINE BvhRay bvh_ray(Ray ray) {
   return r;
 }
 
-// Four planes of a node along one axis: origin + q * scale (q * scale is exact, so this is
-// the one rounding the builder checked its bounds with)
-CD_ALWAYS_INLINE float4 bvh_planes(__global const unsigned char* q, int offset, float origin, float scale) {
-  return convert_float4(vload4(0, q + offset)) * scale + origin;
-}
-
 // The children of node `ref` that the ray enters before tmax, nearest first: entry
 // distances d[0..3] (INFINITY: missed) and references c[0..3]
 CD_ALWAYS_INLINE void bvh_node_children(const BvhRay* r, __global const BvhNode* nodes, int ref, float tmax, float* d,
                                         int* c) {
-  __global const BvhNode* n = &nodes[ref];
-  float3 org = vload3(0, n->origin), scale = vload3(0, n->scale);
+  __global const float* b = (__global const float*)&nodes[ref];
   int far_x = r->near_x ^ 4, far_y = r->near_y ^ 4, far_z = r->near_z ^ 4;
-  float4 enter = bvh_max4(bvh_max4((bvh_planes(n->q, r->near_x, org.x, scale.x) - r->ox) * r->ix,
-                                   (bvh_planes(n->q, r->near_y, org.y, scale.y) - r->oy) * r->iy),
-                          bvh_max4((bvh_planes(n->q, r->near_z, org.z, scale.z) - r->oz) * r->iz, (float4)(0.0f)));
-  float4 exit = bvh_min4(bvh_min4((bvh_planes(n->q, far_x, org.x, scale.x) - r->ox) * r->ix,
-                                  (bvh_planes(n->q, far_y, org.y, scale.y) - r->oy) * r->iy),
-                         bvh_min4((bvh_planes(n->q, far_z, org.z, scale.z) - r->oz) * r->iz, (float4)(tmax)));
+  float4 enter =
+      bvh_max4(bvh_max4((vload4(0, b + r->near_x) - r->ox) * r->ix, (vload4(0, b + r->near_y) - r->oy) * r->iy),
+               bvh_max4((vload4(0, b + r->near_z) - r->oz) * r->iz, (float4)(0.0f)));
+  float4 exit = bvh_min4(bvh_min4((vload4(0, b + far_x) - r->ox) * r->ix, (vload4(0, b + far_y) - r->oy) * r->iy),
+                         bvh_min4((vload4(0, b + far_z) - r->oz) * r->iz, (float4)(tmax)));
   // Robust exit (Ize 2013, Robust BVH Ray Traversal): widen by 2 gamma(3), with room
-  // for OpenCL's 2.5 ulp division in inv_dir; unused slots (child 0) never hit
-  int4 k = vload4(0, n->child);
-  float4 e = (enter <= exit * 1.000001f) & (k != (int4)(0)) ? enter : (float4)(INFINITY);
+  // for OpenCL's 2.5 ulp division in inv_dir
+  float4 e = enter <= exit * 1.000001f ? enter : (float4)(INFINITY);
+  int4 k = vload4(0, nodes[ref].child);
   float d0 = e.s0, d1 = e.s1, d2 = e.s2, d3 = e.s3;
   int c0 = k.s0, c1 = k.s1, c2 = k.s2, c3 = k.s3;
   BVH_SORT2(d0, c0, d1, c1);

@@ -182,21 +182,21 @@
 #define MEDIUM_GRID 1u     // coefficients scaled by a dense density grid (trilinear), delta tracking
 #define MEDIUM_NANOVDB 2u  // as MEDIUM_GRID, the density from a NanoVDB float grid (nanovdb.cl)
 
-// 4-wide BVH node, 64 bytes (one cache line); its encoding is private to bvh_builder.cpp
-// and bvh_traverse.cl. The four child boxes are quantized to 8 bits per plane (Ylitie,
-// Karras & Laine 2017): plane = origin[a] + q * scale[a] along axis a, scale[a] a power of
-// two, so q * scale is exact and the plane is one rounding of the sum; the builder rounds
-// lo down and hi up, so each box holds its child. q is stored by coordinate (structure of
-// arrays) so that one float4 operation tests a slab of all four: q[0..3] lo_x, q[4..7]
-// hi_x, q[8..11] lo_y, q[12..15] hi_y, q[16..19] lo_z, q[20..23] hi_z.
-// child[i]: > 0 an inner node's index; < 0 a leaf, ~child[i] its first BvhTriangle (the
-// leaf runs to the triangle flagged BVH_TRI_LAST); 0 an unused slot (the root is nobody's
-// child), which the traversal masks out (its q: lo 255, hi 0).
+// 4-wide BVH node, 128 bytes; its encoding is private to bvh_builder.cpp and
+// bvh_traverse.cl. The four child boxes are stored by coordinate (structure of arrays) so
+// that one float4 operation tests a slab of all four: lo_x[i] .. hi_z[i] bound child i.
+// child[i]: >= 0 an inner node's index; < 0 a leaf, ~child[i] its first BvhTriangle (the
+// leaf runs to the triangle flagged BVH_TRI_LAST). Unused slots have lo = +1e30 > hi =
+// -1e30, which no ray enters, and child 0.
 typedef struct {
-  float origin[3];
-  float scale[3];
-  unsigned char q[24];  // hi_* must follow lo_* by 4: traversal picks the near plane by offset
+  float lo_x[4];
+  float hi_x[4];  // must follow lo_x (and hi_y lo_y, hi_z lo_z): traversal picks by offset
+  float lo_y[4];
+  float hi_y[4];
+  float lo_z[4];
+  float hi_z[4];
   int child[4];
+  int pad[4];
 } BvhNode;
 
 // Traversal stack entries: at most 3 per node on the way down (the builder's
@@ -482,7 +482,8 @@ typedef struct {
 // One entry per line, columns aligned:
 // clang-format off
 #define CD_LAYOUT(SIZE, FIELD)                                                                                \
-  SIZE(BvhNode, 64) FIELD(BvhNode, scale, 12) FIELD(BvhNode, q, 24) FIELD(BvhNode, child, 48)                \
+  SIZE(BvhNode, 128) FIELD(BvhNode, hi_x, 16) FIELD(BvhNode, lo_y, 32) FIELD(BvhNode, hi_y, 48)               \
+    FIELD(BvhNode, lo_z, 64) FIELD(BvhNode, hi_z, 80) FIELD(BvhNode, child, 96) FIELD(BvhNode, pad, 112)      \
   SIZE(BvhTriangle, 48) FIELD(BvhTriangle, prim, 12) FIELD(BvhTriangle, v1, 16) FIELD(BvhTriangle, flags, 28) \
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \

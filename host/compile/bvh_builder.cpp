@@ -73,54 +73,10 @@ struct Range {
   bool leaf = false;
 };
 
-// A 4-wide node while the tree is built, its child boxes exact; quantize_node turns it into
-// the kernel's dev::BvhNode once the tree is joined. Unused slots have lo = kEmptyLo >
-// hi = kEmptyHi and child 0.
-struct WideNode {
-  float lo_x[4], hi_x[4], lo_y[4], hi_y[4], lo_z[4], hi_z[4];
-  int child[4];
-};
-
-// The kernel's node for w: per axis, the origin is the lower corner of the used boxes'
-// union and the scale the smallest power of two with 255 steps covering its extent (at
-// least 1e-5 of the coordinates' magnitude, so that an unused slot's lo 255 and hi 0 stay
-// apart); lo rounds down and hi up to a step, checked in the float arithmetic the kernel
-// uses (origin + q * scale, q * scale exact).
-dev::BvhNode quantize_node(const WideNode& w) {
-  dev::BvhNode n{};
-  const float* lo[3] = {w.lo_x, w.lo_y, w.lo_z};
-  const float* hi[3] = {w.hi_x, w.hi_y, w.hi_z};
-  for (int a = 0; a < 3; ++a) {
-    float l = kEmptyLo, h = kEmptyHi;
-    for (int i = 0; i < 4; ++i)
-      if (w.lo_x[i] <= w.hi_x[i]) l = std::min(l, lo[a][i]), h = std::max(h, hi[a][i]);
-    if (l > h) l = h = 0.0f;  // no used slot
-    double need = std::max({double(h) - double(l), 1e-5 * std::max(std::fabs(l), std::fabs(h)), 1e-30}) / 255.0;
-    int e = 0;
-    std::frexp(need, &e);  // need < 2^e
-    float scale = std::ldexp(1.0f, e);
-    n.origin[a] = l;
-    n.scale[a] = scale;
-    for (int i = 0; i < 4; ++i) {
-      int qlo = 255, qhi = 0;
-      if (w.lo_x[i] <= w.hi_x[i]) {
-        qlo = int(std::clamp(std::floor((double(lo[a][i]) - l) / scale), 0.0, 255.0));
-        qhi = int(std::clamp(std::ceil((double(hi[a][i]) - l) / scale), 0.0, 255.0));
-        while (qlo > 0 && l + float(qlo) * scale > lo[a][i]) --qlo;
-        while (qhi < 255 && l + float(qhi) * scale < hi[a][i]) ++qhi;
-      }
-      n.q[8 * a + i] = static_cast<unsigned char>(qlo);
-      n.q[8 * a + 4 + i] = static_cast<unsigned char>(qhi);
-    }
-  }
-  for (int i = 0; i < 4; ++i) n.child[i] = w.lo_x[i] <= w.hi_x[i] ? w.child[i] : 0;
-  return n;
-}
-
 // 4-wide nodes of one subtree (the top of the tree, or one worker's job): child
 // references inside it are indices into `nodes`, relocated when the subtrees are joined
 struct Subtree {
-  std::vector<WideNode> nodes;
+  std::vector<dev::BvhNode> nodes;
   int depth = 1;
 };
 
@@ -234,21 +190,16 @@ class Builder {
     // relocated; each job's nodes freed once copied (host memory: README, Performance)
     size_t total = top.sub.nodes.size();
     for (const Job& j : jobs) total += j.out.nodes.size();
-    std::vector<WideNode> nodes = std::move(top.sub.nodes);
-    nodes.reserve(total);
+    bvh_.nodes = std::move(top.sub.nodes);
+    bvh_.nodes.reserve(total);
     bvh_.depth = top.sub.depth;
     for (Job& j : jobs) {
-      int offset = int(nodes.size());
-      append(nodes, j.out.nodes, offset);
-      std::vector<WideNode>().swap(j.out.nodes);
-      nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
+      int offset = int(bvh_.nodes.size());
+      append(bvh_.nodes, j.out.nodes, offset);
+      std::vector<dev::BvhNode>().swap(j.out.nodes);
+      bvh_.nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
       bvh_.depth = std::max(bvh_.depth, j.out.depth);
     }
-    // The kernel's quantized nodes (half the size), in parallel
-    bvh_.nodes.resize(nodes.size());
-    parallel_for(nodes.size(), [&](size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i) bvh_.nodes[i] = quantize_node(nodes[i]);
-    });
     return std::move(bvh_);
   }
 
@@ -304,8 +255,8 @@ class Builder {
     for (std::thread& th : pool) th.join();
   }
 
-  static WideNode empty_node() {
-    WideNode n{};
+  static dev::BvhNode empty_node() {
+    dev::BvhNode n{};
     for (int i = 0; i < 4; ++i) {
       n.lo_x[i] = n.lo_y[i] = n.lo_z[i] = kEmptyLo;
       n.hi_x[i] = n.hi_y[i] = n.hi_z[i] = kEmptyHi;
@@ -315,7 +266,7 @@ class Builder {
   }
 
   static void set_child(Subtree& out, uint32_t node, int slot, const Range& r, int ref) {
-    WideNode& n = out.nodes[node];
+    dev::BvhNode& n = out.nodes[node];
     n.lo_x[slot] = r.box.lo.x;
     n.lo_y[slot] = r.box.lo.y;
     n.lo_z[slot] = r.box.lo.z;
@@ -464,8 +415,8 @@ class Builder {
   }
 
   // Appends `from` to `to`, inner-child references (into `from`) moved by offset
-  static void append(std::vector<WideNode>& to, const std::vector<WideNode>& from, int offset) {
-    for (WideNode n : from) {
+  static void append(std::vector<dev::BvhNode>& to, const std::vector<dev::BvhNode>& from, int offset) {
+    for (dev::BvhNode n : from) {
       for (int i = 0; i < 4; ++i)
         if (n.child[i] >= 0 && n.lo_x[i] <= n.hi_x[i]) n.child[i] += offset;
       to.push_back(n);
@@ -627,32 +578,19 @@ int bvh_build_threads() {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-bool bvh_child_used(const dev::BvhNode& n, int i) { return n.child[i] != 0; }
-
-void bvh_child_box(const dev::BvhNode& n, int i, glm::vec3* lo, glm::vec3* hi) {
-  for (int a = 0; a < 3; ++a) {
-    (*lo)[a] = n.origin[a] + float(n.q[8 * a + i]) * n.scale[a];
-    (*hi)[a] = n.origin[a] + float(n.q[8 * a + 4 + i]) * n.scale[a];
-  }
-}
-
 double sah_cost(const Bvh& bvh) {
   if (bvh.nodes.empty()) return 0.0;
-  auto area = [](const dev::BvhNode& n, int i) {
-    glm::vec3 lo, hi;
-    bvh_child_box(n, i, &lo, &hi);
-    glm::dvec3 d = glm::dvec3(hi) - glm::dvec3(lo);
-    return 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
-  };
   // The root's box: the union of its children's
+  auto area = [](const dev::BvhNode& n, int i) {
+    double dx = double(n.hi_x[i]) - n.lo_x[i], dy = double(n.hi_y[i]) - n.lo_y[i], dz = double(n.hi_z[i]) - n.lo_z[i];
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+  };
   const dev::BvhNode& root = bvh.nodes[0];
   glm::dvec3 lo(1e300), hi(-1e300);
   for (int i = 0; i < 4; ++i) {
-    if (!bvh_child_used(root, i)) continue;
-    glm::vec3 l, h;
-    bvh_child_box(root, i, &l, &h);
-    lo = glm::min(lo, glm::dvec3(l));
-    hi = glm::max(hi, glm::dvec3(h));
+    if (root.lo_x[i] > root.hi_x[i]) continue;
+    lo = glm::min(lo, glm::dvec3(root.lo_x[i], root.lo_y[i], root.lo_z[i]));
+    hi = glm::max(hi, glm::dvec3(root.hi_x[i], root.hi_y[i], root.hi_z[i]));
   }
   if (lo.x > hi.x) return 0.0;
   glm::dvec3 d = hi - lo;
@@ -663,9 +601,9 @@ double sah_cost(const Bvh& bvh) {
   double cost = kTraversalCost;
   for (const dev::BvhNode& n : bvh.nodes)
     for (int i = 0; i < 4; ++i) {
-      if (!bvh_child_used(n, i)) continue;
+      if (n.lo_x[i] > n.hi_x[i]) continue;
       double weight;
-      if (n.child[i] > 0) {
+      if (n.child[i] >= 0) {
         weight = kTraversalCost;
       } else {
         size_t t = size_t(~n.child[i]), count = 1;

@@ -12,7 +12,7 @@
 namespace candela {
 
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;     // 4-wide, quantized, root at 0
+  std::vector<dev::BvhNode> nodes;     // 4-wide, root at 0
   std::vector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
   int depth = 0;                       // of the binary SAH tree before collapsing (the 4-wide tree is half as deep)
 };
@@ -30,11 +30,6 @@ Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>&
 
 // Threads build_bvh uses by default: CANDELA_BVH_THREADS when set (> 0), else every core
 int bvh_build_threads();
-
-// Child slot i of node n: whether it is used, and its box as the kernel sees it (the
-// quantized planes, which hold the child's exact bounds)
-bool bvh_child_used(const dev::BvhNode& n, int i);
-void bvh_child_box(const dev::BvhNode& n, int i, glm::vec3* lo, glm::vec3* hi);
 
 // Surface-area-heuristic cost of the 4-wide tree, relative to one triangle test: 1 (the
 // root) + the sum over child slots of (slot box area / root box area) x (1 for an inner

@@ -72,8 +72,8 @@ void check_compiled(const candela::CompiledScene& c, const candela::CameraDesc& 
   require(!b.bvh_nodes.empty(), "BVH root");
   for (const auto& n : b.bvh_nodes)
     for (int i = 0; i < 4; ++i) {
-      if (n.child[i] == 0) continue;  // unused slot
-      if (n.child[i] < 0) {           // leaf run: ends at a BVH_TRI_LAST triangle inside the array
+      if (n.lo_x[i] > n.hi_x[i]) continue;  // unused slot
+      if (n.child[i] < 0) {                 // leaf run: ends at a BVH_TRI_LAST triangle inside the array
         size_t t = size_t(~n.child[i]);
         while (t < b.bvh_tris.size() && !(b.bvh_tris[t].flags & BVH_TRI_LAST)) ++t;
         require(t < b.bvh_tris.size(), "BVH leaf range");
