@@ -163,10 +163,19 @@ Bounds framing_bounds(const Scene& scene, size_t* backdrops) {
     for (const auto& p : scene.meshes[i].positions) mesh_bounds[i].grow(p);
     if (!is_planar(mesh_bounds[i])) solid.grow(mesh_bounds[i]);
   }
+  // Beneath or behind the solids: across its plane it spans their bounds
+  auto spans_solids = [&](const Bounds& b) {
+    glm::vec3 e = b.hi - b.lo;
+    int flat = e.x <= e.y && e.x <= e.z ? 0 : e.y <= e.z ? 1 : 2;
+    for (int a = 0; a < 3; ++a)
+      if (a != flat && (b.lo[a] > solid.lo[a] || b.hi[a] < solid.hi[a])) return false;
+    return true;
+  };
   size_t skipped = 0;
   for (const Bounds& b : mesh_bounds) {
     if (b.empty()) continue;
-    bool backdrop = !solid.empty() && is_planar(b) && largest_extent(b) > kBackdrop * largest_extent(solid);
+    bool backdrop = !solid.empty() && is_planar(b) && largest_extent(b) > kBackdrop * largest_extent(solid) &&
+                    spans_solids(b);
     skipped += backdrop;
     if (!backdrop) framed.grow(b);
   }

@@ -232,7 +232,8 @@ glm::vec3 triangle_normal_area(const glm::vec3& a, const glm::vec3& b, const glm
 
 // The bounds a camera is framed on: every mesh's but a backdrop's. A backdrop is a planar
 // mesh (smallest side of its bounds under 1 % of its largest: a ground plane or a wall)
-// more than 4 times as large as the bounds of the scene's non-planar meshes, so that an
+// more than 4 times as large as the bounds of the scene's non-planar meshes and spanning
+// them across its plane (they stand on it or before it), so that an
 // asset on a vast floor fills the frame rather than being a speck on it. Without
 // non-planar meshes nothing is a backdrop. *backdrops (if given) gets how many were left out.
 Bounds framing_bounds(const Scene& scene, size_t* backdrops = nullptr);

@@ -214,6 +214,20 @@ TEST(Framing, AnAssetOnAVastFloorFillsTheFrame) {
   add_quad(&planes, {0, 0, 0}, {1, 0, 1}, {0, 1, 0}, 0);
   EXPECT_EQ(framing_bounds(planes, &backdrops).lo, glm::vec3(-50, 0, -50));
   EXPECT_EQ(backdrops, 0u);
+  // Nor is a large flat panel above a small solid part: across its plane it does not span it
+  Scene panel;
+  panel.materials = {MaterialDesc()};
+  add_quad(&panel, {2, 5, -10}, {2, 25, 10}, {1, 0, 0}, 0);
+  add_tetrahedron(&panel, {0, 0, 0}, 1.0f);
+  EXPECT_EQ(framing_bounds(panel, &backdrops).hi, glm::vec3(2, 25, 10));
+  EXPECT_EQ(backdrops, 0u);
+  // A wall behind it, spanning it, is a backdrop
+  Scene wall;
+  wall.materials = {MaterialDesc()};
+  add_quad(&wall, {2, -1, -10}, {2, 19, 10}, {1, 0, 0}, 0);
+  add_tetrahedron(&wall, {0, 0, 0}, 1.0f);
+  EXPECT_EQ(framing_bounds(wall, &backdrops).hi, glm::vec3(1, 1, 1));
+  EXPECT_EQ(backdrops, 1u);
 }
 
 // A glTF with one point light of `intensity` and, optionally, scene extras light_units
