@@ -174,8 +174,8 @@ Bounds framing_bounds(const Scene& scene, size_t* backdrops) {
   size_t skipped = 0;
   for (const Bounds& b : mesh_bounds) {
     if (b.empty()) continue;
-    bool backdrop = !solid.empty() && is_planar(b) && largest_extent(b) > kBackdrop * largest_extent(solid) &&
-                    spans_solids(b);
+    bool backdrop =
+        !solid.empty() && is_planar(b) && largest_extent(b) > kBackdrop * largest_extent(solid) && spans_solids(b);
     skipped += backdrop;
     if (!backdrop) framed.grow(b);
   }
