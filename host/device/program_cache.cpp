@@ -132,7 +132,7 @@ std::string kernel_cache_dir() {
 }
 
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
-                           const std::string& options) {
+                           const std::string& options, const std::function<void()>& before_compile) {
   auto start = std::chrono::steady_clock::now();
   ProgramBuild result;
   std::string dir = kernel_cache_dir();
@@ -149,6 +149,7 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
   }
 
   if (!result.from_cache) {
+    if (before_compile) before_compile();
     cl::Program program(context, source);
     try {
       program.build({device.device}, options.c_str());

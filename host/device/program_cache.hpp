@@ -22,9 +22,11 @@ struct ProgramBuild {
 
 // Builds `source` with `options` for the device, through the cache. A corrupt or
 // rejected cache entry falls back to a source build. A failed source build throws
-// Error with the device's build log.
+// Error with the device's build log. `before_compile` (if set) is called just before a
+// build from source (no usable cache entry): what a caller announces before a wait of
+// seconds to minutes.
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
-                           const std::string& options);
+                           const std::string& options, const std::function<void()>& before_compile = {});
 
 std::string kernel_cache_dir();
 

@@ -65,7 +65,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   }
   std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
   options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
-  ProgramBuild build = build_program(context_, device_, renderer_program_source(), options);
+  ProgramBuild build = build_program(context_, device_, renderer_program_source(), options, [&] {
+    if (settings.before_kernel_compile) settings.before_kernel_compile(device_.description());
+  });
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");

@@ -52,6 +52,9 @@ struct RenderSettings {
   PixelFilter filter = PixelFilter::Box;
   Sampler sampler = Sampler::Sobol;
   double launch_seconds = 0.2;  // target duration of one launch
+  // Called with the device's description before its kernel is built from source (not in
+  // the kernel cache): seconds on PoCL, minutes on rusticl
+  std::function<void(const std::string&)> before_kernel_compile;
 };
 
 struct RenderProgress {

@@ -477,5 +477,19 @@ else
   fail "Ctrl-C keeps the samples done (exit $rc)"; cat "$tmp/int.err"
 fi
 
+# ---- A kernel build from source is announced (a wait of minutes on rusticl); a cached one is not ----
+kc=$tmp/kcache-note
+CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n1.png" --width 16 --spp 1 --device pocl >/dev/null 2>"$tmp/n1"
+CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n2.png" --width 16 --spp 1 --device pocl >/dev/null 2>"$tmp/n2"
+CANDELA_CACHE_DIR=$tmp/kcache-quiet "$bin" render "$scene" -o "$tmp/n3.png" --width 16 --spp 1 --device pocl -q \
+  >/dev/null 2>"$tmp/n3"
+if [ "$(grep -c '^compiling the render kernel for .*not in the kernel cache' "$tmp/n1")" -eq 1 ] &&
+  ! grep -q '^compiling the render kernel' "$tmp/n2" && ! grep -q '^compiling the render kernel' "$tmp/n3"; then
+  pass "an uncached kernel build is announced once, a cached or quiet one not"
+else
+  fail "the kernel build note"
+  cat "$tmp/n1" "$tmp/n2" "$tmp/n3"
+fi
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]
