@@ -160,12 +160,15 @@ float energy_aniso_lookup_at(const GgxEnergy* e, int part, float t, float mu) {
   return sum;
 }
 
-// sin^2 of the azimuth of w from the lobe's major axis (0 at the normal)
-float energy_aniso_t(const GgxEnergy* e, float3 w) {
-  float c = e->swap ? w.y : w.x, s = e->swap ? w.x : w.y;
+// sin^2 of the azimuth of w from a lobe's major axis, the frame's x (its y if `swap`); 0 at
+// the normal
+float energy_aniso_t_from(bool swap, float3 w) {
+  float c = swap ? w.y : w.x, s = swap ? w.x : w.y;
   float r2 = c * c + s * s;
   return r2 > 0.0f ? s * s / r2 : 0.0f;
 }
+
+float energy_aniso_t(const GgxEnergy* e, float3 w) { return energy_aniso_t_from(e->swap, w); }
 #endif
 
 // E(mu) (part 0) or E5(mu) (part 1) of an isotropic lobe: bilinear in (coordinate, r)
@@ -307,6 +310,28 @@ Ggx energy_aniso_node_ggx(int j, int k) {
   return g;
 }
 
+// Point q < energy_aniso_average_points(p, n) of the quadrature of E_avg = (1 / pi)
+// integral of E cos over the hemisphere for a lobe (a1, a0) whose table has p azimuth nodes
+// and n nodes in part's coordinate (part 0: y at the alpha seen along the azimuth, kept at
+// least alpha_floor): 8-point Gauss-Legendre in the azimuth phi in [0, pi / 2] within each
+// cell of t = sin^2 phi, and in mu between the mu of consecutive nodes. Returns (t, mu,
+// weight), the weight including mu, so that E_avg = sum of weight E(t, mu).
+int energy_aniso_average_points(int p, int n) { return 64 * (p - 1) * (n - 1); }
+
+float3 energy_aniso_average_point(int q, int p, int n, float a1, float a0, int part, float alpha_floor) {
+  const float x[4] = ENERGY_GL_X;
+  const float w[4] = ENERGY_GL_W;
+  int qm = q % 8, i = (q / 8) % (n - 1), kp = (q / (8 * (n - 1))) % 8, l = q / (64 * (n - 1));
+  float p0 = asin(sqrt((float)l / (float)(p - 1))), p1 = asin(sqrt((float)(l + 1) / (float)(p - 1)));
+  float pc = 0.5f * (p0 + p1), ph = 0.5f * (p1 - p0);
+  float sp = sin(pc + (kp < 4 ? -ph * x[kp] : ph * x[kp - 4])), t = sp * sp;
+  float alpha = fmax(energy_aniso_alpha(a1, a0, t), alpha_floor);
+  float a = energy_coordinate_mu(part, (float)i / (float)(n - 1), alpha);
+  float b = energy_coordinate_mu(part, (float)(i + 1) / (float)(n - 1), alpha);
+  float c = 0.5f * (a + b), h = 0.5f * (b - a), mu = c + (qm < 4 ? -h * x[qm] : h * x[qm - 4]);
+  return (float3)(t, mu, ph * w[kp & 3] * 2.0f * h * w[qm & 3] * mu / (0.5f * PI_F));
+}
+
 // Table entries (i, l, j, k) as energy_ggx_albedo_table's, seen from the azimuth with
 // sin^2 = t_l; global size (N, P, R Q). Without `exact`, the isotropic table's values at
 // alpha = sqrt(ax ay) instead of the quadrature (runs after the isotropic table and its averages).
@@ -353,39 +378,17 @@ GgxEnergy energy_aniso_row(__global const float* table, int j, int k) {
 }
 
 // E_avg(j, k) = (1 / pi) integral of E cos over the hemisphere as energy_lookup interpolates
-// it: the mean over the azimuth phi in [0, pi / 2] of 2 integral of E mu dmu, by 8-point
-// Gauss-Legendre in phi within each cell of t = sin^2 phi and in mu between the mu of
-// consecutive nodes (as energy_ggx_average_table). Global size (R Q, 2).
+// it (energy_aniso_average_point). Global size (R Q, 2).
 __kernel void energy_ggx_aniso_average_table(__global float* table) {
-  const float x[4] = ENERGY_GL_X;
-  const float w[4] = ENERGY_GL_W;
   int jk = (int)get_global_id(0), part = (int)get_global_id(1);
   if (jk >= GGX_ANISO_R * GGX_ANISO_Q || part > 1) return;
   int j = jk % GGX_ANISO_R, k = jk / GGX_ANISO_R;
   GgxEnergy e = energy_aniso_row(table, j, k);
   float total = 0.0f;
-  for (int l = 0; l + 1 < GGX_ANISO_P; ++l) {
-    float p0 = asin(sqrt((float)l / (float)(GGX_ANISO_P - 1)));
-    float p1 = asin(sqrt((float)(l + 1) / (float)(GGX_ANISO_P - 1)));
-    float pc = 0.5f * (p0 + p1), ph = 0.5f * (p1 - p0);
-    for (int kp = 0; kp < 8; ++kp) {
-      float phi = pc + (kp < 4 ? -ph * x[kp] : ph * x[kp - 4]), wphi = w[kp & 3];
-      float sp = sin(phi), t = sp * sp, alpha = energy_aniso_alpha(e.a1, e.a0, t), sum = 0.0f;
-      for (int i = 0; i + 1 < GGX_ANISO_N; ++i) {
-        float a = energy_coordinate_mu(part, (float)i / (float)(GGX_ANISO_N - 1), alpha);
-        float b = energy_coordinate_mu(part, (float)(i + 1) / (float)(GGX_ANISO_N - 1), alpha);
-        float c = 0.5f * (a + b), h = 0.5f * (b - a), segment = 0.0f;
-        for (int q = 0; q < 4; ++q) {
-          float lo = c - h * x[q], hi = c + h * x[q];
-          segment +=
-              w[q] * (lo * energy_aniso_lookup_at(&e, part, t, lo) + hi * energy_aniso_lookup_at(&e, part, t, hi));
-        }
-        sum += 2.0f * h * segment;
-      }
-      total += ph * wphi * sum;
-    }
+  for (int q = 0; q < energy_aniso_average_points(GGX_ANISO_P, GGX_ANISO_N); ++q) {
+    float3 pt = energy_aniso_average_point(q, GGX_ANISO_P, GGX_ANISO_N, e.a1, e.a0, part, 0.0f);
+    total += pt.z * energy_aniso_lookup_at(&e, part, pt.x, pt.y);
   }
-  total /= 0.5f * PI_F;
   if (j == 0 && part == 0) total = 1.0f;
   *(__global float*)energy_aniso_average(table, part, j, k) = fmin(total, 1.0f);
 }

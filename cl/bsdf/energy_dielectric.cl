@@ -21,16 +21,19 @@
 //
 // E_s(mu, roughness, eta) comes from the dielectric part of the ggx_albedo buffer, computed
 // by the table kernels below from the lobe's own visible-normal sampling (as energy.cl does
-// for reflection). Lookups are trilinear in (y, roughness, eta); anisotropic lobes use
-// sqrt(ax ay).
+// for reflection). Lookups are trilinear in (y, roughness, eta). Anisotropic lobes (with
+// CD_FEATURE_ANISOTROPY) have a table of their own over the azimuth and the two alphas too,
+// as energy.cl's anisotropic GGX table, at fewer nodes.
 
 // The eta coordinate: x = 2 (eta - 1) / (eta + 1) for eta >= 1 (1 / eta on side 1); node
-// k is eta = (1 + x / 2) / (1 - x / 2), from 1 (kept at 1.01: an interface of eta 1 refracts
-// nothing) to 3
-float energy_dielectric_eta_node(int k) {
-  float t = 0.5f * (float)k / (float)(DIEL_ALBEDO_F - 1);
+// k of f is eta = (1 + x / 2) / (1 - x / 2), from 1 (kept at 1.01: an interface of eta 1
+// refracts nothing) to 3
+float energy_dielectric_eta_node_of(int k, int f) {
+  float t = 0.5f * (float)k / (float)(f - 1);
   return fmax((1.0f + t) / (1.0f - t), 1.01f);
 }
+
+float energy_dielectric_eta_node(int k) { return energy_dielectric_eta_node_of(k, DIEL_ALBEDO_F); }
 
 float energy_dielectric_eta_x(float eta) {
   float e = eta >= 1.0f ? eta : 1.0f / eta;
@@ -40,11 +43,10 @@ float energy_dielectric_eta_x(float eta) {
 float energy_dielectric_r_node(int j) { return (float)j / (float)(DIEL_ALBEDO_R - 1); }
 float energy_dielectric_y_node(int i) { return (float)i / (float)(DIEL_ALBEDO_N - 1); }
 
-// E(mu) of the interface (eta seen from wo) by quadrature over the visible normals h, as
+// E(wo) of the interface (eta seen from wo) by quadrature over the visible normals h, as
 // energy_ggx_albedo_quadrature does: each h reflects with F(wo.h) and refracts with
 // 1 - F, and the weight X |cos_i| / pdf of either is G(wo, wi) / G1(wo)
-float energy_dielectric_quadrature(Ggx g, float eta, float mu, uint n) {
-  float3 wo = (float3)(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+float energy_dielectric_quadrature_wo(Ggx g, float eta, float3 wo, uint n) {
   float lo = ggx_lambda(g, wo);
   float sum = 0.0f, weights = 0.0f;
   for (uint a = 0u; a < n; ++a) {
@@ -63,6 +65,11 @@ float energy_dielectric_quadrature(Ggx g, float eta, float mu, uint n) {
     sum += 3.0f * v * v * row / (float)n;
   }
   return sum / weights;
+}
+
+// The same at cosine mu (wo in the xz-plane)
+float energy_dielectric_quadrature(Ggx g, float eta, float mu, uint n) {
+  return energy_dielectric_quadrature_wo(g, eta, (float3)(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu), n);
 }
 
 // Entry (i, j, k + F side): E at y_i, roughness r_j, eta node k on side `side`. The delta
@@ -88,27 +95,110 @@ typedef struct {
   int row, col;  // roughness cell [row, row + 1], eta cell [col, col + 1]
   float t, s;    // the weights of row + 1 and col + 1
   int side;      // wo's side
+#if CD_FEATURE_ANISOTROPY
+  bool aniso;    // ax != ay: the anisotropic table, row in sqrt(a1), col in its eta nodes
+  bool swap;     // the major axis is the frame's y
+  float a1, a0;  // major and minor alpha
+  int qrow;      // ratio cell in (a0 / a1)^(1/4) and the weight of qrow + 1
+  float tq;
+#endif
 } DielectricEnergy;
 
-DielectricEnergy energy_dielectric_cells(__global const float* table, float alpha, float eta) {
+// The cell [*cell, *cell + 1] of x in [0, 1] on `nodes` uniform nodes and the weight of *cell + 1
+void energy_cell_of(float x, int nodes, int* cell, float* weight) {
+  float z = clamp(x, 0.0f, 1.0f) * (float)(nodes - 1);
+  *cell = min((int)z, nodes - 2);
+  *weight = z - (float)*cell;
+}
+
+DielectricEnergy energy_dielectric_cells(__global const float* table, Ggx g, float eta) {
   DielectricEnergy d;
   d.table = table;
-  d.alpha = alpha;
-  float x = clamp(sqrt(alpha), 0.0f, 1.0f) * (float)(DIEL_ALBEDO_R - 1);
-  d.row = min((int)x, DIEL_ALBEDO_R - 2);
-  d.t = x - (float)d.row;
-  float z = energy_dielectric_eta_x(eta) * (float)(DIEL_ALBEDO_F - 1);
-  d.col = min((int)z, DIEL_ALBEDO_F - 2);
-  d.s = z - (float)d.col;
+  d.alpha = sqrt(g.ax * g.ay);
   d.side = eta < 1.0f;
+#if CD_FEATURE_ANISOTROPY
+  d.aniso = g.ax != g.ay;
+  d.swap = g.ay > g.ax;
+  d.a1 = fmax(g.ax, g.ay);
+  d.a0 = fmin(g.ax, g.ay);
+  d.qrow = 0;
+  d.tq = 0.0f;
+  if (d.aniso) {
+    energy_cell_of(sqrt(d.a1), DIEL_ANISO_R, &d.row, &d.t);
+    energy_cell_of(sqrt(sqrt(d.a0 / d.a1)), DIEL_ANISO_Q, &d.qrow, &d.tq);
+    energy_cell_of(energy_dielectric_eta_x(eta), DIEL_ANISO_F, &d.col, &d.s);
+    return d;
+  }
+#endif
+  energy_cell_of(sqrt(d.alpha), DIEL_ALBEDO_R, &d.row, &d.t);
+  energy_cell_of(energy_dielectric_eta_x(eta), DIEL_ALBEDO_F, &d.col, &d.s);
   return d;
 }
 
-// E_side(mu), trilinear in (y, roughness, eta)
-float energy_dielectric_lookup(const DielectricEnergy* d, int side, float mu) {
-  float x = clamp(energy_y(mu, d->alpha), 0.0f, 1.0f) * (float)(DIEL_ALBEDO_N - 1);
-  int i = min((int)x, DIEL_ALBEDO_N - 2);
-  float w = x - (float)i;
+// The isotropic interface at node (j, k) of the table on `side` exactly
+DielectricEnergy energy_dielectric_node(__global const float* table, int j, int k, int side) {
+  Ggx g;
+  g.ax = g.ay = energy_dielectric_r_node(j) * energy_dielectric_r_node(j);
+  float eta = energy_dielectric_eta_node(k);
+  DielectricEnergy d = energy_dielectric_cells(table, g, side ? 1.0f / eta : eta);
+  d.row = min(j, DIEL_ALBEDO_R - 2);
+  d.t = (float)(j - d.row);
+  d.col = min(k, DIEL_ALBEDO_F - 2);
+  d.s = (float)(k - d.col);
+  return d;
+}
+
+#if CD_FEATURE_ANISOTROPY
+__global const float* energy_dielectric_aniso_entry(__global const float* table, int side, int f, int k, int j, int l,
+                                                    int i) {
+  return table + DIEL_ANISO_OFFSET +
+         ((((side * DIEL_ANISO_F + f) * DIEL_ANISO_Q + k) * DIEL_ANISO_R + j) * DIEL_ANISO_P + l) * DIEL_ANISO_N + i;
+}
+
+__global const float* energy_dielectric_aniso_average_entry(__global const float* table, int side, int f, int k,
+                                                            int j) {
+  return table + DIEL_ANISO_OFFSET + DIEL_ANISO_NODES * DIEL_ANISO_P * DIEL_ANISO_N +
+         ((side * DIEL_ANISO_F + f) * DIEL_ANISO_Q + k) * DIEL_ANISO_R + j;
+}
+
+// The anisotropic table's y: energy_y at the alpha seen along the azimuth, at least
+// DIEL_ANISO_Y_ALPHA: along the minor axis of a line-shaped lobe alpha is tiny, and
+// energy_y would spend every node but one on grazing angles, while the interface's E has
+// its edge where total internal reflection sets in, at mid angles
+#define DIEL_ANISO_Y_ALPHA 0.1f
+
+float energy_dielectric_aniso_y_alpha(const DielectricEnergy* d, float t) {
+  return fmax(energy_aniso_alpha(d->a1, d->a0, t), DIEL_ANISO_Y_ALPHA);
+}
+
+// E_side of an anisotropic interface at (t, mu): bilinear in (y, t) at each of the eight
+// (roughness, ratio, eta) corners of its cells
+float energy_dielectric_aniso_lookup_at(const DielectricEnergy* d, int side, float t, float mu) {
+  int i, l;
+  float sy, sp;
+  energy_cell_of(energy_y(mu, energy_dielectric_aniso_y_alpha(d, t)), DIEL_ANISO_N, &i, &sy);
+  energy_cell_of(t, DIEL_ANISO_P, &l, &sp);
+  float sum = 0.0f;
+  for (int corner = 0; corner < 8; ++corner) {
+    int dj = corner & 1, dk = (corner >> 1) & 1, df = corner >> 2;
+    float w = (dj ? d->t : 1.0f - d->t) * (dk ? d->tq : 1.0f - d->tq) * (df ? d->s : 1.0f - d->s);
+    __global const float* c =
+        energy_dielectric_aniso_entry(d->table, side, d->col + df, d->qrow + dk, d->row + dj, l, i);
+    sum += w * mix(mix(c[0], c[1], sy), mix(c[DIEL_ANISO_N], c[DIEL_ANISO_N + 1], sy), sp);
+  }
+  return sum;
+}
+#endif
+
+// E_side(w), trilinear in (y, roughness, eta) (anisotropic: energy_dielectric_aniso_lookup_at)
+float energy_dielectric_lookup(const DielectricEnergy* d, int side, EnergyDir dir) {
+  float mu = energy_dir_mu(dir);
+#if CD_FEATURE_ANISOTROPY
+  if (d->aniso) return energy_dielectric_aniso_lookup_at(d, side, energy_aniso_t_from(d->swap, dir), mu);
+#endif
+  int i;
+  float w;
+  energy_cell_of(energy_y(mu, d->alpha), DIEL_ALBEDO_N, &i, &w);
   __global const float* p =
       d->table + DIEL_ALBEDO_OFFSET + ((side * DIEL_ALBEDO_F + d->col) * DIEL_ALBEDO_R + d->row) * DIEL_ALBEDO_N + i;
   const int dr = DIEL_ALBEDO_N, dc = DIEL_ALBEDO_R * DIEL_ALBEDO_N;
@@ -117,8 +207,20 @@ float energy_dielectric_lookup(const DielectricEnergy* d, int side, float mu) {
   return mix(mix(e00, e10, d->t), mix(e01, e11, d->t), d->s);
 }
 
-// E_side,avg, bilinear in (roughness, eta) between the node averages
+// E_side,avg, bilinear in (roughness, eta) between the node averages (anisotropic: trilinear
+// in (roughness, ratio, eta))
 float energy_dielectric_average(const DielectricEnergy* d, int side) {
+#if CD_FEATURE_ANISOTROPY
+  if (d->aniso) {
+    float sum = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+      int dj = corner & 1, dk = (corner >> 1) & 1, df = corner >> 2;
+      float w = (dj ? d->t : 1.0f - d->t) * (dk ? d->tq : 1.0f - d->tq) * (df ? d->s : 1.0f - d->s);
+      sum += w * *energy_dielectric_aniso_average_entry(d->table, side, d->col + df, d->qrow + dk, d->row + dj);
+    }
+    return sum;
+  }
+#endif
   __global const float* p = d->table + DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_ROWS * DIEL_ALBEDO_N +
                             (side * DIEL_ALBEDO_F + d->col) * DIEL_ALBEDO_R + d->row;
   return mix(mix(p[0], p[1], d->t), mix(p[DIEL_ALBEDO_R], p[DIEL_ALBEDO_R + 1], d->t), d->s);
@@ -133,27 +235,96 @@ __kernel void energy_dielectric_average_table(__global float* table) {
   int j = (int)get_global_id(0), ks = (int)get_global_id(1);
   if (j >= DIEL_ALBEDO_R || ks >= 2 * DIEL_ALBEDO_F) return;
   int side = ks / DIEL_ALBEDO_F, k = ks % DIEL_ALBEDO_F;
-  DielectricEnergy d;
-  d.table = table;
-  d.alpha = energy_dielectric_r_node(j) * energy_dielectric_r_node(j);
-  d.row = min(j, DIEL_ALBEDO_R - 2);
-  d.t = (float)(j - d.row);
-  d.col = min(k, DIEL_ALBEDO_F - 2);
-  d.s = (float)(k - d.col);
-  d.side = side;
+  DielectricEnergy d = energy_dielectric_node(table, j, k, side);
   float sum = 0.0f;
   for (int i = 0; i + 1 < DIEL_ALBEDO_N; ++i) {
     float a = energy_mu(energy_dielectric_y_node(i), d.alpha), b = energy_mu(energy_dielectric_y_node(i + 1), d.alpha);
     float c = 0.5f * (a + b), h = 0.5f * (b - a), segment = 0.0f;
     for (int q = 0; q < 4; ++q) {
       float lo = c - h * x[q], hi = c + h * x[q];
-      segment += w[q] * (lo * energy_dielectric_lookup(&d, side, lo) + hi * energy_dielectric_lookup(&d, side, hi));
+      segment += w[q] * (lo * energy_dielectric_lookup(&d, side, energy_dir(lo)) +
+                         hi * energy_dielectric_lookup(&d, side, energy_dir(hi)));
     }
     sum += 2.0f * h * segment;
   }
   if (j == 0) sum = 1.0f;
   table[DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_ROWS * DIEL_ALBEDO_N + ks * DIEL_ALBEDO_R + j] = fmin(sum, 1.0f);
 }
+
+#if CD_FEATURE_ANISOTROPY
+// The anisotropic lobe at node (j, k): major alpha a1 = r_j^2 along x, minor
+// a0 = max(q_k^4 a1, GGX_DELTA_ALPHA) (the fourth root of the ratio: nodes crowd towards the
+// line-shaped lobes, whose E changes fastest); j = 0 is the delta lobe
+Ggx energy_dielectric_aniso_node(int j, int k) {
+  float r = (float)j / (float)(DIEL_ANISO_R - 1), q = (float)k / (float)(DIEL_ANISO_Q - 1);
+  Ggx g;
+  g.ax = r * r;
+  g.ay = fmin(g.ax, fmax(q * q * q * q * g.ax, GGX_DELTA_ALPHA));
+  return g;
+}
+
+// Node (j, k, f, side) of the anisotropic table from its flat index: roughness fastest
+void energy_dielectric_aniso_node_of(int index, int* j, int* k, int* f, int* side) {
+  *j = index % DIEL_ANISO_R;
+  *k = (index / DIEL_ANISO_R) % DIEL_ANISO_Q;
+  *f = (index / (DIEL_ANISO_R * DIEL_ANISO_Q)) % DIEL_ANISO_F;
+  *side = index / (DIEL_ANISO_R * DIEL_ANISO_Q * DIEL_ANISO_F);
+}
+
+// Entry (i, l) of node (j, k, f, side): E at y_i and the azimuth with sin^2 = t_l from the
+// major axis, by quadrature (the delta row: 1); without `exact`, the isotropic table's value
+// at alpha = sqrt(ax ay) instead (runs after the isotropic table and its averages). Global
+// size (N, P, DIEL_ANISO_NODES).
+__kernel void energy_dielectric_aniso_table(__global float* table, uint n, uint exact) {
+  int i = (int)get_global_id(0), l = (int)get_global_id(1), node = (int)get_global_id(2);
+  if (i >= DIEL_ANISO_N || l >= DIEL_ANISO_P || node >= DIEL_ANISO_NODES) return;
+  int j, k, f, side;
+  energy_dielectric_aniso_node_of(node, &j, &k, &f, &side);
+  Ggx g = energy_dielectric_aniso_node(j, k);
+  float eta = energy_dielectric_eta_node_of(f, DIEL_ANISO_F);
+  if (side) eta = 1.0f / eta;
+  float t = (float)l / (float)(DIEL_ANISO_P - 1), e = 1.0f;
+  float y_alpha = fmax(energy_aniso_alpha(g.ax, g.ay, t), DIEL_ANISO_Y_ALPHA);
+  float mu = fmax(energy_mu((float)i / (float)(DIEL_ANISO_N - 1), y_alpha), 1e-4f);
+  if (!ggx_is_delta(g) && exact) {
+    float st = sqrt(fmax(0.0f, 1.0f - mu * mu));
+    e = energy_dielectric_quadrature_wo(g, eta, (float3)(st * sqrt(1.0f - t), st * sqrt(t), mu), n);
+  } else if (!ggx_is_delta(g)) {
+    Ggx iso;
+    iso.ax = iso.ay = sqrt(g.ax * g.ay);
+    DielectricEnergy d = energy_dielectric_cells(table, iso, eta);
+    e = energy_dielectric_lookup(&d, side, energy_dir(mu));
+  }
+  *(__global float*)energy_dielectric_aniso_entry(table, side, f, k, j, l, i) = fmin(e, 1.0f);
+}
+
+// E_avg of node (j, k, f, side) over the E the lookups interpolate
+// (energy_aniso_average_point). Global size DIEL_ANISO_NODES.
+__kernel void energy_dielectric_aniso_average_table(__global float* table) {
+  int node = (int)get_global_id(0);
+  if (node >= DIEL_ANISO_NODES) return;
+  int j, k, f, side;
+  energy_dielectric_aniso_node_of(node, &j, &k, &f, &side);
+  Ggx g = energy_dielectric_aniso_node(j, k);
+  float eta = energy_dielectric_eta_node_of(f, DIEL_ANISO_F);
+  DielectricEnergy d = energy_dielectric_cells(table, g, side ? 1.0f / eta : eta);
+  d.aniso = true;  // also the delta row (ax = ay = 0) and the isotropic column (ratio 1)
+  d.swap = false;
+  d.row = min(j, DIEL_ANISO_R - 2);
+  d.t = (float)(j - d.row);
+  d.qrow = min(k, DIEL_ANISO_Q - 2);
+  d.tq = (float)(k - d.qrow);
+  d.col = min(f, DIEL_ANISO_F - 2);
+  d.s = (float)(f - d.col);
+  float total = 0.0f;
+  for (int q = 0; q < energy_aniso_average_points(DIEL_ANISO_P, DIEL_ANISO_N); ++q) {
+    float3 pt = energy_aniso_average_point(q, DIEL_ANISO_P, DIEL_ANISO_N, d.a1, d.a0, 0, DIEL_ANISO_Y_ALPHA);
+    total += pt.z * energy_dielectric_aniso_lookup_at(&d, side, pt.x, pt.y);
+  }
+  if (j == 0) total = 1.0f;
+  *(__global float*)energy_dielectric_aniso_average_entry(table, side, f, k, j) = fmin(total, 1.0f);
+}
+#endif
 
 // 2 integral of F mu dmu from the rarer side (eta >= 1), of the sheet's 2F / (1 + F) if
 // `sheet`, by 8-point Gauss-Legendre quadrature in mu
@@ -196,7 +367,6 @@ DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta,
   m.e_o = 1.0f;
   m.refl = m.trans = m.q = m.p_refl = 0.0f;
   if (!table || ggx_is_delta(g) || mu_o <= 0.0f) return m;
-  float alpha = sqrt(g.ax * g.ay);
   // A_0, A_1: the missing averages of the rarer and the denser side
   float a_same, a_other, a0, a1, x;
   if (thin) {
@@ -205,8 +375,8 @@ DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta,
     a_same = a_other = a0 = a1 = 1.0f - m.ggx.e_avg;
     x = 1.0f - energy_dielectric_fresnel_average(eta, true);
   } else {
-    m.diel = energy_dielectric_cells(table, alpha, eta);
-    m.e_o = energy_dielectric_lookup(&m.diel, m.diel.side, mu_o);
+    m.diel = energy_dielectric_cells(table, g, eta);
+    m.e_o = energy_dielectric_lookup(&m.diel, m.diel.side, wo);
     a0 = 1.0f - energy_dielectric_average(&m.diel, 0);
     a1 = 1.0f - energy_dielectric_average(&m.diel, 1);
     a_same = m.diel.side ? a1 : a0;
@@ -228,7 +398,8 @@ DielectricMs energy_dielectric_at(__global const float* table, Ggx g, float eta,
 float energy_dielectric_e_at(const DielectricMs* m, float3 wi) {
   float mu = fabs(wi.z);
   if (m->thin) return energy_albedo(&m->ggx, energy_at((float3)(wi.x, wi.y, mu)));
-  return energy_dielectric_lookup(&m->diel, wi.z > 0.0f ? m->diel.side : 1 - m->diel.side, mu);
+  return energy_dielectric_lookup(&m->diel, wi.z > 0.0f ? m->diel.side : 1 - m->diel.side,
+                                  energy_at((float3)(wi.x, wi.y, mu)));
 }
 
 // The compensation lobe f_ms(wo, wi) (radiance: transmission scaled by 1 / eta^2 as the

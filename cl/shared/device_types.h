@@ -163,7 +163,21 @@
 #define GGX_ANISO_QUADRATURE 32  // quadrature points per side of each entry
 #define GGX_ANISO_ROWS (GGX_ANISO_P * GGX_ANISO_R * GGX_ANISO_Q)
 #define GGX_ANISO_PART (GGX_ANISO_ROWS * GGX_ANISO_N + GGX_ANISO_R * GGX_ANISO_Q)
-#define GGX_ALBEDO_SIZE (GGX_ANISO_OFFSET + 2 * GGX_ANISO_PART)  // the whole buffer
+// Then the anisotropic rough dielectric's E (cl/bsdf/energy_dielectric.cl; quadrature only
+// for a scene with anisotropic refracting glass): DIEL_ANISO_N x DIEL_ANISO_P x DIEL_ANISO_R x
+// DIEL_ANISO_Q nodes (y, t, sqrt of the major alpha, the ratio's fourth root) for each eta node
+// (as DIEL_ALBEDO_F's, fewer) and side, y fastest, then the averages by (roughness, ratio,
+// eta, side)
+#define DIEL_ANISO_OFFSET (GGX_ANISO_OFFSET + 2 * GGX_ANISO_PART)
+#define DIEL_ANISO_N 24
+#define DIEL_ANISO_P 8
+#define DIEL_ANISO_R 10
+#define DIEL_ANISO_Q 7
+#define DIEL_ANISO_F 8
+#define DIEL_ANISO_QUADRATURE 24                                           // quadrature points per side of each entry
+#define DIEL_ANISO_NODES (2 * DIEL_ANISO_F * DIEL_ANISO_Q * DIEL_ANISO_R)  // (roughness, ratio, eta, side)
+#define DIEL_ANISO_SIZE (DIEL_ANISO_NODES * (DIEL_ANISO_P * DIEL_ANISO_N + 1))
+#define GGX_ALBEDO_SIZE (DIEL_ANISO_OFFSET + DIEL_ANISO_SIZE)  // the whole buffer
 
 // Sheen albedo table (cl/bsdf/sheen.cl): the directional albedo E(mu) of the Charlie sheen
 // lobe with colour 1 at SHEEN_ALBEDO_N x SHEEN_ALBEDO_N nodes (mu, sheen roughness), mu fastest,

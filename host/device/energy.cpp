@@ -33,10 +33,18 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
     cl::Kernel aniso(program, "energy_ggx_aniso_table"), aniso_average(program, "energy_ggx_aniso_average_table");
     aniso.setArg(0, *buffer);
     aniso.setArg(1, cl_uint(GGX_ANISO_QUADRATURE));
-    aniso.setArg(2, cl_uint(anisotropic == AnisotropicAlbedo::exact));
+    aniso.setArg(2, cl_uint(anisotropic != AnisotropicAlbedo::approximate));
     aniso_average.setArg(0, *buffer);
     queue.enqueueNDRangeKernel(aniso, cl::NullRange, cl::NDRange(GGX_ANISO_N, GGX_ANISO_P, GGX_ANISO_R * GGX_ANISO_Q));
     queue.enqueueNDRangeKernel(aniso_average, cl::NullRange, cl::NDRange(GGX_ANISO_R * GGX_ANISO_Q, 2));
+    cl::Kernel glass(program, "energy_dielectric_aniso_table"),
+        glass_average(program, "energy_dielectric_aniso_average_table");
+    glass.setArg(0, *buffer);
+    glass.setArg(1, cl_uint(DIEL_ANISO_QUADRATURE));
+    glass.setArg(2, cl_uint(anisotropic == AnisotropicAlbedo::exact_glass));
+    glass_average.setArg(0, *buffer);
+    queue.enqueueNDRangeKernel(glass, cl::NullRange, cl::NDRange(DIEL_ANISO_N, DIEL_ANISO_P, DIEL_ANISO_NODES));
+    queue.enqueueNDRangeKernel(glass_average, cl::NullRange, cl::NDRange(DIEL_ANISO_NODES));
   } else {
     // Unread by a kernel without the feature; zeros, so the cached table is well defined
     queue.enqueueFillBuffer(*buffer, 0.0f, GGX_ANISO_OFFSET * sizeof(float),
@@ -50,18 +58,24 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
 
 AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials) {
   if (!kernel_feature) return AnisotropicAlbedo::none;
+  AnisotropicAlbedo need = AnisotropicAlbedo::approximate;
   for (const dev::Material& m : materials) {
-    if (m.type == MATERIAL_GLTF && m.params.gltf.anisotropy_strength > 0.0f) return AnisotropicAlbedo::exact;
-    if (m.type == MATERIAL_CONDUCTOR && m.params.conductor.anisotropy_strength > 0.0f) return AnisotropicAlbedo::exact;
+    bool gltf = m.type == MATERIAL_GLTF && m.params.gltf.anisotropy_strength > 0.0f;
+    if (gltf && m.params.gltf.transmission > 0.0f && !(m.flags & MATERIAL_THIN_WALLED))
+      return AnisotropicAlbedo::exact_glass;
+    if (gltf || (m.type == MATERIAL_CONDUCTOR && m.params.conductor.anisotropy_strength > 0.0f))
+      need = AnisotropicAlbedo::exact;
   }
-  return AnisotropicAlbedo::approximate;
+  return need;
 }
 
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                 const std::string& program_cache_file, AnisotropicAlbedo anisotropic) {
   auto start = std::chrono::steady_clock::now();
   GgxAlbedoTable t;
-  const char* suffix = anisotropic == AnisotropicAlbedo::exact ? ".ggx_albedo_aniso" : ".ggx_albedo";
+  const char* suffix = anisotropic == AnisotropicAlbedo::exact_glass ? ".ggx_albedo_aniso_glass"
+                       : anisotropic == AnisotropicAlbedo::exact     ? ".ggx_albedo_aniso"
+                                                                     : ".ggx_albedo";
   std::string path = program_cache_file.empty() ? "" : program_cache_file + suffix;
   try {
     t.buffer = cached_device_table(

@@ -22,10 +22,13 @@ struct GgxAlbedoTable {
 // `exact` integrates it by quadrature (several minutes on rusticl, so only for scenes with an
 // anisotropic material); `approximate` fills it with the isotropic table's values at
 // alpha = sqrt(ax ay) at next to no cost (the generic kernel of a scene without anisotropy).
-enum class AnisotropicAlbedo { none, approximate, exact };
+// `exact_glass` integrates the anisotropic rough dielectric's part too (the rest fill it
+// from the isotropic dielectric table).
+enum class AnisotropicAlbedo { none, approximate, exact, exact_glass };
 
-// The part a scene's kernel needs: `none` without the feature, `exact` when some material
-// has anisotropy strength > 0, else `approximate`
+// The part a scene's kernel needs: `none` without the feature, `exact_glass` when some
+// material is anisotropic refracting glass (anisotropy strength > 0, transmission > 0, not
+// thin-walled), `exact` when some material has anisotropy strength > 0, else `approximate`
 AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials);
 
 // The table for `program`, whose cache entry is `program_cache_file`

@@ -176,17 +176,8 @@ EnergyRig& energy_rig() {
 
 // The test program with CD_FEATURE_ANISOTROPY and the exact anisotropic table
 EnergyRig& anisotropic_energy_rig() {
-  static std::unique_ptr<KernelRig> program;
-  static std::unique_ptr<EnergyRig> r;
-  if (!r) {
-    KernelRig& shared = kernel_rig("pocl");
-    ProgramBuild b =
-        build_program(shared.context, shared.device, test_program_source(), kAnisotropicTestProgramOptions);
-    program = std::make_unique<KernelRig>(shared.device, shared.context, b.program);
-    program->program_cache_file = b.cache_file;
-    r = std::make_unique<EnergyRig>(*program, AnisotropicAlbedo::exact);
-  }
-  return *r;
+  static EnergyRig r(anisotropic_kernel_rig(), AnisotropicAlbedo::exact);
+  return r;
 }
 
 }  // namespace

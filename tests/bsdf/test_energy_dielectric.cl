@@ -7,9 +7,29 @@ __kernel void test_energy_dielectric_lookup(__global const float* table, __globa
                                             __global float2* out) {
   uint i = get_global_id(0);
   float4 q = queries[i];
-  DielectricEnergy d = energy_dielectric_cells(table, q.y * q.y, q.z);
-  out[i] = (float2)(energy_dielectric_lookup(&d, d.side, q.x), energy_dielectric_average(&d, d.side));
+  DielectricEnergy d = energy_dielectric_cells(table, ggx_from_roughness(q.y, 0.0f), q.z);
+  out[i] = (float2)(energy_dielectric_lookup(&d, d.side, energy_dir(q.x)), energy_dielectric_average(&d, d.side));
 }
+
+#if CD_FEATURE_ANISOTROPY
+// The anisotropic table: (E_s(wo), E_s,avg) for queries (wo, eta seen from wo) and
+// (glTF roughness, anisotropy strength) in params: the lobe KHR_materials_anisotropy makes
+__kernel void test_energy_dielectric_aniso_lookup(__global const float* table, __global const float4* queries,
+                                                  float2 params, __global float2* out) {
+  uint i = get_global_id(0);
+  float4 q = queries[i];
+  DielectricEnergy d = energy_dielectric_cells(table, ggx_from_roughness(params.x, params.y), q.w);
+  out[i] = (float2)(energy_dielectric_lookup(&d, d.side, q.xyz), energy_dielectric_average(&d, d.side));
+}
+
+// E_s(wo) of the same lobes by quadrature with n x n points
+__kernel void test_energy_dielectric_aniso_quadrature(__global const float4* queries, float2 params, uint n,
+                                                      __global float* out) {
+  uint i = get_global_id(0);
+  float4 q = queries[i];
+  out[i] = energy_dielectric_quadrature_wo(ggx_from_roughness(params.x, params.y), q.w, q.xyz, n);
+}
+#endif
 
 // E_s(mu) by the table's quadrature with n x n points, for the same queries
 __kernel void test_energy_dielectric_quadrature(__global const float4* queries, uint n, __global float* out) {

@@ -54,6 +54,18 @@ KernelRig& kernel_rig(const std::string& name) {
   return *r;
 }
 
+KernelRig& anisotropic_kernel_rig() {
+  static std::unique_ptr<KernelRig> rig;
+  if (!rig) {
+    KernelRig& shared = kernel_rig("pocl");
+    ProgramBuild b =
+        build_program(shared.context, shared.device, test_program_source(), kAnisotropicTestProgramOptions);
+    rig = std::make_unique<KernelRig>(shared.device, shared.context, b.program);
+    rig->program_cache_file = b.cache_file;
+  }
+  return *rig;
+}
+
 void DeviceTest::SetUp() {
   rig_ = rig_or_null(GetParam());
   if (!rig_) GTEST_SKIP() << GetParam() << " OpenCL device is not available";

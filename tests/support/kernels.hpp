@@ -112,6 +112,9 @@ struct KernelRig {
 KernelRig& kernel_rig(const std::string& name);
 // The same, or null when the device is absent
 KernelRig* rig_or_null(const std::string& name);
+// The test program built with kAnisotropicTestProgramOptions on PoCL (the context of
+// kernel_rig("pocl")), built on first use and kept for the rest of the process
+KernelRig& anisotropic_kernel_rig();
 
 // `out` (a KernelRig&) on the device named `name`, or the test skipped when it is absent
 #define CANDELA_RIG_OR_SKIP(name, out)                                              \
