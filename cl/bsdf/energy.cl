@@ -23,6 +23,13 @@
 // nodes for every alpha. Nodes at y, r = i / (N - 1).
 float energy_node(int i) { return (float)i / (float)(GGX_ALBEDO_N - 1); }
 
+// The cell [*cell, *cell + 1] of x in [0, 1] on `nodes` uniform nodes and the weight of *cell + 1
+void energy_cell_of(float x, int nodes, int* cell, float* weight) {
+  float z = clamp(x, 0.0f, 1.0f) * (float)(nodes - 1);
+  *cell = min((int)z, nodes - 2);
+  *weight = z - (float)*cell;
+}
+
 float energy_y(float mu, float alpha) {
   float c = 4.0f * alpha;
   return sqrt(mu * (1.0f + c) / (mu + c));
@@ -143,13 +150,10 @@ __global const float* energy_aniso_average(__global const float* table, int part
 // E (part 0) or E5 (part 1) at (t, mu): bilinear in (coordinate, t) at each of the four
 // (roughness, ratio) corners, weighted by the lobe's cells
 float energy_aniso_lookup_at(const GgxEnergy* e, int part, float t, float mu) {
-  float x =
-      clamp(energy_coordinate(part, mu, energy_aniso_alpha(e->a1, e->a0, t)), 0.0f, 1.0f) * (float)(GGX_ANISO_N - 1);
-  int i = min((int)x, GGX_ANISO_N - 2);
-  float s = x - (float)i;
-  float xp = clamp(t, 0.0f, 1.0f) * (float)(GGX_ANISO_P - 1);
-  int l = min((int)xp, GGX_ANISO_P - 2);
-  float sp = xp - (float)l;
+  int i, l;
+  float s, sp;
+  energy_cell_of(energy_coordinate(part, mu, energy_aniso_alpha(e->a1, e->a0, t)), GGX_ANISO_N, &i, &s);
+  energy_cell_of(t, GGX_ANISO_P, &l, &sp);
   float sum = 0.0f;
   for (int dk = 0; dk < 2; ++dk)
     for (int dj = 0; dj < 2; ++dj) {
@@ -173,9 +177,9 @@ float energy_aniso_t(const GgxEnergy* e, float3 w) { return energy_aniso_t_from(
 
 // E(mu) (part 0) or E5(mu) (part 1) of an isotropic lobe: bilinear in (coordinate, r)
 float energy_lookup_mu(const GgxEnergy* e, int part, float mu) {
-  float x = clamp(energy_coordinate(part, mu, e->alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
-  int i = min((int)x, GGX_ALBEDO_N - 2);
-  float s = x - (float)i;
+  int i;
+  float s;
+  energy_cell_of(energy_coordinate(part, mu, e->alpha), GGX_ALBEDO_N, &i, &s);
   __global const float* lo = e->table + part * GGX_ALBEDO_HALF + e->row * GGX_ALBEDO_N + i;
   __global const float* hi = lo + GGX_ALBEDO_N;
   return mix(mix(lo[0], lo[1], s), mix(hi[0], hi[1], s), e->t);
@@ -253,12 +257,8 @@ GgxEnergy energy_ggx_aniso(GgxEnergy iso, Ggx g, float3 wo) {
   e.swap = g.ay > g.ax;
   e.a1 = fmax(g.ax, g.ay);
   e.a0 = fmin(g.ax, g.ay);
-  float x = clamp(sqrt(e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_R - 1);
-  e.row = min((int)x, GGX_ANISO_R - 2);
-  e.t = x - (float)e.row;
-  float xq = clamp(sqrt(e.a0 / e.a1), 0.0f, 1.0f) * (float)(GGX_ANISO_Q - 1);
-  e.qrow = min((int)xq, GGX_ANISO_Q - 2);
-  e.tq = xq - (float)e.qrow;
+  energy_cell_of(sqrt(e.a1), GGX_ANISO_R, &e.row, &e.t);
+  energy_cell_of(sqrt(e.a0 / e.a1), GGX_ANISO_Q, &e.qrow, &e.tq);
   float avg[2];
   for (int part = 0; part < 2; ++part) {
     __global const float* lo = energy_aniso_average(e.table, part, e.row, e.qrow);
@@ -278,9 +278,7 @@ GgxEnergy energy_ggx_aniso(GgxEnergy iso, Ggx g, float3 wo) {
 GgxEnergy energy_ggx_mu(__global const float* table, Ggx g, float mu_o) {
   GgxEnergy e = energy_cell(ggx_is_delta(g) ? 0 : table, sqrt(g.ax * g.ay), 0, 0.0f);
   if (!e.table) return e;
-  float x = clamp(sqrt(e.alpha), 0.0f, 1.0f) * (float)(GGX_ALBEDO_N - 1);
-  e.row = min((int)x, GGX_ALBEDO_N - 2);
-  e.t = x - (float)e.row;
+  energy_cell_of(sqrt(e.alpha), GGX_ALBEDO_N, &e.row, &e.t);
   __global const float* avg = table + GGX_ALBEDO_N * GGX_ALBEDO_N + e.row;
   e.e_avg = mix(avg[0], avg[1], e.t);
   e.e5_avg = mix(avg[GGX_ALBEDO_HALF], avg[GGX_ALBEDO_HALF + 1], e.t);

@@ -104,13 +104,6 @@ typedef struct {
 #endif
 } DielectricEnergy;
 
-// The cell [*cell, *cell + 1] of x in [0, 1] on `nodes` uniform nodes and the weight of *cell + 1
-void energy_cell_of(float x, int nodes, int* cell, float* weight) {
-  float z = clamp(x, 0.0f, 1.0f) * (float)(nodes - 1);
-  *cell = min((int)z, nodes - 2);
-  *weight = z - (float)*cell;
-}
-
 DielectricEnergy energy_dielectric_cells(__global const float* table, Ggx g, float eta) {
   DielectricEnergy d;
   d.table = table;
@@ -298,17 +291,14 @@ __kernel void energy_dielectric_aniso_table(__global float* table, uint n, uint 
   *(__global float*)energy_dielectric_aniso_entry(table, side, f, k, j, l, i) = fmin(e, 1.0f);
 }
 
-// E_avg of node (j, k, f, side) over the E the lookups interpolate
-// (energy_aniso_average_point). Global size DIEL_ANISO_NODES.
-__kernel void energy_dielectric_aniso_average_table(__global float* table) {
-  int node = (int)get_global_id(0);
-  if (node >= DIEL_ANISO_NODES) return;
-  int j, k, f, side;
-  energy_dielectric_aniso_node_of(node, &j, &k, &f, &side);
+// The anisotropic interface at node (roughness j, ratio k, eta f) of the table on `side`
+// exactly; the anisotropic cells also for the delta row (ax = ay = 0) and the isotropic
+// column (ratio 1)
+DielectricEnergy energy_dielectric_aniso_node_cells(__global const float* table, int j, int k, int f, int side) {
   Ggx g = energy_dielectric_aniso_node(j, k);
   float eta = energy_dielectric_eta_node_of(f, DIEL_ANISO_F);
   DielectricEnergy d = energy_dielectric_cells(table, g, side ? 1.0f / eta : eta);
-  d.aniso = true;  // also the delta row (ax = ay = 0) and the isotropic column (ratio 1)
+  d.aniso = true;
   d.swap = false;
   d.row = min(j, DIEL_ANISO_R - 2);
   d.t = (float)(j - d.row);
@@ -316,6 +306,17 @@ __kernel void energy_dielectric_aniso_average_table(__global float* table) {
   d.tq = (float)(k - d.qrow);
   d.col = min(f, DIEL_ANISO_F - 2);
   d.s = (float)(f - d.col);
+  return d;
+}
+
+// E_avg of node (j, k, f, side) over the E the lookups interpolate
+// (energy_aniso_average_point). Global size DIEL_ANISO_NODES.
+__kernel void energy_dielectric_aniso_average_table(__global float* table) {
+  int node = (int)get_global_id(0);
+  if (node >= DIEL_ANISO_NODES) return;
+  int j, k, f, side;
+  energy_dielectric_aniso_node_of(node, &j, &k, &f, &side);
+  DielectricEnergy d = energy_dielectric_aniso_node_cells(table, j, k, f, side);
   float total = 0.0f;
   for (int q = 0; q < energy_aniso_average_points(DIEL_ANISO_P, DIEL_ANISO_N); ++q) {
     float3 pt = energy_aniso_average_point(q, DIEL_ANISO_P, DIEL_ANISO_N, d.a1, d.a0, 0, DIEL_ANISO_Y_ALPHA);
