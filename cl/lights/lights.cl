@@ -370,122 +370,132 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // Light tree (Conty Estevez & Kulla 2018, Importance Sampling of Many Lights with Adaptive
 // Tree Splitting): selection descends from the root, taking each child with probability
 // proportional to its importance at the shading point, an estimate of the irradiance its
-// lights can send there; the selection pmf is the product of those probabilities. A node's
+// lights can send there; the selection pmf is the product of those probabilities. A child's
 // importance is I cos(theta') cos(theta_i') / d^2: I its summed peak intensity, d the
-// distance to its centre (at least half its diagonal: points in or near the box), theta'
-// the smallest angle its emission cone can make with the direction to ctx.p (the angle
-// from the cone's axis less theta_o and less the angle theta_b its bounding sphere
-// subtends; 0 importance beyond theta_e: no light in the node emits toward ctx.p), and
-// theta_i' the smallest angle between the shading normal and a direction into the sphere
-// (the |cos| the estimator weighs by; 1 in a medium, n = 0). Both cosines are kept at
-// least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so float
-// rounding never gives 0 to a light that can contribute; and a child of nonzero importance
-// is taken with probability at least the root's `min_prob`, which the host sets so that the
-// product over the deepest trail, times the tree's share, stays above 2^-124: no light's
-// pmf underflows (to 0 on devices that flush denormals). Sampling and the pmf of a given
-// light (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
+// distance to its box's centre (the radius r of its bounding sphere when ctx.p lies inside
+// the sphere, where both cosines are 1), theta' the smallest angle its emission cone can make
+// with the direction to ctx.p (the angle from the cone's axis less theta_o and less the angle
+// theta_b the sphere subtends; 0 importance beyond theta_e: no light of the child emits
+// toward ctx.p), and theta_i' the smallest angle between the shading normal and a direction
+// into the sphere (the |cos| the estimator weighs by; 1 in a medium, n = 0). Both cosines
+// are kept at least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so
+// float rounding never gives 0 to a light that can contribute. A node's four children are
+// weighed at once, one child per float4 lane. Every child of nonzero importance is given at
+// least the root's `min_prob` times their sum before they are normalized, so a probability
+// of at least min_prob / (1 + 4 min_prob); the host sets min_prob so that the product over the
+// deepest trail, times the tree's share, stays above 2^-124: no light's pmf underflows (to
+// 0 on devices that flush denormals). Sampling and the pmf of a given light
+// (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
 // STRATEGY_AUTO's two evaluations of a light's selection probability agree exactly.
-// Inside a planar emitter of several triangles (LIGHT_TREE_CLUSTER nodes) the children are
-// taken by their share of the power, with no importance to evaluate.
+// Inside a planar emitter of several triangles (cluster nodes) the children are taken by
+// their share of the intensity, with no importance to evaluate.
 #define LIGHT_TREE_MIN_COS 1e-3f
 
-// cos(a - b) for angles a, b in [0, pi] given by their cosines, or 1 when a <= b
-float lights_tree_cos_minus(float cos_a, float cos_b) {
+// The importances of node's four children at ctx (0 in empty slots)
+float4 lights_tree_importance(__global const LightTreeNode* node, const LightSampleContext* ctx) {
 #pragma OPENCL FP_CONTRACT OFF
-  if (cos_a >= cos_b) return 1.0f;
-  float sin_a = sqrt(fmax(0.0f, 1.0f - cos_a * cos_a)), sin_b = sqrt(fmax(0.0f, 1.0f - cos_b * cos_b));
-  return cos_a * cos_b + sin_a * sin_b;
-}
-
-float lights_tree_importance(__global const LightTreeNode* node, const LightSampleContext* ctx) {
-#pragma OPENCL FP_CONTRACT OFF
-  if (!(node->intensity > 0.0f)) return 0.0f;
-  float3 lo = load3(node->lo), hi = load3(node->hi);
-  float3 c = 0.5f * (lo + hi);
-  float3 diag = hi - lo;
-  float r2 = 0.25f * dot(diag, diag);  // bounding sphere radius^2
-  float3 d = ctx->p - c;
-  float dist2 = dot(d, d);
-  float cos_b = -1.0f;  // inside the sphere: directions everywhere
-  if (dist2 > r2) cos_b = sqrt(fmax(0.0f, 1.0f - r2 / dist2));
-  float3 w = dist2 > 0.0f ? d * rsqrt(dist2) : (float3)(0.0f, 0.0f, 1.0f);  // from the node to ctx.p
+  float4 intensity = vload4(0, node->intensity);
+  float4 lo_x = vload4(0, node->lo[0]), lo_y = vload4(0, node->lo[1]), lo_z = vload4(0, node->lo[2]);
+  float4 hi_x = vload4(0, node->hi[0]), hi_y = vload4(0, node->hi[1]), hi_z = vload4(0, node->hi[2]);
+  float4 ex = hi_x - lo_x, ey = hi_y - lo_y, ez = hi_z - lo_z;
+  float4 r2 = 0.25f * (ex * ex + ey * ey + ez * ez);  // bounding sphere radius^2
+  float4 dx = ctx->p.x - 0.5f * (lo_x + hi_x), dy = ctx->p.y - 0.5f * (lo_y + hi_y),
+         dz = ctx->p.z - 0.5f * (lo_z + hi_z);
+  float4 dist2 = dx * dx + dy * dy + dz * dz;
+  int4 outside = isgreater(dist2, r2);
+  // theta_b, the angle the sphere subtends: its sine and cosine both from r^2 / d^2, and the
+  // cosine and sine of each difference of angles below from the addition formulas (no
+  // square root of a previous result on the dependent chain)
+  float4 sin2_b = select((float4)(1.0f), r2 / fmax(dist2, 1e-30f), outside);
+  float4 cos_b = sqrt(fmax(0.0f, 1.0f - sin2_b)), sin_b = sqrt(fmin(sin2_b, 1.0f));
+  float4 inv_d = rsqrt(fmax(dist2, 1e-30f));
+  float4 wx = dx * inv_d, wy = dy * inv_d, wz = dz * inv_d;  // from the child to ctx.p
   // Emitter side: theta' = max(0, theta_w - theta_o - theta_b)
-  float cos_w = clamp(dot(load3(node->axis), w), -1.0f, 1.0f);
-  float cos_p = lights_tree_cos_minus(lights_tree_cos_minus(cos_w, node->cos_o), cos_b);
-  if (cos_p < node->cos_e - LIGHT_TREE_MIN_COS) return 0.0f;
-  float importance = node->intensity * fmax(cos_p, LIGHT_TREE_MIN_COS);
+  float4 cos_o = vload4(0, node->cos_o), sin_o = sqrt(fmax(0.0f, 1.0f - cos_o * cos_o));
+  float4 cos_w = vload4(0, node->axis[0]) * wx + vload4(0, node->axis[1]) * wy + vload4(0, node->axis[2]) * wz;
+  cos_w = clamp(cos_w, -1.0f, 1.0f);
+  float4 sin_w = sqrt(fmax(0.0f, 1.0f - cos_w * cos_w));
+  int4 in_cone = isgreaterequal(cos_w, cos_o);  // theta_w <= theta_o
+  float4 cos_x = select(cos_w * cos_o + sin_w * sin_o, (float4)(1.0f), in_cone);
+  float4 sin_x = select(fmax(0.0f, sin_w * cos_o - cos_w * sin_o), (float4)(0.0f), in_cone);
+  float4 cos_p = select(cos_x * cos_b + sin_x * sin_b, (float4)(1.0f), isgreaterequal(cos_x, cos_b));
+  float4 importance = intensity * fmax(cos_p, LIGHT_TREE_MIN_COS);
+  importance = select(importance, (float4)(0.0f), isless(cos_p, vload4(0, node->cos_e) - LIGHT_TREE_MIN_COS));
   // Receiver side: theta_i' = max(0, theta_i - theta_b), |cos| to the shading normal
   if (dot(ctx->ns, ctx->ns) > 0.0f) {
-    float cos_i = fmin(fabs(dot(ctx->ns, w)), 1.0f);
-    importance *= fmax(lights_tree_cos_minus(cos_i, cos_b), LIGHT_TREE_MIN_COS);
+    float4 cos_i = fmin(fabs(ctx->ns.x * wx + ctx->ns.y * wy + ctx->ns.z * wz), 1.0f);
+    float4 sin_i = sqrt(fmax(0.0f, 1.0f - cos_i * cos_i));
+    float4 cos_r = select(cos_i * cos_b + sin_i * sin_b, (float4)(1.0f), isgreaterequal(cos_i, cos_b));
+    importance *= fmax(cos_r, LIGHT_TREE_MIN_COS);
   }
-  return importance / fmax(fmax(dist2, r2), 1e-30f);
+  importance = select(intensity / fmax(r2, 1e-30f), importance / fmax(dist2, 1e-30f), outside);
+  return select((float4)(0.0f), importance, isgreater(intensity, 0.0f));
 }
 
-// Probability of taking the first child of interior node `node`, from its children's importances
-float lights_tree_first(const SceneData* sc, uint node, const LightSampleContext* ctx) {
+// The probabilities of taking each of node's children at ctx; false when none can light ctx.p
+bool lights_tree_children(const SceneData* sc, uint node, const LightSampleContext* ctx, float4* p) {
 #pragma OPENCL FP_CONTRACT OFF
-  float lo = sc->light_tree[0].min_prob;
-  if (sc->light_tree[node].leaf == LIGHT_TREE_CLUSTER) return clamp(sc->light_tree[node].share, lo, 1.0f - lo);
-  float a = lights_tree_importance(&sc->light_tree[node + 1u], ctx);
-  float b = lights_tree_importance(&sc->light_tree[sc->light_tree[node].child], ctx);
-  float sum = a + b;
-  if (!(sum > 0.0f)) return -1.0f;  // neither child can light ctx.p
-  float first;
-  if (isinf(a) || isinf(b))
-    first = isinf(a) ? (isinf(b) ? 0.5f : 1.0f) : 0.0f;
-  else
-    first = isinf(sum) ? 0.5f * a / (0.5f * a + 0.5f * b) : a / sum;
-  if (a > 0.0f && b > 0.0f) first = clamp(first, lo, 1.0f - lo);
-  return first;
+  __global const LightTreeNode* n = &sc->light_tree[node];
+  float4 w = n->cluster ? vload4(0, n->intensity) : lights_tree_importance(n, ctx);
+  int4 infinite = isinf(w);
+  if (any(infinite)) w = select((float4)(0.0f), (float4)(1.0f), infinite);
+  float sum = w.x + w.y + w.z + w.w;
+  if (isinf(sum)) {  // finite weights whose sum overflows
+    w *= 0.25f;
+    sum = w.x + w.y + w.z + w.w;
+  }
+  if (!(sum > 0.0f)) return false;
+  float4 q = select((float4)(0.0f), fmax(w, sc->light_tree[0].min_prob * sum), isgreater(w, 0.0f));
+  *p = q * (1.0f / (q.x + q.y + q.z + q.w));
+  return true;
 }
 
 // Whether selection uses the tree (the kernel has it, it has lights, and the scene was
 // compiled for it)
-bool lights_tree_used(const SceneData* sc) { return CD_FEATURE_LIGHT_TREE && sc->light_tree[0].intensity > 0.0f; }
+bool lights_tree_used(const SceneData* sc) { return CD_FEATURE_LIGHT_TREE && sc->light_tree[0].share > 0.0f; }
 
 // A light of the tree chosen with u, and its probability within the tree; false when no
 // light of the tree can light ctx.p
 bool lights_tree_sample(const SceneData* sc, const LightSampleContext* ctx, float u, uint* light, float* pmf) {
 #pragma OPENCL FP_CONTRACT OFF
-  if (!(lights_tree_importance(&sc->light_tree[0], ctx) > 0.0f)) return false;
   uint node = 0u;
   float prob = 1.0f;
-  while (sc->light_tree[node].leaf != LIGHT_TREE_LEAF) {
-    float first = lights_tree_first(sc, node, ctx);
-    if (first < 0.0f) return false;
-    if (u < first) {
-      u = fmin(u / first, 0x1.fffffep-1f);
-      prob *= first;
-      node = node + 1u;
-    } else {
-      u = fmin((u - first) / (1.0f - first), 0x1.fffffep-1f);
-      prob *= 1.0f - first;
-      node = sc->light_tree[node].child;
+  for (uint level = 0u; level < LIGHT_TREE_MAX_DEPTH; ++level) {
+    float4 p;
+    if (!lights_tree_children(sc, node, ctx, &p)) return false;
+    // The slot whose interval of the running sum holds u; the last nonzero one when
+    // rounding leaves u past them all (slots of probability 0 have empty intervals)
+    float c1 = p.x, c2 = c1 + p.y, c3 = c2 + p.z;
+    uint slot = u < c1 ? 0u : (u < c2 ? 1u : (u < c3 ? 2u : 3u));
+    uint last = p.w > 0.0f ? 3u : (p.z > 0.0f ? 2u : (p.y > 0.0f ? 1u : 0u));
+    slot = min(slot, last);
+    float below = slot == 0u ? 0.0f : (slot == 1u ? c1 : (slot == 2u ? c2 : c3));
+    float taken = slot == 0u ? p.x : (slot == 1u ? p.y : (slot == 2u ? p.z : p.w));
+    u = fmin(fmax(u - below, 0.0f) / taken, 0x1.fffffep-1f);
+    prob *= taken;
+    __global const LightTreeNode* n = &sc->light_tree[node];
+    if (n->leaf[slot] == LIGHT_TREE_LEAF) {
+      *light = n->child[slot];
+      *pmf = prob;
+      return prob > 0.0f;
     }
+    node = n->child[slot];
   }
-  *light = sc->light_tree[node].child;
-  *pmf = prob;
-  return prob > 0.0f;
+  return false;
 }
 
 // The probability with which lights_tree_sample picks `light` (one of the tree's) at ctx
 float lights_tree_pmf(const SceneData* sc, const LightSampleContext* ctx, uint light) {
 #pragma OPENCL FP_CONTRACT OFF
-  if (!(lights_tree_importance(&sc->light_tree[0], ctx) > 0.0f)) return 0.0f;
   __global const LightTreeTrail* trail = &sc->light_trails[light];
   uint node = 0u;
   float prob = 1.0f;
   for (uint k = 0u; k < trail->depth; ++k) {
-    float first = lights_tree_first(sc, node, ctx);
-    if (first < 0.0f) return 0.0f;
-    if (((trail->bits[k >> 5] >> (k & 31u)) & 1u) == 0u) {
-      prob *= first;
-      node = node + 1u;
-    } else {
-      prob *= 1.0f - first;
-      node = sc->light_tree[node].child;
-    }
+    float4 p;
+    if (!lights_tree_children(sc, node, ctx, &p)) return 0.0f;
+    uint slot = (trail->bits[k >> 4] >> (2u * (k & 15u))) & 3u;
+    prob *= slot == 0u ? p.x : (slot == 1u ? p.y : (slot == 2u ? p.z : p.w));
+    node = sc->light_tree[node].child[slot];
   }
   return prob;
 }

@@ -347,43 +347,46 @@ typedef struct {
   float params[8];    // per-type parameters, see above
 } Light;
 
-// A node of the light tree, 64 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
+// A node of the light tree, 240 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
 // Importance Sampling of Many Lights with Adaptive Tree Splitting). The tree holds the
-// finite lights (triangles, points, spots), one per leaf; nodes are stored depth first, an
-// interior node's first child right after it. Interior nodes inside a planar emitter made
-// of several triangles (a quad light; host/compile/light_tree.cpp) are LIGHT_TREE_CLUSTER:
-// they take their first child with probability `share` (its share of their power) instead
-// of by importance. Each node bounds its lights' positions
-// (lo, hi), the directions they emit in (every light's emission axis lies within theta_o
-// of `axis`, and each emits only within theta_e beyond its axis) and sums their peak
-// radiant intensity (luminance; a triangle: L A). A scene without finite lights, or one
-// compiled for power selection, has one node of intensity 0: every light goes through the
-// alias table.
+// finite lights (triangles, points, spots), one per leaf; a node has up to four children,
+// stored by field across its slots (lo[axis][slot], ...) so that the kernel weighs all four
+// in one pass of float4 arithmetic; the root is node 0. Each slot bounds its child's
+// lights: their positions (lo, hi), the directions they emit in (every light's emission
+// axis lies within theta_o of `axis`, and each emits only within theta_e beyond its axis)
+// and their summed peak radiant intensity (luminance; a triangle: L A); intensity 0 marks an
+// empty slot. A node inside a planar emitter made of several triangles (a quad light;
+// host/compile/light_tree.cpp) is a cluster: it takes its children by their share of its
+// intensity instead of by importance. A scene without finite lights, or one compiled for
+// power selection, has one node of share 0: every light goes through the alias table.
 #define LIGHT_TREE_INTERIOR 0u
 #define LIGHT_TREE_LEAF 1u
-#define LIGHT_TREE_CLUSTER 2u
+#define LIGHT_TREE_WIDTH 4u
 typedef struct {
-  float lo[3];
-  float intensity;
-  float hi[3];
-  float cos_o;  // cos theta_o
-  float axis[3];
-  float cos_e;         // cos theta_e
-  unsigned int child;  // interior: index of the second child; leaf: index of its light
-  unsigned int leaf;   // LIGHT_TREE_INTERIOR, LIGHT_TREE_LEAF or LIGHT_TREE_CLUSTER
-  float share;         // root: probability that selection goes into the tree; cluster: of the first child
-  float min_prob;      // root: least probability of a child that can light the point (see lights.cl)
+  float lo[3][4];         // [axis][slot]
+  float hi[3][4];         // [axis][slot]
+  float axis[3][4];       // [axis][slot]
+  float intensity[4];     // 0: no child in the slot
+  float cos_o[4];         // cos theta_o
+  float cos_e[4];         // cos theta_e
+  unsigned int child[4];  // LIGHT_TREE_LEAF slot: its light; LIGHT_TREE_INTERIOR: the child node
+  unsigned int leaf[4];   // LIGHT_TREE_INTERIOR or LIGHT_TREE_LEAF
+  unsigned int cluster;   // 1: children by their share of the intensity, not by importance
+  unsigned int pad;
+  float share;     // root: probability that selection goes into the tree
+  float min_prob;  // root: least probability of a child that can light the point, before
+                   // renormalization (see lights.cl)
 } LightTreeNode;
 
-// The path from the root of the light tree to a light's leaf, 16 bytes: step k (k < depth)
-// goes to the second child when bit k of bits[0] (k < 32) or bits[1] (k >= 32) is set.
-// Lights outside the tree have depth LIGHT_TREE_NONE.
+// The path from the root of the light tree to a light's leaf, 32 bytes: step k (k < depth)
+// takes slot (bits[k / 16] >> (2 (k % 16))) & 3. Lights outside the tree have depth
+// LIGHT_TREE_NONE.
 #define LIGHT_TREE_NONE 0xffffffffu
 #define LIGHT_TREE_MAX_DEPTH 64u
 typedef struct {
-  unsigned int bits[2];
+  unsigned int bits[4];
   unsigned int depth;
-  unsigned int pad;
+  unsigned int pad[3];
 } LightTreeTrail;
 
 // A participating medium, 128 bytes (media.cl). Coefficients are per unit length in linear
@@ -520,10 +523,11 @@ typedef struct {
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                                                 \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)                      \
     FIELD(Light, params, 32)                                                                                  \
-  SIZE(LightTreeNode, 64) FIELD(LightTreeNode, intensity, 12) FIELD(LightTreeNode, cos_o, 28) \
-    FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, cos_e, 44) FIELD(LightTreeNode, child, 48) \
-    FIELD(LightTreeNode, leaf, 52) FIELD(LightTreeNode, share, 56) FIELD(LightTreeNode, min_prob, 60) \
-  SIZE(LightTreeTrail, 16) FIELD(LightTreeTrail, depth, 8) \
+  SIZE(LightTreeNode, 240) FIELD(LightTreeNode, hi, 48) FIELD(LightTreeNode, axis, 96)                      \
+    FIELD(LightTreeNode, intensity, 144) FIELD(LightTreeNode, cos_o, 160) FIELD(LightTreeNode, cos_e, 176)    \
+    FIELD(LightTreeNode, child, 192) FIELD(LightTreeNode, leaf, 208) FIELD(LightTreeNode, cluster, 224)       \
+    FIELD(LightTreeNode, share, 232) FIELD(LightTreeNode, min_prob, 236)                                      \
+  SIZE(LightTreeTrail, 32) FIELD(LightTreeTrail, depth, 16)                                                   \
   SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48)               \
     FIELD(Medium, emission_grid, 44) FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68)                 \
     FIELD(Medium, grid_min, 80) FIELD(Medium, grid_max, 96) FIELD(Medium, majorant_offset, 112)               \

@@ -154,11 +154,82 @@ double hull_area(std::vector<glm::dvec2> p) {
 // all; two square lamps one lamp's width apart cover half
 constexpr double kClusterCover = 0.75;
 
+// A node of the binary tree the builder splits, before it is made four wide
+constexpr uint32_t kCluster = 2u;  // interior node inside a planar emitter
+struct BinaryNode {
+  LightBounds bounds;
+  uint32_t next = 0;                    // interior: the second child (the first follows the node); leaf: its light
+  uint32_t kind = LIGHT_TREE_INTERIOR;  // LIGHT_TREE_INTERIOR, LIGHT_TREE_LEAF or kCluster
+};
+
+// Makes the binary tree four wide: a node's children are its binary children, each replaced
+// by its own two (and so on, level by level, while the four slots last) when it is of the
+// node's kind, interior or cluster: a cluster is never opened by an interior node and
+// weighed lane by lane, and a leaf stays a leaf. Writes each light's trail.
+struct Widener {
+  const std::vector<BinaryNode>& binary;
+  LightTree* tree;
+
+  uint32_t widen(uint32_t b, const dev::LightTreeTrail& trail) {
+    uint32_t index = uint32_t(tree->nodes.size());
+    tree->nodes.emplace_back();
+    tree->depth = std::max(tree->depth, int(trail.depth) + 1);
+    uint32_t kind = binary[b].kind;
+    // Open children of the node's kind level by level while the slots last
+    std::vector<uint32_t> children{b + 1, binary[b].next};
+    for (bool opened = true; opened && children.size() < LIGHT_TREE_WIDTH;) {
+      opened = false;
+      for (size_t i = 0; i < children.size() && children.size() < LIGHT_TREE_WIDTH;) {
+        uint32_t c = children[i];
+        if (binary[c].kind != kind) {
+          ++i;
+          continue;
+        }
+        children[i] = c + 1;
+        children.insert(children.begin() + long(i) + 1, binary[c].next);
+        opened = true;
+        i += 2;
+      }
+    }
+    tree->nodes[index].cluster = kind == kCluster ? 1u : 0u;
+    for (uint32_t slot = 0; slot < children.size(); ++slot) {
+      const BinaryNode& c = binary[children[slot]];
+      write(index, slot, c.bounds);
+      dev::LightTreeTrail t = trail;
+      t.bits[t.depth >> 4] |= slot << (2u * (t.depth & 15u));
+      ++t.depth;
+      if (c.kind == LIGHT_TREE_LEAF) {
+        tree->nodes[index].leaf[slot] = LIGHT_TREE_LEAF;
+        tree->nodes[index].child[slot] = c.next;
+        tree->trails[c.next] = t;
+      } else {
+        uint32_t child = widen(children[slot], t);
+        tree->nodes[index].leaf[slot] = LIGHT_TREE_INTERIOR;
+        tree->nodes[index].child[slot] = child;
+      }
+    }
+    return index;
+  }
+
+  void write(uint32_t index, uint32_t slot, const LightBounds& b) {
+    dev::LightTreeNode& n = tree->nodes[index];
+    for (int k = 0; k < 3; ++k) {
+      n.lo[k][slot] = b.lo[k];
+      n.hi[k][slot] = b.hi[k];
+      n.axis[k][slot] = float(b.axis[k]);
+    }
+    float intensity = float(std::min(b.intensity, double(std::numeric_limits<float>::max())));
+    n.intensity[slot] = std::max(intensity, std::numeric_limits<float>::min());
+    n.cos_o[slot] = b.theta_o >= kPi ? -1.0f : cos_down(b.theta_o);
+    n.cos_e[slot] = cos_down(b.theta_e);
+  }
+};
+
 struct Builder {
   const dev::SceneBuffers& buffers;
   const std::vector<LightBounds>& bounds;
-  std::vector<uint32_t>& order;  // light indices, partitioned in place
-  LightTree* tree;
+  std::vector<uint32_t>& order;   // light indices, partitioned in place
+  std::vector<BinaryNode> nodes;  // depth first, a node's first child right after it
 
   // Whether lights order[begin, end) make one planar emitter: triangles in one plane, all
   // single-sided facing one way or all double-sided, that cover at least kClusterCover of
@@ -193,46 +264,23 @@ struct Builder {
     return area >= kClusterCover * hull_area(std::move(points));
   }
 
-  // Builds the subtree over order[begin, end) at `depth` with trail `bits`; returns its
-  // bounds. `cluster`: the lights are part of one planar emitter (planar_emitter).
-  LightBounds build(size_t begin, size_t end, uint32_t depth, uint64_t bits, bool cluster = false) {
-    size_t index = tree->nodes.size();
-    tree->nodes.emplace_back();
-    tree->depth = std::max(tree->depth, int(depth));
+  // Builds the binary subtree over order[begin, end) at `depth`; returns its bounds.
+  // `cluster`: the lights are part of one planar emitter (planar_emitter).
+  LightBounds build(size_t begin, size_t end, uint32_t depth, bool cluster = false) {
+    size_t index = nodes.size();
+    nodes.emplace_back();
     if (end - begin == 1) {
-      uint32_t light = order[begin];
-      dev::LightTreeTrail& t = tree->trails[light];
-      t.bits[0] = uint32_t(bits);
-      t.bits[1] = uint32_t(bits >> 32);
-      t.depth = depth;
-      write(index, bounds[light], light, LIGHT_TREE_LEAF);
-      return bounds[light];
+      nodes[index] = BinaryNode{bounds[order[begin]], order[begin], LIGHT_TREE_LEAF};
+      return bounds[order[begin]];
     }
     if (depth + 1 >= LIGHT_TREE_MAX_DEPTH) throw Error("light tree deeper than LIGHT_TREE_MAX_DEPTH");
     cluster = cluster || planar_emitter(begin, end);
     size_t mid = split(begin, end, depth);
-    LightBounds a = build(begin, mid, depth + 1, bits, cluster);
-    uint32_t second = uint32_t(tree->nodes.size());
-    LightBounds b = build(mid, end, depth + 1, bits | (uint64_t(1) << depth), cluster);
-    LightBounds u = unite(a, b);
-    write(index, u, second, cluster ? LIGHT_TREE_CLUSTER : LIGHT_TREE_INTERIOR);
-    if (cluster) tree->nodes[index].share = float(a.intensity / (a.intensity + b.intensity));
-    return u;
-  }
-
-  void write(size_t index, const LightBounds& b, uint32_t child, uint32_t leaf) {
-    dev::LightTreeNode& n = tree->nodes[index];
-    for (int k = 0; k < 3; ++k) {
-      n.lo[k] = b.lo[k];
-      n.hi[k] = b.hi[k];
-      n.axis[k] = float(b.axis[k]);
-    }
-    n.intensity = float(std::min(b.intensity, double(std::numeric_limits<float>::max())));
-    n.intensity = std::max(n.intensity, std::numeric_limits<float>::min());
-    n.cos_o = b.theta_o >= kPi ? -1.0f : cos_down(b.theta_o);
-    n.cos_e = cos_down(b.theta_e);
-    n.child = child;
-    n.leaf = leaf;
+    LightBounds a = build(begin, mid, depth + 1, cluster);
+    uint32_t second = uint32_t(nodes.size());
+    LightBounds b = build(mid, end, depth + 1, cluster);
+    nodes[index] = BinaryNode{unite(a, b), second, cluster ? kCluster : LIGHT_TREE_INTERIOR};
+    return nodes[index].bounds;
   }
 
   // Where to split order[begin, end): the lowest-cost bucket boundary, or the median along
@@ -305,7 +353,9 @@ struct Builder {
 LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<double>& power,
                            const std::vector<double>& pmf) {
   LightTree tree;
-  tree.trails.assign(buffers.lights.size(), dev::LightTreeTrail{{0u, 0u}, LIGHT_TREE_NONE, 0u});
+  dev::LightTreeTrail none{};
+  none.depth = LIGHT_TREE_NONE;
+  tree.trails.assign(buffers.lights.size(), none);
   std::vector<LightBounds> bounds(buffers.lights.size());
   std::vector<uint32_t> order;
   double share = 0.0;
@@ -317,20 +367,17 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
     share += pmf[i];
   }
   if (order.empty()) return tree;
-  Builder builder{buffers, bounds, order, &tree};
-  builder.build(0, order.size(), 0u, 0u);
+  Builder builder{buffers, bounds, order, {}};
+  builder.build(0, order.size(), 0u);
   // One light, or one planar emitter: the tree would pick as the alias table does, by power
-  if (tree.nodes[0].leaf != LIGHT_TREE_INTERIOR) {
-    LightTree none;
-    none.trails = std::move(tree.trails);
-    for (dev::LightTreeTrail& t : none.trails) t.depth = LIGHT_TREE_NONE;
-    return none;
-  }
+  if (builder.nodes[0].kind != LIGHT_TREE_INTERIOR) return tree;
+  Widener{builder.nodes, &tree}.widen(0, dev::LightTreeTrail{});
   tree.nodes[0].share = float(std::min(share, 1.0));
-  // Least probability of a child: min_prob^depth x share >= 2^-124 (a normal float)
-  if (tree.depth > 0)
-    tree.nodes[0].min_prob =
-        float(std::min(0.25, std::pow(std::ldexp(1.0, -124) / double(tree.nodes[0].share), 1.0 / double(tree.depth))));
+  // Least probability of a child before renormalization, min_prob: after it a child gets
+  // at least q = min_prob / (1 + 4 min_prob); q^depth x share >= 2^-124 (a normal float),
+  // with a margin for rounding
+  double q = std::pow(std::ldexp(1.0, -124) / double(tree.nodes[0].share), 1.0 / double(tree.depth));
+  tree.nodes[0].min_prob = float(q < 0.2 ? std::min(1.0 / 16.0, 1.001 * q / (1.0 - 4.0 * q)) : 1.0 / 16.0);
   return tree;
 }
 

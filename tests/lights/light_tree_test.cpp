@@ -1,6 +1,6 @@
 // The light tree (host/compile/light_tree.cpp, cl/lights/lights.cl) on the real kernel code:
-//  - its structure: every tree light's trail leads to its leaf, every node bounds its
-//    children's positions and emission cones;
+//  - its structure: every tree light's trail leads to its leaf, every slot of a node bounds
+//    its child's positions and emission cones;
 //  - lights_select_pmf sums to 1 over the lights at random shading points (inside the
 //    lights' bounds too, and in a medium, n = 0), and is > 0 for every light that can
 //    light the point;
@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <glm/glm.hpp>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -33,20 +34,31 @@ const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 
 CompiledScene compiled(const std::string& file) { return compile_scene(load_gltf(scene_path(file))); }
 
-glm::dvec3 node_lo(const dev::LightTreeNode& n) { return {n.lo[0], n.lo[1], n.lo[2]}; }
-glm::dvec3 node_hi(const dev::LightTreeNode& n) { return {n.hi[0], n.hi[1], n.hi[2]}; }
-glm::dvec3 node_axis(const dev::LightTreeNode& n) { return {n.axis[0], n.axis[1], n.axis[2]}; }
+// What a node's slot bounds: its child's box, emission cone and intensity
+struct Slot {
+  glm::dvec3 lo, hi, axis;
+  double cos_o, cos_e, intensity;
+};
+
+Slot slot_of(const dev::LightTreeNode& n, uint32_t k) {
+  return {{n.lo[0][k], n.lo[1][k], n.lo[2][k]},
+          {n.hi[0][k], n.hi[1][k], n.hi[2][k]},
+          {n.axis[0][k], n.axis[1][k], n.axis[2][k]},
+          n.cos_o[k],
+          n.cos_e[k],
+          n.intensity[k]};
+}
 
 // Whether cone (axis a, cos_o a) holds cone b: the angle between the axes plus b's theta_o
 // within a's theta_o (1e-5 rad of rounding)
-bool cone_holds(const dev::LightTreeNode& a, const dev::LightTreeNode& b) {
-  double theta_a = std::acos(std::clamp(double(a.cos_o), -1.0, 1.0));
-  double theta_b = std::acos(std::clamp(double(b.cos_o), -1.0, 1.0));
-  double d = std::acos(std::clamp(glm::dot(node_axis(a), node_axis(b)), -1.0, 1.0));
+bool cone_holds(const Slot& a, const Slot& b) {
+  double theta_a = std::acos(std::clamp(a.cos_o, -1.0, 1.0));
+  double theta_b = std::acos(std::clamp(b.cos_o, -1.0, 1.0));
+  double d = std::acos(std::clamp(glm::dot(a.axis, b.axis), -1.0, 1.0));
   return theta_a >= 3.14159 || d + theta_b <= theta_a + 1e-5;
 }
 
-// Checks the tree's structure and counts its LIGHT_TREE_CLUSTER nodes
+// Checks the tree's structure and counts its cluster nodes
 void check_tree(const CompiledScene& c, size_t* clusters) {
   const auto& nodes = c.buffers.light_tree;
   const auto& trails = c.buffers.light_trails;
@@ -63,48 +75,66 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
     }
     ++in_tree;
     share += light.pmf;
+    ASSERT_GT(trails[l].depth, 0u);
     uint32_t node = 0;
     for (uint32_t k = 0; k < trails[l].depth; ++k) {
-      ASSERT_NE(nodes[node].leaf, LIGHT_TREE_LEAF);
-      node = ((trails[l].bits[k >> 5] >> (k & 31)) & 1u) ? nodes[node].child : node + 1;
       ASSERT_LT(node, nodes.size());
+      uint32_t slot = (trails[l].bits[k >> 4] >> (2 * (k & 15))) & 3u;
+      ASSERT_GT(nodes[node].intensity[slot], 0.0f) << "light " << l << "'s trail enters an empty slot";
+      bool last = k + 1 == trails[l].depth;
+      ASSERT_EQ(nodes[node].leaf[slot], last ? LIGHT_TREE_LEAF : LIGHT_TREE_INTERIOR) << "light " << l;
+      if (last) {
+        EXPECT_EQ(nodes[node].child[slot], l) << "light " << l << "'s trail ends at another light's leaf";
+      }
+      node = nodes[node].child[slot];
     }
-    EXPECT_EQ(nodes[node].leaf, LIGHT_TREE_LEAF);
-    EXPECT_EQ(nodes[node].child, l) << "light " << l << "'s trail ends at another light's leaf";
   }
-  EXPECT_EQ(nodes.size(), 2 * in_tree - 1);
+  // Every node but the root fills one slot, and every light one
+  size_t slots = 0;
+  for (const dev::LightTreeNode& n : nodes)
+    for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k) slots += n.intensity[k] > 0.0f ? 1 : 0;
+  EXPECT_EQ(slots, nodes.size() - 1 + in_tree);
   uint32_t depth = 0;
   for (const dev::LightTreeTrail& t : trails)
     if (t.depth != LIGHT_TREE_NONE) depth = std::max(depth, t.depth);
-  std::printf("%zu lights in the tree, deepest leaf at depth %u\n", in_tree, depth);
-  // No trail's least pmf (every turn at min_prob) underflows
-  if (depth > 0) {
-    EXPECT_GE(depth * std::log2(double(nodes[0].min_prob)) + std::log2(double(nodes[0].share)), -124.01);
-  }
+  std::printf("%zu lights in the tree, %zu nodes, deepest leaf at depth %u\n", in_tree, nodes.size(), depth);
+  // No trail's least pmf (every turn at the least probability a child can get) underflows
+  double q = double(nodes[0].min_prob) / (1.0 + 4.0 * double(nodes[0].min_prob));
+  EXPECT_GE(depth * std::log2(q) + std::log2(double(nodes[0].share)), -124.01);
   EXPECT_NEAR(nodes[0].share, share, 1e-5);
   // A tree of one light or one planar emitter would pick as the alias table does: none is built
-  EXPECT_EQ(nodes[0].leaf, LIGHT_TREE_INTERIOR);
+  EXPECT_EQ(nodes[0].cluster, 0u);
   *clusters = 0;
   for (size_t i = 0; i < nodes.size(); ++i) {
     const dev::LightTreeNode& n = nodes[i];
-    if (n.leaf == LIGHT_TREE_LEAF) continue;
-    if (n.leaf == LIGHT_TREE_CLUSTER) {  // children by their share of the power, clusters too
-      ++*clusters;
-      for (const dev::LightTreeNode* ch : {&nodes[i + 1], &nodes[n.child]})
-        EXPECT_NE(ch->leaf, LIGHT_TREE_INTERIOR) << "node " << i;
-      EXPECT_NEAR(n.share, nodes[i + 1].intensity / (nodes[i + 1].intensity + nodes[n.child].intensity), 1e-5);
-      double facing = nodes[i + 1].axis[0] * nodes[n.child].axis[0] + nodes[i + 1].axis[1] * nodes[n.child].axis[1] +
-                      nodes[i + 1].axis[2] * nodes[n.child].axis[2];
-      EXPECT_NEAR(nodes[i + 1].cos_o < -0.5f ? std::abs(facing) : facing, 1.0, 1e-6)
-          << "a cluster's lights lie in one plane, facing one way when single-sided";
+    int filled = 0;
+    for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k) {
+      if (!(n.intensity[k] > 0.0f)) continue;
+      ++filled;
+      Slot s = slot_of(n, k);
+      if (n.cluster) {  // children by their share of the intensity, clusters too
+        if (n.leaf[k] == LIGHT_TREE_INTERIOR) {
+          EXPECT_EQ(nodes[n.child[k]].cluster, 1u) << "node " << i;
+        }
+        double facing = glm::dot(s.axis, slot_of(n, 0).axis);
+        EXPECT_NEAR(s.cos_o < -0.5 ? std::abs(facing) : facing, 1.0, 1e-6)
+            << "a cluster's lights lie in one plane, facing one way when single-sided";
+      }
+      if (n.leaf[k] == LIGHT_TREE_LEAF) continue;
+      // The slot bounds its child's slots
+      const dev::LightTreeNode& m = nodes[n.child[k]];
+      for (uint32_t j = 0; j < LIGHT_TREE_WIDTH; ++j) {
+        if (!(m.intensity[j] > 0.0f)) continue;
+        Slot ch = slot_of(m, j);
+        EXPECT_TRUE(glm::all(glm::lessThanEqual(s.lo, ch.lo)));
+        EXPECT_TRUE(glm::all(glm::greaterThanEqual(s.hi, ch.hi)));
+        EXPECT_TRUE(cone_holds(s, ch)) << "node " << i;
+        EXPECT_LE(s.cos_e, ch.cos_e);
+        EXPECT_GE(s.intensity, 0.999 * ch.intensity);
+      }
     }
-    for (const dev::LightTreeNode* ch : {&nodes[i + 1], &nodes[n.child]}) {
-      EXPECT_TRUE(glm::all(glm::lessThanEqual(node_lo(n), node_lo(*ch))));
-      EXPECT_TRUE(glm::all(glm::greaterThanEqual(node_hi(n), node_hi(*ch))));
-      EXPECT_TRUE(cone_holds(n, *ch)) << "node " << i;
-      EXPECT_LE(n.cos_e, ch->cos_e);
-      EXPECT_GE(n.intensity, 0.999 * ch->intensity);
-    }
+    EXPECT_GE(filled, 2) << "node " << i << " has one child";
+    if (n.cluster) ++*clusters;
   }
 }
 
@@ -167,7 +197,13 @@ class LightTreeTest : public DeviceTest {
 // boxes, some outside), with random normals; every fourth in a medium (n = 0)
 void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* ps, std::vector<cl_float4>* ns) {
   const dev::LightTreeNode& root = c.buffers.light_tree[0];
-  glm::dvec3 lo = node_lo(root), hi = node_hi(root), mid = 0.5 * (lo + hi), half = 0.75 * (hi - lo) + 0.5;
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k) {
+    if (!(root.intensity[k] > 0.0f)) continue;
+    lo = glm::min(lo, slot_of(root, k).lo);
+    hi = glm::max(hi, slot_of(root, k).hi);
+  }
+  glm::dvec3 mid = 0.5 * (lo + hi), half = 0.75 * (hi - lo) + 0.5;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g;
