@@ -30,6 +30,13 @@ void energy_cell_of(float x, int nodes, int* cell, float* weight) {
   *weight = z - (float)*cell;
 }
 
+// The cell of node j itself on `nodes` nodes: [j, j + 1] with weight 0, or for the last node
+// the last cell with weight 1 (a lookup exactly at a node, no interpolation)
+void energy_node_cell(int j, int nodes, int* cell, float* weight) {
+  *cell = min(j, nodes - 2);
+  *weight = (float)(j - *cell);
+}
+
 float energy_y(float mu, float alpha) {
   float c = 4.0f * alpha;
   return sqrt(mu * (1.0f + c) / (mu + c));
@@ -214,8 +221,10 @@ GgxEnergy energy_cell(__global const float* table, float alpha, int row, float t
 
 // The lookup at row j exactly (no interpolation in roughness)
 GgxEnergy energy_row(__global const float* table, int j) {
-  int row = min(j, GGX_ALBEDO_N - 2);
-  return energy_cell(table, energy_node(j) * energy_node(j), row, (float)(j - row));
+  int row;
+  float t;
+  energy_node_cell(j, GGX_ALBEDO_N, &row, &t);
+  return energy_cell(table, energy_node(j) * energy_node(j), row, t);
 }
 
 // 8-point Gauss-Legendre nodes and weights on [-1, 1] (half of them: +-x)
@@ -368,10 +377,8 @@ GgxEnergy energy_aniso_row(__global const float* table, int j, int k) {
   e.a1 = g.ax;
   e.a0 = g.ay;
   e.alpha = sqrt(g.ax * g.ay);
-  e.row = min(j, GGX_ANISO_R - 2);
-  e.t = (float)(j - e.row);
-  e.qrow = min(k, GGX_ANISO_Q - 2);
-  e.tq = (float)(k - e.qrow);
+  energy_node_cell(j, GGX_ANISO_R, &e.row, &e.t);
+  energy_node_cell(k, GGX_ANISO_Q, &e.qrow, &e.tq);
   return e;
 }
 

@@ -134,10 +134,8 @@ DielectricEnergy energy_dielectric_node(__global const float* table, int j, int 
   g.ax = g.ay = energy_dielectric_r_node(j) * energy_dielectric_r_node(j);
   float eta = energy_dielectric_eta_node(k);
   DielectricEnergy d = energy_dielectric_cells(table, g, side ? 1.0f / eta : eta);
-  d.row = min(j, DIEL_ALBEDO_R - 2);
-  d.t = (float)(j - d.row);
-  d.col = min(k, DIEL_ALBEDO_F - 2);
-  d.s = (float)(k - d.col);
+  energy_node_cell(j, DIEL_ALBEDO_R, &d.row, &d.t);
+  energy_node_cell(k, DIEL_ALBEDO_F, &d.col, &d.s);
   return d;
 }
 
@@ -300,12 +298,9 @@ DielectricEnergy energy_dielectric_aniso_node_cells(__global const float* table,
   DielectricEnergy d = energy_dielectric_cells(table, g, side ? 1.0f / eta : eta);
   d.aniso = true;
   d.swap = false;
-  d.row = min(j, DIEL_ANISO_R - 2);
-  d.t = (float)(j - d.row);
-  d.qrow = min(k, DIEL_ANISO_Q - 2);
-  d.tq = (float)(k - d.qrow);
-  d.col = min(f, DIEL_ANISO_F - 2);
-  d.s = (float)(f - d.col);
+  energy_node_cell(j, DIEL_ANISO_R, &d.row, &d.t);
+  energy_node_cell(k, DIEL_ANISO_Q, &d.qrow, &d.tq);
+  energy_node_cell(f, DIEL_ANISO_F, &d.col, &d.s);
   return d;
 }
 
