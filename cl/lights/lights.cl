@@ -380,9 +380,10 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // into the sphere (the |cos| the estimator weighs by; 1 in a medium, n = 0). Both cosines
 // are kept at least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so
 // float rounding never gives 0 to a light that can contribute. A node's four children are
-// weighed at once, one child per float4 lane. Every child of nonzero importance is given at
-// least the root's `min_prob` times their sum before they are normalized, so a probability
-// of at least min_prob / (1 + 4 min_prob); the host sets min_prob so that the product over the
+// weighed at once, one child per float4 lane. Every child of nonzero importance is given a
+// share of at least the root's `min_prob` before the shares are renormalized, so a
+// probability of at least min_prob / (1 + 4 min_prob) (also when another child's importance
+// is infinite); the host sets min_prob so that the product over the
 // deepest trail, times the tree's share, stays above 2^-124: no light's pmf underflows (to
 // 0 on devices that flush denormals). Sampling and the pmf of a given light
 // (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
@@ -403,33 +404,33 @@ float4 lights_tree_importance(__global const LightTreeNode* node, const LightSam
          dz = ctx->p.z - 0.5f * (lo_z + hi_z);
   float4 dist2 = dx * dx + dy * dy + dz * dz;
   int4 outside = isgreater(dist2, r2);
-  // theta_b, the angle the sphere subtends: its sine and cosine both from r^2 / d^2, and the
-  // cosine and sine of each difference of angles below from the addition formulas (no
-  // square root of a previous result on the dependent chain)
+  // theta_b, the angle the sphere subtends: its sine and cosine both from r^2 / d^2; the
+  // sine of each difference of angles below comes from the addition formula, not from a
+  // square root of its cosine
   float4 sin2_b = select((float4)(1.0f), r2 / fmax(dist2, 1e-30f), outside);
-  float4 cos_b = sqrt(fmax(0.0f, 1.0f - sin2_b)), sin_b = sqrt(fmin(sin2_b, 1.0f));
+  float4 cos_b = sqrt(fmax(1.0f - sin2_b, 0.0f)), sin_b = sqrt(fmin(sin2_b, 1.0f));
   float4 inv_d = rsqrt(fmax(dist2, 1e-30f));
   float4 wx = dx * inv_d, wy = dy * inv_d, wz = dz * inv_d;  // from the child to ctx.p
   // Emitter side: theta' = max(0, theta_w - theta_o - theta_b)
-  float4 cos_o = vload4(0, node->cos_o), sin_o = sqrt(fmax(0.0f, 1.0f - cos_o * cos_o));
+  float4 cos_o = vload4(0, node->cos_o), sin_o = sqrt(fmax(1.0f - cos_o * cos_o, 0.0f));
   float4 cos_w = vload4(0, node->axis[0]) * wx + vload4(0, node->axis[1]) * wy + vload4(0, node->axis[2]) * wz;
   cos_w = clamp(cos_w, -1.0f, 1.0f);
-  float4 sin_w = sqrt(fmax(0.0f, 1.0f - cos_w * cos_w));
+  float4 sin_w = sqrt(fmax(1.0f - cos_w * cos_w, 0.0f));
   int4 in_cone = isgreaterequal(cos_w, cos_o);  // theta_w <= theta_o
   float4 cos_x = select(cos_w * cos_o + sin_w * sin_o, (float4)(1.0f), in_cone);
-  float4 sin_x = select(fmax(0.0f, sin_w * cos_o - cos_w * sin_o), (float4)(0.0f), in_cone);
+  float4 sin_x = select(fmax(sin_w * cos_o - cos_w * sin_o, 0.0f), (float4)(0.0f), in_cone);
   float4 cos_p = select(cos_x * cos_b + sin_x * sin_b, (float4)(1.0f), isgreaterequal(cos_x, cos_b));
   float4 importance = intensity * fmax(cos_p, LIGHT_TREE_MIN_COS);
   importance = select(importance, (float4)(0.0f), isless(cos_p, vload4(0, node->cos_e) - LIGHT_TREE_MIN_COS));
   // Receiver side: theta_i' = max(0, theta_i - theta_b), |cos| to the shading normal
   if (dot(ctx->ns, ctx->ns) > 0.0f) {
     float4 cos_i = fmin(fabs(ctx->ns.x * wx + ctx->ns.y * wy + ctx->ns.z * wz), 1.0f);
-    float4 sin_i = sqrt(fmax(0.0f, 1.0f - cos_i * cos_i));
+    float4 sin_i = sqrt(fmax(1.0f - cos_i * cos_i, 0.0f));
     float4 cos_r = select(cos_i * cos_b + sin_i * sin_b, (float4)(1.0f), isgreaterequal(cos_i, cos_b));
     importance *= fmax(cos_r, LIGHT_TREE_MIN_COS);
   }
   importance = select(intensity / fmax(r2, 1e-30f), importance / fmax(dist2, 1e-30f), outside);
-  return select((float4)(0.0f), importance, isgreater(intensity, 0.0f));
+  return select((float4)(0.0f), importance, isgreater(intensity, (float4)(0.0f)));
 }
 
 // The probabilities of taking each of node's children at ctx; false when none can light ctx.p
@@ -437,15 +438,16 @@ bool lights_tree_children(const SceneData* sc, uint node, const LightSampleConte
 #pragma OPENCL FP_CONTRACT OFF
   __global const LightTreeNode* n = &sc->light_tree[node];
   float4 w = n->cluster ? vload4(0, n->intensity) : lights_tree_importance(n, ctx);
+  int4 can_light = isgreater(w, (float4)(0.0f));  // before any rescaling below can flush a lane
   int4 infinite = isinf(w);
-  if (any(infinite)) w = select((float4)(0.0f), (float4)(1.0f), infinite);
+  if (any(infinite)) w = select((float4)(0.0f), (float4)(1.0f), infinite);  // the finite get the floor
   float sum = w.x + w.y + w.z + w.w;
   if (isinf(sum)) {  // finite weights whose sum overflows
     w *= 0.25f;
     sum = w.x + w.y + w.z + w.w;
   }
   if (!(sum > 0.0f)) return false;
-  float4 q = select((float4)(0.0f), fmax(w, sc->light_tree[0].min_prob * sum), isgreater(w, 0.0f));
+  float4 q = select((float4)(0.0f), fmax(w / sum, sc->light_tree[0].min_prob), can_light);
   *p = q * (1.0f / (q.x + q.y + q.z + q.w));
   return true;
 }

@@ -234,7 +234,7 @@ struct Builder {
   // Whether lights order[begin, end) make one planar emitter: triangles in one plane, all
   // single-sided facing one way or all double-sided, that cover at least kClusterCover of
   // their convex hull. Importance barely tells such lights apart from any point the emitter
-  // lights, so the tree picks among them by power alone (LIGHT_TREE_CLUSTER nodes).
+  // lights, so the tree picks among them by power alone (cluster nodes).
   bool planar_emitter(size_t begin, size_t end) const {
     const dev::Light& first = buffers.lights[order[begin]];
     if (first.type != LIGHT_TRIANGLE) return false;
@@ -353,9 +353,9 @@ struct Builder {
 LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<double>& power,
                            const std::vector<double>& pmf) {
   LightTree tree;
-  dev::LightTreeTrail none{};
-  none.depth = LIGHT_TREE_NONE;
-  tree.trails.assign(buffers.lights.size(), none);
+  dev::LightTreeTrail none_trail{};
+  none_trail.depth = LIGHT_TREE_NONE;
+  tree.trails.assign(buffers.lights.size(), none_trail);
   std::vector<LightBounds> bounds(buffers.lights.size());
   std::vector<uint32_t> order;
   double share = 0.0;
@@ -373,11 +373,17 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
   if (builder.nodes[0].kind != LIGHT_TREE_INTERIOR) return tree;
   Widener{builder.nodes, &tree}.widen(0, dev::LightTreeTrail{});
   tree.nodes[0].share = float(std::min(share, 1.0));
-  // Least probability of a child before renormalization, min_prob: after it a child gets
-  // at least q = min_prob / (1 + 4 min_prob); q^depth x share >= 2^-124 (a normal float),
-  // with a margin for rounding
+  // Least share of a child before renormalization, min_prob: after it a child gets at least
+  // q = min_prob / (1 + 4 min_prob); q^depth x share >= 2^-124 (a normal float), with a
+  // margin for rounding. A tree too deep for any floor to keep that (q near 1/4: some 60
+  // levels) is not used: selection by power instead.
   double q = std::pow(std::ldexp(1.0, -124) / double(tree.nodes[0].share), 1.0 / double(tree.depth));
-  tree.nodes[0].min_prob = float(q < 0.2 ? std::min(1.0 / 16.0, 1.001 * q / (1.0 - 4.0 * q)) : 1.0 / 16.0);
+  if (!(q < 0.24)) {
+    LightTree none;
+    none.trails.assign(buffers.lights.size(), none_trail);
+    return none;
+  }
+  tree.nodes[0].min_prob = float(1.001 * q / (1.0 - 4.0 * q));
   return tree;
 }
 

@@ -148,6 +148,39 @@ TEST(LightTree, TrailsLeadToLeavesAndNodesBoundChildren) {
   EXPECT_EQ(clusters, 0u);
 }
 
+// A deep tree: triangles in parallel planes at geometric spacing, each twice the size of the
+// one before, so that every split cuts off the largest (a chain of binary nodes, which the
+// four-wide tree opens three at a time) until the builder turns to median splits. Trails
+// then run past level 16, into the trail's second word, and the least-probability floor
+// holds at that depth.
+TEST(LightTree, DeepTreeTrailsAndFloor) {
+  constexpr int kLights = 120;
+  CompiledScene c;
+  c.buffers.materials.emplace_back();  // single-sided
+  std::vector<double> power, pmf;
+  for (int i = 0; i < kLights; ++i) {
+    float x = std::ldexp(1.0f, i - 60);
+    for (const glm::vec3& v : {glm::vec3(x, 0, 0), glm::vec3(x, x, 0), glm::vec3(x, 0, x)})
+      c.buffers.positions.insert(c.buffers.positions.end(), {v.x, v.y, v.z});
+    dev::Prim prim{{uint32_t(3 * i), uint32_t(3 * i + 1), uint32_t(3 * i + 2)}, 0u};
+    c.buffers.prims.push_back(prim);
+    dev::Light light{};
+    light.type = LIGHT_TRIANGLE;
+    light.index = uint32_t(i);
+    light.params[0] = 0.5f * x * x;  // area
+    light.pmf = 1.0f / kLights;
+    c.buffers.lights.push_back(light);
+    power.push_back(1.0);
+    pmf.push_back(1.0 / kLights);
+  }
+  LightTree tree = build_light_tree(c.buffers, power, pmf);
+  c.buffers.light_tree = tree.nodes;
+  c.buffers.light_trails = tree.trails;
+  size_t clusters = 0;
+  check_tree(c, &clusters);
+  EXPECT_GT(tree.depth, 16) << "no trail reaches the trail's second word";
+}
+
 // One quad light (the Cornell box; a large panel) is one planar emitter: no tree is built,
 // and the kernel is compiled without one
 TEST(LightTree, NoTreeForOnePlanarEmitter) {
