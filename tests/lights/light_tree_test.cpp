@@ -3,7 +3,7 @@
 //    its child's positions and emission cones;
 //  - lights_select_pmf sums to 1 over the lights at random shading points (inside the
 //    lights' bounds too, and in a medium, n = 0), and is > 0 for every light that can
-//    light the point;
+//    light the point, also along trails deeper than 16 levels (a tree built to be deep);
 //  - the frequencies of lights_select match lights_select_pmf (chi-square, alpha 0.01 with
 //    the Sidak correction over this file's chi-square tests), and the pmf it reports is
 //    the one lights_select_pmf computes;
@@ -29,7 +29,7 @@
 namespace candela::test {
 namespace {
 
-constexpr int kChiSquareTests = 3 * 2;  // per device: 3 contexts on 2 scenes
+constexpr int kChiSquareTests = 3 * 3;  // per device: 3 contexts on 3 scenes
 const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 
 CompiledScene compiled(const std::string& file) { return compile_scene(load_gltf(scene_path(file))); }
@@ -152,13 +152,15 @@ TEST(LightTree, TrailsLeadToLeavesAndNodesBoundChildren) {
 // one before, so that every split cuts off the largest (a chain of binary nodes, which the
 // four-wide tree opens three at a time) until the builder turns to median splits. Trails
 // then run past level 16, into the trail's second word, and the least-probability floor
-// holds at that depth.
-TEST(LightTree, DeepTreeTrailsAndFloor) {
-  constexpr int kLights = 120;
+// holds at that depth. Every triangle faces +x (single-sided); equal powers, the alias
+// table's pmf set as the scene compiler sets it.
+constexpr int kDeepLights = 120;
+CompiledScene deep_tree_scene(int* depth) {
   CompiledScene c;
   c.buffers.materials.emplace_back();  // single-sided
-  std::vector<double> power, pmf;
-  for (int i = 0; i < kLights; ++i) {
+  std::vector<double> power(kDeepLights, 1.0), pmf;
+  c.buffers.light_alias = alias_table(power, &pmf);
+  for (int i = 0; i < kDeepLights; ++i) {
     float x = std::ldexp(1.0f, i - 60);
     for (const glm::vec3& v : {glm::vec3(x, 0, 0), glm::vec3(x, x, 0), glm::vec3(x, 0, x)})
       c.buffers.positions.insert(c.buffers.positions.end(), {v.x, v.y, v.z});
@@ -168,17 +170,23 @@ TEST(LightTree, DeepTreeTrailsAndFloor) {
     light.type = LIGHT_TRIANGLE;
     light.index = uint32_t(i);
     light.params[0] = 0.5f * x * x;  // area
-    light.pmf = 1.0f / kLights;
+    light.pmf = float(pmf[size_t(i)]);
     c.buffers.lights.push_back(light);
-    power.push_back(1.0);
-    pmf.push_back(1.0 / kLights);
   }
   LightTree tree = build_light_tree(c.buffers, power, pmf);
   c.buffers.light_tree = tree.nodes;
   c.buffers.light_trails = tree.trails;
+  c.features.light_tree = true;
+  *depth = tree.depth;
+  return c;
+}
+
+TEST(LightTree, DeepTreeTrailsAndFloor) {
+  int depth = 0;
+  CompiledScene c = deep_tree_scene(&depth);
   size_t clusters = 0;
   check_tree(c, &clusters);
-  EXPECT_GT(tree.depth, 16) << "no trail reaches the trail's second word";
+  EXPECT_GT(depth, 16) << "no trail reaches the trail's second word";
 }
 
 // One quad light (the Cornell box; a large panel) is one planar emitter: no tree is built,
@@ -218,8 +226,13 @@ bool can_light(const CompiledScene& c, size_t l, const glm::dvec3& p) {
 
 class LightTreeTest : public DeviceTest {
  protected:
+  // A shipped scene, or "deep" (deep_tree_scene)
   void use(const std::string& file) {
-    compiled_ = compiled(file);
+    int depth = 0;
+    use(file == "deep" ? deep_tree_scene(&depth) : compiled(file));
+  }
+  void use(CompiledScene c) {
+    compiled_ = std::move(c);
     scene_ = std::make_unique<SceneOnDevice>(rig(), compiled_);
   }
   CompiledScene compiled_;
@@ -227,8 +240,11 @@ class LightTreeTest : public DeviceTest {
 };
 
 // Random shading points over the lights' bounds grown by half (so some lie inside node
-// boxes, some outside), with random normals; every fourth in a medium (n = 0)
-void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* ps, std::vector<cl_float4>* ns) {
+// boxes, some outside), with random normals; every fourth in a medium (n = 0). In the deep
+// tree's scene (`deep`), points in front of every triangle (x beyond the largest's plane),
+// so that every light can light them, down to the deepest trail.
+void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* ps, std::vector<cl_float4>* ns,
+                     bool deep = false) {
   const dev::LightTreeNode& root = c.buffers.light_tree[0];
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
   for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k) {
@@ -237,6 +253,10 @@ void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* 
     hi = glm::max(hi, slot_of(root, k).hi);
   }
   glm::dvec3 mid = 0.5 * (lo + hi), half = 0.75 * (hi - lo) + 0.5;
+  if (deep) {
+    mid = glm::dvec3(2.0 * hi.x, 0.0, 0.0);
+    half = glm::dvec3(0.5 * hi.x, 2.0 * hi.y, 2.0 * hi.z);
+  }
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g;
@@ -249,12 +269,12 @@ void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* 
 
 TEST_P(LightTreeTest, PmfSumsToOneAndCoversEveryLightThatCanContribute) {
   if (IsSkipped()) return;
-  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+  for (const std::string f : {"lights/many-lights.gltf", "lights/punctual.gltf", "deep"}) {
     SCOPED_TRACE(f);
     use(f);
     constexpr int kContexts = 64;
     std::vector<cl_float4> ps, ns;
-    random_contexts(compiled_, kContexts, &ps, &ns);
+    random_contexts(compiled_, kContexts, &ps, &ns, f == "deep");
     size_t n = compiled_.buffers.lights.size();
     auto out = rig().output<float>(kContexts * n);
     rig().run("test_lights_select_pmf", kContexts * n, *scene_, rig().input(ps), rig().input(ns), out);
@@ -274,11 +294,11 @@ TEST_P(LightTreeTest, PmfSumsToOneAndCoversEveryLightThatCanContribute) {
 
 TEST_P(LightTreeTest, SelectionFrequenciesMatchPmf) {
   if (IsSkipped()) return;
-  for (const char* f : {"lights/many-lights.gltf", "lights/punctual.gltf"}) {
+  for (const std::string f : {"lights/many-lights.gltf", "lights/punctual.gltf", "deep"}) {
     SCOPED_TRACE(f);
     use(f);
     std::vector<cl_float4> ps, ns;
-    random_contexts(compiled_, 3, &ps, &ns);
+    random_contexts(compiled_, 3, &ps, &ns, f == "deep");
     ns[2] = f4(glm::dvec3(0.0));  // one in a medium
     size_t n = compiled_.buffers.lights.size();
     constexpr size_t kSamples = 1 << 20;
