@@ -38,6 +38,9 @@ typedef struct {
   float diffuse_transmission;         // KHR_materials_diffuse_transmission: the diffuse part's share transmitted
   float3 diffuse_transmission_color;  // its colour
 #endif
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  float diffuse_roughness;  // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON; 0: Lambert)
+#endif
 #if CD_FEATURE_IRIDESCENCE
   float iridescence;      // KHR_materials_iridescence: the film's share of the metal and specular Fresnel (0: none)
   float iridescence_ior;  // the film's index

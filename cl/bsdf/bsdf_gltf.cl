@@ -135,6 +135,10 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
       load3(g->diffuse_transmission) * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION_COLOR, s).xyz;
   layered = layered || lobe->diffuse_transmission > 0.0f;
 #endif
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  lobe->diffuse_roughness = clamp(g->diffuse_roughness * bsdf_texture(sc, m, TEX_DIFFUSE_ROUGHNESS, s).x, 0.0f, 1.0f);
+  layered = layered || lobe->diffuse_roughness > 0.0f;
+#endif
 #if CD_FEATURE_IRIDESCENCE
   // The film's factor (texture R) and thickness, from minimum to maximum by texture G; a
   // film of thickness 0 is none
@@ -152,6 +156,15 @@ float schlick_weight(float cos_i) {
   float m = clamp(1.0f - cos_i, 0.0f, 1.0f);
   float m2 = m * m;
   return m2 * m2 * m;
+}
+
+// The diffuse base's BRDF: Lambert, or EON where KHR_materials_diffuse_roughness roughens it
+float3 gltf_base_diffuse(const Bsdf* b, float3 wo, float3 wi) {
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  float r = b->lobe.gltf.diffuse_roughness;
+  if (r > 0.0f) return diffuse_eon_eval(b->base_color, r, wo, wi);
+#endif
+  return b->base_color * INV_PI_F;
 }
 
 // KHR_materials_diffuse_transmission's factor at the hit (0 where compiled out)
@@ -469,7 +482,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
       e5_i = energy_lookup(&e, 1, energy_at(wi));
     }
     under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) *
-            gltf_below_of(&spec, gltf_layer_albedo_of(&spec, e_i, e5_i)) * g->base_norm * b->base_color * INV_PI_F;
+            gltf_below_of(&spec, gltf_layer_albedo_of(&spec, e_i, e5_i)) * g->base_norm * gltf_base_diffuse(b, wo, wi);
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
       float3 fm, fd;

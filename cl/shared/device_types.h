@@ -28,6 +28,7 @@
   X(conductor, CD_FEATURE_CONDUCTOR, 1, "a mesh's material shaded as MATERIAL_CONDUCTOR")          \
   X(sheen, CD_FEATURE_SHEEN, 1, "a glTF-shaded material with a KHR_materials_sheen colour")        \
   X(diffuse_transmission, CD_FEATURE_DIFFUSE_TRANSMISSION, 1, "a glTF diffuse transmission")       \
+  X(diffuse_roughness, CD_FEATURE_DIFFUSE_ROUGHNESS, 1, "a glTF diffuse roughness (EON) above 0")  \
   X(dispersion, CD_FEATURE_DISPERSION, 1, "a refracting glTF material with dispersion > 0")         \
   X(iridescence, CD_FEATURE_IRIDESCENCE, 1, "a glTF-shaded KHR_materials_iridescence")             \
   X(anisotropy, CD_FEATURE_ANISOTROPY, 1, "a glTF or conductor lobe with anisotropy strength > 0")  \
@@ -84,7 +85,8 @@
 #define TEX_DIFFUSE_TRANSMISSION_COLOR 14  // RGB (sRGB)
 #define TEX_IRIDESCENCE 15                 // R
 #define TEX_IRIDESCENCE_THICKNESS 16       // G
-#define TEX_SLOTS 17
+#define TEX_DIFFUSE_ROUGHNESS 17           // R
+#define TEX_SLOTS 18
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
 // on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
@@ -255,7 +257,8 @@ typedef struct {
   float diffuse_transmission[4];  // KHR_materials_diffuse_transmission: rgb colour factor, w = factor
   float clearcoat_normal_scale;   // KHR_materials_clearcoat clearcoatNormalTexture.scale
   float dispersion;               // KHR_materials_dispersion: 20 / Abbe number (0: none)
-  unsigned int pad[2];
+  float diffuse_roughness;        // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON)
+  unsigned int pad;
   float iridescence[4];  // KHR_materials_iridescence: factor, film ior, thickness minimum, maximum (nm)
 } GltfMaterial;
 
@@ -274,7 +277,7 @@ typedef union {
   ConductorMaterial conductor;
 } MaterialParams;
 
-// Material, 704 bytes: what every type has, then its type's parameters. Colours are linear
+// Material, 736 bytes: what every type has, then its type's parameters. Colours are linear
 // RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;   // MATERIAL_*
@@ -509,12 +512,12 @@ typedef struct {
     FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
     FIELD(GltfMaterial, sheen, 48) FIELD(GltfMaterial, diffuse_transmission, 64)                              \
     FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, dispersion, 84)                       \
-    FIELD(GltfMaterial, pad, 88)                                                                              \
+    FIELD(GltfMaterial, diffuse_roughness, 88) FIELD(GltfMaterial, pad, 92)                                   \
     FIELD(GltfMaterial, iridescence, 96)                                                                      \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
   SIZE(MaterialParams, 112)                                                                                   \
-  SIZE(Material, 704) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
+  SIZE(Material, 736) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
     FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
     FIELD(Material, textures, 160)                                                                            \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \

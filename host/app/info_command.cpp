@@ -99,7 +99,8 @@ void print_materials(const Scene& s) {
                                    "diffuse transmission",
                                    "diffuse transmission colour",
                                    "iridescence",
-                                   "iridescence thickness"};
+                                   "iridescence thickness",
+                                   "diffuse roughness"};
   size_t n = s.materials.size() - 1;  // the last is the glTF default material
   std::printf("materials: %zu\n", n);
   for (size_t i = 0; i < n; ++i) {
@@ -107,13 +108,16 @@ void print_materials(const Scene& s) {
     std::string textures;
     for (int k = 0; k < TEX_SLOTS; ++k)
       if (m.texture(k).index != NO_TEXTURE) textures += std::string(textures.empty() ? "" : ", ") + kSlots[k];
-    char dispersion[48] = "";
+    char dispersion[48] = "", diffuse_roughness[48] = "";
     if (m.has_dispersion()) std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
-    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s%s\n", i, quoted_or(m.name, "(unnamed)").c_str(),
+    if (m.has_diffuse_roughness())
+      std::snprintf(diffuse_roughness, sizeof diffuse_roughness, ", diffuse roughness %.3g", m.diffuse_roughness);
+    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s%s%s\n", i,
+                quoted_or(m.name, "(unnamed)").c_str(),
                 m.type == MATERIAL_CONDUCTOR ? "measured conductor" : "glTF metallic-roughness", m.metallic,
                 m.roughness, m.transmission > 0.0f ? ", transmissive" : "", m.clearcoat > 0.0f ? ", clearcoat" : "",
                 m.diffuse_transmission > 0.0f ? ", diffuse transmission" : "", dispersion,
-                m.iridescence > 0.0f ? ", iridescence" : "",
+                m.iridescence > 0.0f ? ", iridescence" : "", diffuse_roughness,
                 textures.empty() ? "" : ("; textures: " + textures).c_str());
   }
 }

@@ -88,6 +88,7 @@ void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   g.sheen[3] = m.sheen_roughness;
   for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = m.diffuse_transmission_color[c];
   g.diffuse_transmission[3] = m.diffuse_transmission;
+  g.diffuse_roughness = m.diffuse_roughness;
   g.clearcoat_normal_scale = m.clearcoat_normal_scale;
   g.dispersion = m.has_dispersion() ? m.dispersion : 0.0f;  // only a refracting volume disperses
   g.iridescence[0] = m.iridescence;

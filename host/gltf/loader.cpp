@@ -28,6 +28,7 @@ bool supported_extension(const std::string& name) {
                                                    "KHR_materials_anisotropy",
                                                    "KHR_materials_sheen",
                                                    "KHR_materials_diffuse_transmission",
+                                                   "KHR_materials_diffuse_roughness",
                                                    "KHR_materials_dispersion",
                                                    "KHR_materials_iridescence",
                                                    "KHR_materials_unlit",

@@ -149,6 +149,14 @@ void read_iridescence(ReadContext& ctx, const tinygltf::Material& gm, MaterialDe
   set_texture_slot(ctx, m, TEX_IRIDESCENCE_THICKNESS, ir, "iridescenceThicknessTexture", false);
 }
 
+// KHR_materials_diffuse_roughness: the diffuse base's roughness (texture R), shaded by the
+// energy-preserving Oren-Nayar lobe (EON) of OpenPBR
+void read_diffuse_roughness(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
+  const tinygltf::Value& dr = extension(gm, "KHR_materials_diffuse_roughness");
+  m->diffuse_roughness = float(number_or(dr, "diffuseRoughnessFactor", -1, 0.0));
+  set_texture_slot(ctx, m, TEX_DIFFUSE_ROUGHNESS, dr, "diffuseRoughnessTexture", false);
+}
+
 // KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
 void read_unlit(const tinygltf::Material& gm, MaterialDesc* m) {
   m->unlit = gm.extensions.count("KHR_materials_unlit") > 0;
@@ -228,6 +236,7 @@ void check_ranges(const std::string& name, MaterialDesc* m) {
   in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
   in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
   in(m->diffuse_transmission, 0.0f, 1.0f, "diffuseTransmissionFactor");
+  in(m->diffuse_roughness, 0.0f, 1.0f, "diffuseRoughnessFactor");
   in(m->iridescence, 0.0f, 1.0f, "iridescenceFactor");
   in(m->iridescence_ior, 1.0f, 10.0f, "iridescenceIor");
   in(m->iridescence_thickness_min, 0.0f, 1e5f, "iridescenceThicknessMinimum");
@@ -276,6 +285,7 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_diffuse_transmission(ctx, gm, &m);
   read_dispersion(gm, &m);
   read_iridescence(ctx, gm, &m);
+  read_diffuse_roughness(ctx, gm, &m);
   read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);

@@ -9,7 +9,7 @@ namespace candela {
 
 uint32_t MaterialDesc::kernel_type() const {
   bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f &&
-                    sheen_color == glm::vec3(0.0f) && diffuse_transmission == 0.0f;
+                    sheen_color == glm::vec3(0.0f) && diffuse_transmission == 0.0f && diffuse_roughness == 0.0f;
   return unlit || (type == MATERIAL_GLTF && lambertian) ? MATERIAL_DIFFUSE : type;
 }
 
@@ -20,6 +20,8 @@ bool MaterialDesc::has_sheen() const {
 bool MaterialDesc::has_diffuse_transmission() const {
   return kernel_type() == MATERIAL_GLTF && diffuse_transmission > 0.0f;
 }
+
+bool MaterialDesc::has_diffuse_roughness() const { return kernel_type() == MATERIAL_GLTF && diffuse_roughness > 0.0f; }
 
 bool MaterialDesc::has_dispersion() const {
   return kernel_type() == MATERIAL_GLTF && dispersion > 0.0f && transmission > 0.0f && !thin_walled;
@@ -94,6 +96,7 @@ SceneFeatures Scene::features() const {
     f.media |= materials.at(m.material).medium >= 0;
     f.sheen |= materials.at(m.material).has_sheen();
     f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
+    f.diffuse_roughness |= materials.at(m.material).has_diffuse_roughness();
     f.dispersion |= materials.at(m.material).has_dispersion();
     f.iridescence |= materials.at(m.material).has_iridescence();
     f.anisotropy |= materials.at(m.material).has_anisotropy();

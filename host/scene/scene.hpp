@@ -77,8 +77,9 @@ struct MaterialDesc {
   float sheen_roughness = 0.0f;
   float diffuse_transmission = 0.0f;  // KHR_materials_diffuse_transmission
   glm::vec3 diffuse_transmission_color{1.0f};
-  float dispersion = 0.0f;   // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
-  float iridescence = 0.0f;  // KHR_materials_iridescence: the film's share of the Fresnel term
+  float diffuse_roughness = 0.0f;  // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON)
+  float dispersion = 0.0f;         // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
+  float iridescence = 0.0f;        // KHR_materials_iridescence: the film's share of the Fresnel term
   float iridescence_ior = 1.3f;
   float iridescence_thickness_min = 100.0f, iridescence_thickness_max = 400.0f;  // nm
   bool unlit = false;  // KHR_materials_unlit: shows base colour x vertex colour, no lighting
@@ -96,8 +97,9 @@ struct MaterialDesc {
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
   bool alpha_tested() const;
   // The BSDF the kernel shades it with: MATERIAL_DIFFUSE for a glTF material that is exactly
-  // Lambertian whatever its textures (metallic, specular, transmission, clearcoat and diffuse
-  // transmission factors and the sheen colour all 0, each of which multiplies its texture),
+  // Lambertian whatever its textures (metallic, specular, transmission, clearcoat, diffuse
+  // transmission and diffuse roughness factors and the sheen colour all 0, each of which
+  // multiplies its texture),
   // else `type`; an unlit
   // material has no BSDF (MATERIAL_DIFFUSE, never evaluated)
   uint32_t kernel_type() const;
@@ -105,6 +107,8 @@ struct MaterialDesc {
   bool has_sheen() const;
   // A glTF-shaded material with a diffuse transmission (KHR_materials_diffuse_transmission)
   bool has_diffuse_transmission() const;
+  // A glTF-shaded material with a rough diffuse base (KHR_materials_diffuse_roughness)
+  bool has_diffuse_roughness() const;
   // A glTF-shaded refracting solid (transmission through a volume) with dispersion > 0
   bool has_dispersion() const;
   // A glTF-shaded material with a thin film (KHR_materials_iridescence)

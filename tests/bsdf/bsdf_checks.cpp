@@ -50,6 +50,36 @@ Reference dielectric_transmission(const GgxReference& g, double eta, bool thin, 
   return {glm::dvec3(f), t * g.g1(wo) * oh * g.d(h) / wo.z * std::fabs(ih) / denom};
 }
 
+namespace {
+
+// Fujii's single-scattering albedo in closed form: A (1 + r G(mu) / pi) with
+// G(mu) = S (acos mu - S mu) + 2/3 (S / mu (1 - S^3) - S), S = sin theta
+constexpr double kEonC1 = 0.5 - 2.0 / (3.0 * kPi), kEonC2 = 2.0 / 3.0 - 28.0 / (15.0 * kPi);
+double fon_albedo(double mu, double r) {
+  double s = std::sqrt(std::max(1.0 - mu * mu, 0.0));
+  double g = s * (std::acos(mu) - s * mu) + 2.0 / 3.0 * (s / mu * (1.0 - s * s * s) - s);
+  return (1.0 + r * g / kPi) / (1.0 + kEonC1 * r);
+}
+double fon_average(double r) { return (1.0 + kEonC2 * r) / (1.0 + kEonC1 * r); }
+glm::dvec3 eon_rho_ms(glm::dvec3 rho, double r) {
+  double e = fon_average(r);
+  return rho * rho * e / (1.0 - rho * (1.0 - e));
+}
+
+}  // namespace
+
+glm::dvec3 eon_reference(glm::dvec3 rho, double r, glm::dvec3 wo, glm::dvec3 wi) {
+  double s = glm::dot(wo, wi) - wo.z * wi.z, t = s > 0.0 ? std::max(wo.z, wi.z) : 1.0;
+  glm::dvec3 single = rho / kPi * (1.0 + r * s / t) / (1.0 + kEonC1 * r);
+  double multiple = (1.0 - fon_albedo(wo.z, r)) * (1.0 - fon_albedo(wi.z, r)) / (1.0 - fon_average(r));
+  return single + eon_rho_ms(rho, r) / kPi * multiple;
+}
+
+glm::dvec3 eon_albedo(glm::dvec3 rho, double r, double cos_o) {
+  double e = fon_albedo(cos_o, r);
+  return rho * e + eon_rho_ms(rho, r) * (1.0 - e);
+}
+
 GltfReference::GltfReference(const dev::Material& m)
     : base(m.base_color[0], m.base_color[1], m.base_color[2]),
       metallic(m.params.gltf.metallic),
@@ -57,6 +87,7 @@ GltfReference::GltfReference(const dev::Material& m)
       ior(m.params.gltf.ior),
       f90(m.params.gltf.specular_color[3]),
       coat(m.params.gltf.clearcoat),
+      diffuse_roughness(m.params.gltf.diffuse_roughness),
       thin((m.flags & MATERIAL_THIN_WALLED) != 0u),
       ggx(GgxReference::from(m.params.gltf.roughness, m.params.gltf.anisotropy_strength)),
       coat_ggx(GgxReference::from(m.params.gltf.clearcoat_roughness, 0.0)) {
@@ -101,7 +132,8 @@ Reference GltfReference::operator()(glm::dvec3 wo, glm::dvec3 wi, bool reflectio
   auto [spec, spec_pdf] = ggx.delta() ? std::pair{0.0, 0.0} : ggx.reflection(wo, wi);
   bool glossy = m > 0.0 || f90 > 0.0 || coat > 0.0;
   glm::dvec3 fd = glossy ? schlick(f0, glm::dvec3(f90), c) : glm::dvec3(0.0);
-  glm::dvec3 under = (1 - m) * (1 - t) * below_spec(wo.z, wi.z) * base / kPi;
+  glm::dvec3 diffuse = diffuse_roughness > 0.0 ? eon_reference(base, diffuse_roughness, wo, wi) : base / kPi;
+  glm::dvec3 under = (1 - m) * (1 - t) * below_spec(wo.z, wi.z) * diffuse;
   double pdf = w[3] * wi.z / kPi;
   if (glossy) {
     under += (m * schlick(base, glm::dvec3(1.0), c) + (1 - m) * (1 - t) * fd) * spec;

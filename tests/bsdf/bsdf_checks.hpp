@@ -55,13 +55,18 @@ double dielectric_reflectance(double cos_i, double eta, bool thin);
 // h ~ -(eta_wo wo + eta_wi wi); a thin sheet passes the reflection lobe mirrored through it
 Reference dielectric_transmission(const GgxReference& g, double eta, bool thin, glm::dvec3 wo, glm::dvec3 wi);
 
+// The energy-preserving Oren-Nayar lobe (EON) of albedo rho and roughness r in (0, 1] for wo
+// and wi above the surface, and its directional albedo (exact: E_FON integrated in closed form)
+glm::dvec3 eon_reference(glm::dvec3 rho, double r, glm::dvec3 wo, glm::dvec3 wi);
+glm::dvec3 eon_albedo(glm::dvec3 rho, double r, double cos_o);
+
 // glTF metallic-roughness (glTF 2.0 Appendix B with KHR_materials_specular, _ior,
-// _transmission, _clearcoat, _anisotropy) as a weighted sum of lobes: coat over
-// metal + plastic (specular + Lambert) + glass. Its pdf is the kernel's mixture, with
+// _transmission, _clearcoat, _anisotropy, _diffuse_roughness) as a weighted sum of lobes:
+// coat over metal + plastic (specular + Lambert or EON) + glass. Its pdf is the kernel's mixture, with
 // component probabilities estimated at wo (cl/bsdf/bsdf_gltf.cl, gltf_at_wo).
 struct GltfReference {
   glm::dvec3 base, f0;
-  double metallic, transmission, ior, f90, coat;
+  double metallic, transmission, ior, f90, coat, diffuse_roughness;
   bool thin;
   GgxReference ggx, coat_ggx;
 

@@ -1,5 +1,6 @@
 // glTF metallic-roughness (MATERIAL_GLTF: metal, plastic, clearcoat, anisotropy, and a
-// mixture with transmission) in the BSDF harness (bsdf_checks.hpp), against GltfReference,
+// mixture with transmission, the EON diffuse base of KHR_materials_diffuse_roughness) in the
+// BSDF harness (bsdf_checks.hpp), against GltfReference,
 // and its smooth variants' mirrors.
 #include <gtest/gtest.h>
 
@@ -17,6 +18,18 @@ LobeFamily metallic_roughness_family() {
   coat.params.gltf.clearcoat_roughness = 0.2f;
   dev::Material smooth_coat = gltf(brass, 1.0, 0.5);
   smooth_coat.params.gltf.clearcoat = 1.0f;
+  // KHR_materials_diffuse_roughness: the EON base alone (specular factor 0, so its albedo is
+  // known exactly), and under the specular layer
+  auto rough_diffuse = [=](glm::dvec3 base, double r, double specular) {
+    dev::Material m = gltf(base, 0.0, 0.5);
+    m.params.gltf.specular_color[3] = float(specular);
+    m.params.gltf.diffuse_roughness = float(r);
+    return m;
+  };
+  const dev::Material eon = rough_diffuse(orange, 0.7, 0.0);
+  const MaterialCase eon_case{
+      "rough_diffuse",    eon, true, [=](double cos_o) { return eon_albedo(orange, 0.7, cos_o); },
+      GltfReference(eon), {},  {}};
   auto white_coat = [=](double r) {
     dev::Material m = gltf(white, 0.0, r);
     m.params.gltf.clearcoat = 1.0f;
@@ -33,6 +46,8 @@ LobeFamily metallic_roughness_family() {
           gltf_case("mixture", gltf({0.9, 0.7, 0.5}, 0.5, 0.4, 0.5), {40, 40, 0.8, Focus::Mirror, Focus::Refraction}),
           gltf_case("smooth_plastic", gltf(orange, 0.0, 0.0), {}),
           gltf_case("smooth_coat_metal", smooth_coat, kGlossy),
+          eon_case,
+          gltf_case("rough_diffuse_plastic", rough_diffuse(orange, 1.0, 1.0), {}),
       },
       {
           {"metal_white", [=](double r) { return gltf(white, 1.0, r); }, false, ""},
@@ -47,6 +62,7 @@ LobeFamily metallic_roughness_family() {
            },
            false, ""},
           {"mixture_white", [=](double r) { return gltf(white, 0.5, r, 0.5); }, false, ""},
+          {"rough_diffuse_white", [=](double r) { return rough_diffuse(white, r, 0.0); }, false, ""},
       }};
 }
 

@@ -613,4 +613,38 @@ TEST(GltfLoader, IridescenceIsRead) {
   EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
 }
 
+// KHR_materials_diffuse_roughness: factor (texture R, linear), default 0, range check; a
+// material that is otherwise Lambertian is shaded by the glTF BSDF (EON), and the kernel
+// feature is on only where the roughness is above 0
+TEST(GltfLoader, DiffuseRoughnessIsRead) {
+  TempDir dir;
+  json j = quad_gltf().document();
+  j["extensionsUsed"] = {"KHR_materials_diffuse_roughness"};
+  j["textures"] = {{{"source", 0}}};
+  j["images"] = {{{"uri", kPixelPng}}};
+  j["materials"][0]["extensions"]["KHR_materials_diffuse_roughness"] = {{"diffuseRoughnessFactor", 0.6},
+                                                                        {"diffuseRoughnessTexture", {{"index", 0}}}};
+  j["materials"].push_back(j["materials"][0]);
+  j["materials"][1]["extensions"]["KHR_materials_diffuse_roughness"] = json::object();
+  Scene s = load_gltf(dir.write("dr.gltf", j.dump()));
+  const MaterialDesc& m = s.materials[0];
+  EXPECT_FLOAT_EQ(m.diffuse_roughness, 0.6f);
+  const TextureSlot& tex = m.texture(TEX_DIFFUSE_ROUGHNESS);
+  ASSERT_NE(tex.index, NO_TEXTURE);
+  EXPECT_FALSE(s.textures.at(size_t(tex.index)).srgb);
+  EXPECT_EQ(m.kernel_type(), MATERIAL_GLTF);
+  EXPECT_TRUE(m.has_diffuse_roughness());
+  EXPECT_TRUE(s.features().diffuse_roughness);
+  EXPECT_EQ(join(s.warnings).find("KHR_materials_diffuse_roughness"), std::string::npos) << join(s.warnings);
+  EXPECT_FLOAT_EQ(s.materials[1].diffuse_roughness, 0.0f);
+  EXPECT_EQ(s.materials[1].kernel_type(), MATERIAL_DIFFUSE);
+  EXPECT_FALSE(s.materials[1].has_diffuse_roughness());
+  CompiledScene c = compile_scene(s);
+  EXPECT_FLOAT_EQ(c.buffers.materials[0].params.gltf.diffuse_roughness, 0.6f);
+  j["materials"][0]["extensions"]["KHR_materials_diffuse_roughness"]["diffuseRoughnessFactor"] = 0.0;
+  EXPECT_FALSE(load_gltf(dir.write("none.gltf", j.dump())).features().diffuse_roughness);
+  j["materials"][0]["extensions"]["KHR_materials_diffuse_roughness"]["diffuseRoughnessFactor"] = 1.5;
+  EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
+}
+
 }  // namespace candela::test
