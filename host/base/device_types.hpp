@@ -10,6 +10,8 @@
 #include <initializer_list>
 #include <vector>
 
+#include "base/uninit_vector.hpp"
+
 namespace candela::dev {
 #include "cl/shared/color.h"
 #include "cl/shared/device_types.h"
@@ -25,8 +27,23 @@ CD_LAYOUT(CD_ASSERT_SIZE, CD_ASSERT_FIELD)
 #undef CD_ASSERT_SIZE
 #undef CD_ASSERT_FIELD
 
+// The host's vector for each scene buffer: the BVH's nodes and triangles, the largest, are
+// written by the builder's threads, so resizing them leaves their elements uninitialized
+template <class T>
+struct HostBufferOf {
+  using vector = std::vector<T>;
+};
+template <>
+struct HostBufferOf<BvhNode> {
+  using vector = UninitVector<BvhNode>;
+};
+template <>
+struct HostBufferOf<BvhTriangle> {
+  using vector = UninitVector<BvhTriangle>;
+};
+
 // Host copies of every scene buffer, one vector per entry of CD_SCENE_BUFFERS
-#define CD_HOST_BUFFER(type, name) std::vector<type> name;
+#define CD_HOST_BUFFER(type, name) HostBufferOf<type>::vector name;
 #define CD_BUFFER_BYTES(type, name) +name.size() * sizeof(type)
 struct SceneBuffers {
   CD_SCENE_BUFFERS(CD_HOST_BUFFER)

@@ -76,7 +76,7 @@ struct Range {
 // 4-wide nodes of one subtree (the top of the tree, or one worker's job): child
 // references inside it are indices into `nodes`, relocated when the subtrees are joined
 struct Subtree {
-  std::vector<dev::BvhNode> nodes;
+  UninitVector<dev::BvhNode> nodes;
   int depth = 1;
 };
 
@@ -185,21 +185,28 @@ class Builder {
     }
     std::vector<Job>& jobs = top.jobs;
     run_jobs(jobs);
-    std::vector<Ref>().swap(refs_);  // the leaves hold the triangles now
+    decltype(refs_)().swap(refs_);  // the leaves hold the triangles now
     // Join: the jobs' nodes after the top's, in job order, their child references
-    // relocated; each job's nodes freed once copied (host memory: README, Performance)
+    // relocated; the threads copy a job each, and free its nodes once copied (host memory:
+    // README, Performance)
+    std::vector<size_t> offset(jobs.size());
     size_t total = top.sub.nodes.size();
-    for (const Job& j : jobs) total += j.out.nodes.size();
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      offset[k] = total;
+      total += jobs[k].out.nodes.size();
+    }
     bvh_.nodes = std::move(top.sub.nodes);
-    bvh_.nodes.reserve(total);
     bvh_.depth = top.sub.depth;
-    for (Job& j : jobs) {
-      int offset = int(bvh_.nodes.size());
-      append(bvh_.nodes, j.out.nodes, offset);
-      std::vector<dev::BvhNode>().swap(j.out.nodes);
-      bvh_.nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + offset : j.ref;
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      const Job& j = jobs[k];
+      bvh_.nodes[j.node].child[j.slot] = j.ref >= 0 ? j.ref + int(offset[k]) : j.ref;
       bvh_.depth = std::max(bvh_.depth, j.out.depth);
     }
+    bvh_.nodes.resize(total);  // uninitialized: every job writes its own part
+    for_each_taken(jobs.size(), [&](size_t k) {
+      relocate(jobs[k].out.nodes, &bvh_.nodes[offset[k]], int(offset[k]));
+      decltype(jobs[k].out.nodes)().swap(jobs[k].out.nodes);
+    });
     return std::move(bvh_);
   }
 
@@ -229,6 +236,20 @@ class Builder {
     for (std::thread& th : pool) th.join();
   }
 
+  // fn(k) for k < n on up to threads_ threads, each taking the next k when it is free
+  template <class Fn>
+  void for_each_taken(size_t n, Fn fn) {
+    std::atomic<size_t> next{0};
+    auto worker = [&] {
+      for (size_t k; (k = next.fetch_add(1)) < n;) fn(k);
+    };
+    int t = int(std::min<size_t>(size_t(threads_), n));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < t; ++i) pool.emplace_back(worker);
+    worker();
+    for (std::thread& th : pool) th.join();
+  }
+
   // The workers take the jobs largest first
   void run_jobs(std::vector<Job>& jobs) {
     std::vector<size_t> order(jobs.size());
@@ -236,23 +257,15 @@ class Builder {
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
       return jobs[a].r.end - jobs[a].r.begin > jobs[b].r.end - jobs[b].r.begin;
     });
-    std::atomic<size_t> next{0};
-    auto worker = [&] {
-      for (size_t k; (k = next.fetch_add(1)) < order.size();) {
-        Job& j = jobs[order[k]];
-        Range sub[2];
-        if (split(j.r, &sub[0], &sub[1], false)) {
-          j.ref = int(inner_node(j.out, j.r, sub));
-        } else {
-          j.ref = leaf_ref(j.out, j.r);
-        }
+    for_each_taken(order.size(), [&](size_t k) {
+      Job& j = jobs[order[k]];
+      Range sub[2];
+      if (split(j.r, &sub[0], &sub[1], false)) {
+        j.ref = int(inner_node(j.out, j.r, sub));
+      } else {
+        j.ref = leaf_ref(j.out, j.r);
       }
-    };
-    int t = int(std::min<size_t>(size_t(threads_), jobs.size()));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < t; ++i) pool.emplace_back(worker);
-    worker();
-    for (std::thread& th : pool) th.join();
+    });
   }
 
   static dev::BvhNode empty_node() {
@@ -402,7 +415,8 @@ class Builder {
     for (int k = 0; k < nbig; ++k) {
       int i = big[k];
       int offset = int(out.sub.nodes.size());
-      append(out.sub.nodes, below[i].sub.nodes, offset);
+      out.sub.nodes.resize(out.sub.nodes.size() + below[i].sub.nodes.size());
+      relocate(below[i].sub.nodes, &out.sub.nodes[size_t(offset)], offset);
       out.sub.depth = std::max(out.sub.depth, below[i].sub.depth);
       if (ref[i] >= 0) ref[i] += offset;
       for (Job& j : below[i].jobs) {
@@ -414,12 +428,12 @@ class Builder {
     return node;
   }
 
-  // Appends `from` to `to`, inner-child references (into `from`) moved by offset
-  static void append(std::vector<dev::BvhNode>& to, const std::vector<dev::BvhNode>& from, int offset) {
+  // Copies `from` to `to`, inner-child references (into `from`) moved by offset
+  static void relocate(const UninitVector<dev::BvhNode>& from, dev::BvhNode* to, int offset) {
     for (dev::BvhNode n : from) {
       for (int i = 0; i < 4; ++i)
         if (n.child[i] >= 0 && n.lo_x[i] <= n.hi_x[i]) n.child[i] += offset;
-      to.push_back(n);
+      *to++ = n;
     }
   }
 
@@ -564,7 +578,7 @@ class Builder {
   const int threads_;
   uint32_t job_refs_ = kMinJobRefs;
   std::atomic<int> busy_{1};  // threads at work in the top phase (the caller's included)
-  std::vector<Ref> refs_;     // refs_[i]: primitive stored at leaf position i once built
+  UninitVector<Ref> refs_;    // refs_[i]: primitive stored at leaf position i once built
   Bvh bvh_;
 };
 

@@ -12,9 +12,9 @@
 namespace candela {
 
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;     // 4-wide, root at 0
-  std::vector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
-  int depth = 0;                       // of the binary SAH tree before collapsing (the 4-wide tree is half as deep)
+  UninitVector<dev::BvhNode> nodes;     // 4-wide, root at 0
+  UninitVector<dev::BvhTriangle> tris;  // leaf triangles in BVH order, with their prim index
+  int depth = 0;                        // of the binary SAH tree before collapsing (the 4-wide tree is half as deep)
 };
 
 // Depth limit of the binary SAH tree; it bounds the kernel's traversal stack

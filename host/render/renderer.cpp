@@ -28,10 +28,10 @@ std::string format_mib(uint64_t bytes) {
 }
 
 // A read-only buffer holding `data`, or one dummy element when it is empty
-template <typename T>
-cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T>& data, const char* what) {
-  std::vector<T> one(1);
-  const std::vector<T>& src = data.empty() ? one : data;
+template <typename T, typename A>
+cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T, A>& data, const char* what) {
+  std::vector<T, A> one(1, T{});
+  const std::vector<T, A>& src = data.empty() ? one : data;
   size_t bytes = src.size() * sizeof(T);
   if (bytes > device.max_alloc)
     throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +

@@ -72,10 +72,10 @@ void DeviceTest::SetUp() {
 }
 
 namespace {
-template <typename T>
-cl::Buffer upload_or_dummy(const cl::Context& ctx, const std::vector<T>& data) {
-  std::vector<T> one(1);
-  const std::vector<T>& src = data.empty() ? one : data;
+template <typename T, typename A>
+cl::Buffer upload_or_dummy(const cl::Context& ctx, const std::vector<T, A>& data) {
+  std::vector<T, A> one(1, T{});
+  const std::vector<T, A>& src = data.empty() ? one : data;
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, src.size() * sizeof(T), const_cast<T*>(src.data()));
 }
 }  // namespace

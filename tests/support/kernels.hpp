@@ -81,8 +81,8 @@ struct KernelRig {
   KernelRig(const DeviceEntry& d, const cl::Context& c, const cl::Program& p);  // a program built elsewhere
 
   // A read-only copy of `data` on the device (not empty)
-  template <typename T>
-  cl::Buffer input(const std::vector<T>& data) const {
+  template <typename T, typename A>
+  cl::Buffer input(const std::vector<T, A>& data) const {
     return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T),
                       const_cast<T*>(data.data()));
   }

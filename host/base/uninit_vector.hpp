@@ -1,0 +1,38 @@
+// A std::vector whose resize() leaves trivially constructible elements uninitialized, for
+// large arrays that are written in full right after, by several threads: their memory is
+// then touched once, by the threads that fill it, instead of being zeroed first by one.
+#pragma once
+
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace candela {
+
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+  using value_type = T;
+  template <class U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <class U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  // Default-initialization: nothing is written for a trivially constructible U
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+template <class T>
+using UninitVector = std::vector<T, DefaultInitAllocator<T>>;
+
+}  // namespace candela
