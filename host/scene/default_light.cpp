@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 
@@ -15,6 +16,20 @@ constexpr size_t kMaxEmitters = 4096;  // emissive triangles beyond this are sub
 struct Point {
   glm::dvec3 p, n;
 };
+
+// A triangle by its mesh and its index in the mesh: 8 bytes, where its corners would take
+// 72 (the points' population holds every lit triangle of the scene)
+struct TriangleRef {
+  uint32_t mesh = 0, triangle = 0;
+};
+
+// The corners of triangle t of `mesh` in double precision, and its cross product
+void corners(const MeshDesc& mesh, size_t t, glm::dvec3* a, glm::dvec3* b, glm::dvec3* c, glm::dvec3* cross) {
+  *a = mesh.positions[mesh.indices[3 * t]];
+  *b = mesh.positions[mesh.indices[3 * t + 1]];
+  *c = mesh.positions[mesh.indices[3 * t + 2]];
+  *cross = glm::cross(*b - *a, *c - *a);
+}
 
 // An emissive triangle as a small source: its centroid, unit normal, area and radiance
 // luminance (texture mean included), and whether it emits from both faces
@@ -37,17 +52,17 @@ double mean_emission(const Scene& scene, const MaterialDesc& m, std::vector<doub
 // emitters that are lights: brighter than white (radiance > 1, which glTF reaches only
 // through KHR_materials_emissive_strength). Emission up to white is a glowing material
 // (a screen, a label, a visor), which a glTF viewer never lets light anything.
-void gather(const Scene& scene, std::vector<Point>* tris_c, std::vector<double>* tris_area, std::vector<Emitter>* em,
-            double* emissive_area) {
+void gather(const Scene& scene, std::vector<TriangleRef>* tris, std::vector<double>* tris_area,
+            std::vector<Emitter>* em, double* emissive_area) {
   std::vector<double> texture_mean(scene.textures.size(), -1.0);
-  for (const MeshDesc& mesh : scene.meshes) {
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const MeshDesc& mesh = scene.meshes[i];
     const MaterialDesc& m = scene.materials.at(mesh.material);
     double peak = std::max({m.emission.x, m.emission.y, m.emission.z});
     double radiance = peak > 1.0 ? mean_emission(scene, m, &texture_mean) : 0.0;
     for (size_t t = 0; t < mesh.triangles(); ++t) {
-      glm::dvec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
-                 c = mesh.positions[mesh.indices[3 * t + 2]];
-      glm::dvec3 cr = glm::cross(b - a, c - a);
+      glm::dvec3 a, b, c, cr;
+      corners(mesh, t, &a, &b, &c, &cr);
       double len = glm::length(cr);
       if (!(len > 0.0) || !std::isfinite(len)) continue;
       glm::dvec3 n = cr / len, centroid = (a + b + c) / 3.0;
@@ -55,10 +70,8 @@ void gather(const Scene& scene, std::vector<Point>* tris_c, std::vector<double>*
       if (radiance > 0.0) {
         em->push_back({centroid, n, 0.5 * len, radiance, 1.0, m.double_sided});
       } else {
-        // Points are drawn later, uniformly inside the chosen triangle: keep its corners
-        tris_c->push_back({a, n});
-        tris_c->push_back({b, n});
-        tris_c->push_back({c, n});
+        // Points are drawn later, uniformly inside the chosen triangle
+        tris->push_back({uint32_t(i), uint32_t(t)});
         tris_area->push_back(0.5 * len);
       }
     }
@@ -127,11 +140,11 @@ double irradiance(const Point& q, const std::vector<Emitter>& emitters, const Sc
 }  // namespace
 
 OwnLight own_light_share(const Scene& scene, double environment_radiance) {
-  std::vector<Point> corners;
+  std::vector<TriangleRef> tris;
   std::vector<double> areas;
   std::vector<Emitter> emitters;
   double emissive_area = 0.0;
-  gather(scene, &corners, &areas, &emitters, &emissive_area);
+  gather(scene, &tris, &areas, &emitters, &emissive_area);
   double lit_area = 0.0;
   for (double a : areas) lit_area += a;
   OwnLight own;
@@ -148,8 +161,9 @@ OwnLight own_light_share(const Scene& scene, double environment_radiance) {
   for (int k = 0; k < kPoints; ++k) {
     size_t t = pick(rng);
     double su = std::sqrt(u01(rng)), v = u01(rng);
-    const Point &a = corners[3 * t], &b = corners[3 * t + 1], &c = corners[3 * t + 2];
-    Point q{(1.0 - su) * a.p + su * (1.0 - v) * b.p + su * v * c.p, a.n};
+    glm::dvec3 a, b, c, cr;
+    corners(scene.meshes[tris[t].mesh], tris[t].triangle, &a, &b, &c, &cr);
+    Point q{(1.0 - su) * a + su * (1.0 - v) * b + su * v * c, cr / glm::length(cr)};
     q.p += 1e-4 * q.n * std::max(1.0, glm::length(q.p));  // off the surface, as a ray would start
     share.push_back(irradiance(q, emitters, scene) / e_env);
   }
