@@ -39,8 +39,9 @@ float diffuse_eon_albedo(float mu, float r) {
   return (1.0f + r * INV_PI_F * g) / (1.0f + EON_C1 * r);
 }
 
-// f_ss + f_ms of albedo rho at roughness r in (0, 1]; 0 below the surface
-float3 diffuse_eon_eval(float3 rho, float r, float3 wo, float3 wi) {
+// pi (f_ss + f_ms) of albedo rho at roughness r in (0, 1]; 0 below the surface. e_o:
+// diffuse_eon_albedo(wo.z, r), which the caller computes once per wo
+float3 diffuse_eon_eval_pi(float3 rho, float r, float e_o, float3 wo, float3 wi) {
   if (!(wi.z > 0.0f)) return (float3)(0.0f);
   float mu_i = fmin(wi.z, 1.0f), mu_o = clamp(wo.z, 0.0f, 1.0f);
   float s = dot(wi, wo) - mu_i * mu_o;
@@ -48,8 +49,8 @@ float3 diffuse_eon_eval(float3 rho, float r, float3 wo, float3 wi) {
   float a = 1.0f / (1.0f + EON_C1 * r);
   float e_avg = a * (1.0f + EON_C2 * r);
   float3 rho_ms = rho * rho * e_avg / ((float3)(1.0f) - rho * (1.0f - e_avg));
-  float ms = (1.0f - diffuse_eon_albedo(mu_o, r)) * (1.0f - diffuse_eon_albedo(mu_i, r)) / (1.0f - e_avg);
-  return INV_PI_F * (rho * (a * (1.0f + r * s_over_t)) + rho_ms * ms);
+  float ms = (1.0f - e_o) * (1.0f - diffuse_eon_albedo(mu_i, r)) / (1.0f - e_avg);
+  return rho * (a * (1.0f + r * s_over_t)) + rho_ms * ms;
 }
 
 // One cosine lobe about the normal

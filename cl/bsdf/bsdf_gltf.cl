@@ -158,15 +158,6 @@ float schlick_weight(float cos_i) {
   return m2 * m2 * m;
 }
 
-// The diffuse base's BRDF: Lambert, or EON where KHR_materials_diffuse_roughness roughens it
-float3 gltf_base_diffuse(const Bsdf* b, float3 wo, float3 wi) {
-#if CD_FEATURE_DIFFUSE_ROUGHNESS
-  float r = b->lobe.gltf.diffuse_roughness;
-  if (r > 0.0f) return diffuse_eon_eval(b->base_color, r, wo, wi);
-#endif
-  return b->base_color * INV_PI_F;
-}
-
 // KHR_materials_diffuse_transmission's factor at the hit (0 where compiled out)
 float gltf_diffuse_transmission(const Bsdf* b) {
 #if CD_FEATURE_DIFFUSE_TRANSMISSION
@@ -362,6 +353,9 @@ typedef struct {
 #if CD_FEATURE_SHEEN
   float sheen_e_o, sheen_o;  // gltf_sheen_e and gltf_sheen_below at wo
 #endif
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  float eon_e_o;  // diffuse_eon_albedo at wo of a base with diffuse roughness (else unused)
+#endif
   float w[GLTF_COMPONENT_COUNT];  // selection probabilities by GLTF_* id, summing to 1 (or all 0)
 } GltfAtWo;
 
@@ -434,6 +428,10 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float3 wo) {
   g.sheen_o = gltf_sheen_below(b, g.sheen_e_o);
   g.outer *= g.sheen_o;
 #endif
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  float r = b->lobe.gltf.diffuse_roughness;
+  g.eon_e_o = r > 0.0f ? diffuse_eon_albedo(cos_o, r) : 1.0f;
+#endif
 #define GLTF_WEIGHT(id, name, kind) g.w[id] = gltf_##name##_weight(b, &g, cos_o);
   GLTF_COMPONENTS(GLTF_WEIGHT)
 #undef GLTF_WEIGHT
@@ -442,6 +440,16 @@ GltfAtWo gltf_at_wo(const Bsdf* b, float3 wo) {
   float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
   for (uint k = 0u; k < GLTF_COMPONENT_COUNT; ++k) g.w[k] *= inv;
   return g;
+}
+
+// pi x the diffuse base's BRDF: the base colour (Lambert), or pi x EON where
+// KHR_materials_diffuse_roughness roughens it
+float3 gltf_base_diffuse_pi(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi) {
+#if CD_FEATURE_DIFFUSE_ROUGHNESS
+  float r = b->lobe.gltf.diffuse_roughness;
+  if (r > 0.0f) return diffuse_eon_eval_pi(b->base_color, r, g->eon_e_o, wo, wi);
+#endif
+  return b->base_color;
 }
 
 // A direction in the coat's frame, and |w.n_c|: the cosine the coat's albedo is taken at
@@ -482,7 +490,8 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
       e5_i = energy_lookup(&e, 1, energy_at(wi));
     }
     under = (1.0f - m) * (1.0f - t) * (1.0f - gltf_diffuse_transmission(b)) *
-            gltf_below_of(&spec, gltf_layer_albedo_of(&spec, e_i, e5_i)) * g->base_norm * gltf_base_diffuse(b, wo, wi);
+            gltf_below_of(&spec, gltf_layer_albedo_of(&spec, e_i, e5_i)) * g->base_norm *
+            gltf_base_diffuse_pi(b, g, wo, wi) * INV_PI_F;
     *pdf += w[GLTF_DIFFUSE] * sample_cosine_hemisphere_pdf(wi.z);
     if (glossy && !ggx_is_delta(lobe->ggx)) {
       float3 fm, fd;
