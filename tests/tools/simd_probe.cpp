@@ -34,6 +34,7 @@ uint probe_hash(uint x) {
 float probe_step(float x, float a) { return sqrt(fabs(x * a + 0.5f)) + 0.25f * x; }
 uint probe_count(uint i, uint n) { return n / 2u + probe_hash(i) % n; }
 
+__kernel void probe_counts(__global uint* out, uint n) { out[get_global_id(0)] = probe_count(get_global_id(0), n); }
 __kernel void probe_uniform(__global float* out, uint n) {
   uint i = get_global_id(0);
   float x = (float)i * 1e-3f, a = 1.0f + (float)(i & 7u) * 0.01f;
@@ -81,15 +82,6 @@ __kernel void probe_masked(__global float* out, uint n) {
 }
 )CLC";
 
-uint32_t host_hash(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -131,7 +123,16 @@ int main(int argc, char** argv) {
     program.build({device}, "-cl-std=CL1.2");
     cl::Buffer out(context, CL_MEM_WRITE_ONLY, items * sizeof(float));
     double useful = 0.0;  // steps the divergent counts ask for
-    for (size_t i = 0; i < items; ++i) useful += double(n / 2u + host_hash(uint32_t(i)) % n);
+    {
+      cl::Buffer counts(context, CL_MEM_WRITE_ONLY, items * sizeof(cl_uint));
+      cl::Kernel k(program, "probe_counts");
+      k.setArg(0, counts);
+      k.setArg(1, n);
+      queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(items), cl::NDRange(64));
+      std::vector<cl_uint> m(items);
+      queue.enqueueReadBuffer(counts, CL_TRUE, 0, items * sizeof(cl_uint), m.data());
+      for (cl_uint c : m) useful += double(c);
+    }
     const char* names[] = {"probe_uniform", "probe_unrolled", "probe_divergent", "probe_masked", "probe_lanes8"};
     for (int round = 0; round <= rounds; ++round)  // round 0 warms the driver's lazy code generation up
       for (const char* name : names) {
