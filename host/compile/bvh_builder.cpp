@@ -204,7 +204,7 @@ class Builder {
     }
     bvh_.nodes.resize(total);  // uninitialized: every job writes its own part
     for_each_taken(jobs.size(), [&](size_t k) {
-      relocate(jobs[k].out.nodes, &bvh_.nodes[offset[k]], int(offset[k]));
+      relocate(jobs[k].out.nodes, bvh_.nodes.data() + offset[k], int(offset[k]));  // a leaf job has no node
       decltype(jobs[k].out.nodes)().swap(jobs[k].out.nodes);
     });
     return std::move(bvh_);
@@ -416,7 +416,7 @@ class Builder {
       int i = big[k];
       int offset = int(out.sub.nodes.size());
       out.sub.nodes.resize(out.sub.nodes.size() + below[i].sub.nodes.size());
-      relocate(below[i].sub.nodes, &out.sub.nodes[size_t(offset)], offset);
+      relocate(below[i].sub.nodes, out.sub.nodes.data() + offset, offset);
       out.sub.depth = std::max(out.sub.depth, below[i].sub.depth);
       if (ref[i] >= 0) ref[i] += offset;
       for (Job& j : below[i].jobs) {
