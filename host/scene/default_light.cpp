@@ -17,8 +17,8 @@ struct Point {
   glm::dvec3 p, n;
 };
 
-// A triangle by its mesh and its index in the mesh: 8 bytes, where its corners would take
-// 72 (the points' population holds every lit triangle of the scene)
+// A triangle by its mesh and its index in the mesh: 8 bytes, where its three corners as
+// Points would take 144 (the points' population holds every lit triangle of the scene)
 struct TriangleRef {
   uint32_t mesh = 0, triangle = 0;
 };
