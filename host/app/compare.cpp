@@ -283,10 +283,54 @@ void keep_images(const CompareArgs& args, const fs::path& dir, size_t i) {
                     fs::copy_options::overwrite_existing);
 }
 
+// A device entry `kept:DIR`: a render made earlier, on a machine this one may not reach
+// (scripts/gpu-check writes them), read from DIR: main.exr, main-variance.exr and main.json,
+// and cold.json and same-seed.exr where there. Its size, spp and seed must be the ones this
+// comparison plans for that position.
+bool is_kept(const DeviceRun& r) { return r.selector.rfind("kept:", 0) == 0; }
+
+void read_kept(const CompareArgs& args, const DeviceRun& first, size_t i, DeviceRun* r) {
+  const fs::path dir = r->selector.substr(5);
+  auto file = [&](const char* name) {
+    fs::path p = dir / name;
+    if (!fs::is_regular_file(p)) throw Error("kept render " + dir.string() + " has no " + name);
+    return p.string();
+  };
+  nlohmann::json stats = read_json(file("main.json"));
+  auto mismatch = [&](const char* what, int64_t kept, int64_t planned) {
+    if (kept != planned)
+      throw Error("kept render " + dir.string() + " has " + what + " " + std::to_string(kept) + ", this comparison " +
+                  std::to_string(planned) + " (device " + std::to_string(i) + " renders seed --seed + " +
+                  std::to_string(i) + ")");
+  };
+  mismatch("seed", stats.value("seed", int64_t(-1)), r->seed);
+  mismatch("spp", stats.value("spp", int64_t(-1)), args.spp);
+  mismatch("width", stats.value("width", int64_t(-1)), args.width);
+  if (args.height > 0) mismatch("height", stats.value("height", int64_t(-1)), args.height);
+  r->description = stats.value("device", r->selector);
+  r->build_cached = stats.value("kernel_build_seconds", 0.0);
+  r->cached_hit = stats.value("kernel_from_cache", false);
+  r->render_seconds = stats.value("seconds", 0.0);
+  r->samples_per_second = stats.value("samples_per_second", 0.0);
+  r->spp = stats.value("spp", 0u);
+  if (fs::is_regular_file(dir / "cold.json"))
+    r->build_cold = read_json((dir / "cold.json").string()).value("kernel_build_seconds", 0.0);
+  r->image = read_rgb_image(file("main.exr"), "render");
+  r->variance = read_rgb_image(file("main-variance.exr"), "variance image");
+  if (i > 0 && args.determinism_check && fs::is_regular_file(dir / "same-seed.exr")) {
+    r->same_seed_image = r->seed == first.seed ? r->image : read_rgb_image((dir / "same-seed.exr").string(), "render");
+    r->has_same_seed = true;
+  }
+}
+
 void render_devices(const CompareArgs& args, const fs::path& tmp, std::vector<DeviceRun>* runs) {
   const std::string exe = self_executable();
   for (size_t i = 0; i < runs->size(); ++i) {
     DeviceRun& r = (*runs)[i];
+    if (is_kept(r)) {
+      read_kept(args, (*runs)[0], i, &r);
+      continue;
+    }
     fs::path dir = tmp / ("device" + std::to_string(i));
     fs::create_directories(dir);
     DeviceRenders renders(args, exe, r, dir);

@@ -14,7 +14,10 @@ CLI::App* add_compare_command(CLI::App* app, CompareCommand* c) {
       "Render a scene on several devices and test whether each agrees with the first within the measured noise "
       "(exit 0: consistent, 2: not); options it does not know are passed to every render");
   cmd->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
-  cmd->add_option("--devices", c->devices, "Comma-separated device selectors, the first is the reference")->required();
+  cmd->add_option("--devices", c->devices,
+                  "Comma-separated device selectors, the first is the reference; kept:DIR reads a render made "
+                  "elsewhere from DIR (main.exr, main-variance.exr, main.json) instead of rendering")
+      ->required();
   cmd->add_option("--spp", a.spp, "Samples per pixel on every device (default 64)")->check(integer_in(2, 1 << 24));
   cmd->add_option("--width", a.width, "Image width (default 64)")->check(integer_in(1, 65536));
   cmd->add_option("--height", a.height, "Image height (default from the camera's aspect ratio)")

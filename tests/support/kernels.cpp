@@ -1,5 +1,6 @@
 #include "support/kernels.hpp"
 
+#include <cstdlib>
 #include <map>
 #include <memory>
 
@@ -11,7 +12,10 @@
 
 namespace candela::test {
 
-DeviceEntry pocl_device() { return select_device("pocl"); }
+DeviceEntry pocl_device() {
+  const char* other = std::getenv("CANDELA_TEST_DEVICE");
+  return select_device(other && *other ? other : "pocl");
+}
 
 std::optional<DeviceEntry> rusticl_device() {
   for (const auto& d : list_devices())
