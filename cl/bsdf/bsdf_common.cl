@@ -55,6 +55,15 @@ typedef struct {
   float3 f_avg;  // hemispherical average of its Fresnel term
 } ConductorBsdf;
 
+// The lobe union's first member spans all of it as float4 words. A compiler may copy a union
+// as the one member it lays the union out by, and skip that member's padding: NVIDIA's
+// OpenCL compiler (driver 580) copied a Bsdf as GltfBsdf, whose `bool thin` (one byte, then
+// three of padding) lies over a conductor's k.z, and so rendered every measured conductor
+// without its blue channel's absorption. Words have no padding, and clang lays a union out by
+// its first member of the largest size and alignment.
+#define BSDF_LOBE_BYTES (sizeof(GltfBsdf) > sizeof(ConductorBsdf) ? sizeof(GltfBsdf) : sizeof(ConductorBsdf))
+#define BSDF_LOBE_WORDS ((BSDF_LOBE_BYTES + 15) / 16)
+
 // The BSDF of one shading point: what every type has (frame, normals, colour), then the
 // parameters of its type's lobe, evaluated there
 typedef struct {
@@ -68,6 +77,7 @@ typedef struct {
   int channel;  // the RGB channel whose wavelength a dispersive material refracts (dispersion.cl); -1: none
 #endif
   union {
+    float4 words[BSDF_LOBE_WORDS];  // see below: the union as a whole, without padding
     GltfBsdf gltf;
     ConductorBsdf conductor;
   } lobe;  // by type

@@ -286,6 +286,33 @@ if [ $rc -eq 2 ] && grep -q "^verdict: NOT consistent" "$tmp/out" &&
 else
   fail "compare: max depth 8 against 1 is NOT consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
 fi
+# kept:DIR: a render made elsewhere (scripts/gpu-check) read instead of rendered: seed 1 with
+# its variance, and seed 0 for the determinism check, as a device at position 1 renders them
+k="$tmp/kept"; mkdir -p "$k"
+"$bin" render "$scene" -o "$k/main.exr" --variance "$k/main-variance.exr" --stats "$k/main.json" --spp 8 --width 16 \
+  --seed 1 --max-depth 8 --device pocl -q >/dev/null 2>&1
+"$bin" render "$scene" -o "$k/same-seed.exr" --spp 8 --width 16 --seed 0 --max-depth 8 --device pocl -q >/dev/null 2>&1
+"$bin" compare "$scene" --devices "pocl,kept:$k" --spp 8 --width 16 --max-depth 8 -q >"$tmp/out" 2>"$tmp/err"
+rc=$?
+if [ $rc -eq 0 ] && grep -q "^verdict: statistically consistent" "$tmp/out" &&
+  grep -q "determinism, seed 0 on kept:$k against pocl: max |a-b| 0, max relative 0, 100.0% bit-identical" "$tmp/out"; then
+  pass "compare: a kept render of the same device is consistent and bit-identical at the same seed"
+else
+  fail "compare: a kept render of the same device is consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
+fi
+"$bin" compare "$scene" --devices "pocl,kept:$k" --spp 8 --width 16 --max-depth 1 -q >"$tmp/out" 2>"$tmp/err"
+rc=$?
+if [ $rc -eq 2 ] && grep -q "^verdict: NOT consistent" "$tmp/out"; then
+  pass "compare: a kept render of other settings is NOT consistent"
+else
+  fail "compare: a kept render of other settings is NOT consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
+fi
+expect_error "compare: kept render of another spp" "kept render $k has spp 8, this comparison 16" -- \
+  "$bin" compare "$scene" --devices "pocl,kept:$k" --spp 16 --width 16 -q
+expect_error "compare: kept render at the wrong position" "has seed 1, this comparison 0" -- \
+  "$bin" compare "$scene" --devices "kept:$k,pocl" --spp 8 --width 16 -q
+expect_error "compare: kept folder without a render" "has no main.json" -- \
+  "$bin" compare "$scene" --devices "pocl,kept:$tmp" --spp 8 --width 16 -q
 # PoCL against rusticl: consistent; the same-seed determinism check is reported
 if ls /etc/OpenCL/vendors/ 2>/dev/null | grep -q rusticl; then
   "$bin" compare "$scene" --devices pocl,rusticl --spp 16 --width 24 --max-depth 8 --json "$tmp/c1.json" -q >"$tmp/out" 2>"$tmp/err"

@@ -9,7 +9,10 @@ CD_LIGHTS are exactly their entries, numbered 0, 1, ...; no kernel code compares
 an id or switches on it (the dispatch is generated from the lists); every type has its
 functions with the one signature, and the generated dispatch calls each of them; every
 CD_FEATURE_* macro the kernels use is in CD_SCENE_FEATURES, whose defaults come from the
-list alone. Usage: kernel_lint_test.py REPO_ROOT
+list alone. Fails when a union in kernel code (outside cl/shared/device_types.h, whose
+structs hold only 4-byte scalars) does not begin with a float4 or uint4 array that spans it:
+a compiler may copy a union as the member it lays it out by and drop that member's padding
+(NVIDIA's OpenCL compiler lost a conductor's k.z under a bool's padding). Usage: kernel_lint_test.py REPO_ROOT
 """
 import glob
 import os
@@ -63,6 +66,20 @@ def violations(sources):
                         found.append(f'{path}: {name}() changes its by-value parameter {pm.group(1)} '
                                      f'{pm.group(2)} ("{hit.group(0).strip()}"); copy it into a local first')
                         break
+    return found
+
+
+def union_violations(sources):
+    """Unions whose first member is not a padding-free array of 4-wide vectors."""
+    found = []
+    for path, text in sources.items():
+        if path.endswith(os.path.join('shared', 'device_types.h')):
+            continue
+        text = re.sub(r'//[^\n]*', '', text)
+        for m in re.finditer(r'\bunion\s*\w*\s*\{\s*([^;]*;)', text):
+            if not re.match(r'(?:float|uint|int)4\s+\w+\s*\[[^\]]+\]\s*;', m.group(1)):
+                found.append(f'{path}: a union begins with "{m.group(1).strip()}", not a float4 array spanning it '
+                             f'(a copy may drop the padding of the member it is laid out by)')
     return found
 
 
@@ -290,11 +307,15 @@ def main():
     if not violations(planted):
         print('kernel_lint: the planted violation was not found; the check is broken')
         return 1
+    if not union_violations({'u.cl': 'typedef struct { union { A a; B b; } lobe; } S;'}) or union_violations(
+            {'u.cl': 'typedef struct { union { float4 words[3]; A a; } lobe; } S;'}):
+        print('kernel_lint: the union check misses its planted violation or flags a clean union; the check is broken')
+        return 1
     missed = planted_list_violations()
     if missed:
         print(f'kernel_lint: the list check misses planted violations ({"; ".join(missed)}); the check is broken')
         return 1
-    found = violations(sources)
+    found = violations(sources) + union_violations(sources)
     program_sources = {p: t for p, t in sources.items() if p in program}
     types = os.path.join('cl', 'shared', 'device_types.h')
     gltf = os.path.join('cl', 'bsdf', 'bsdf_gltf.cl')
