@@ -236,6 +236,18 @@ class DeviceRenders {
   std::vector<std::pair<std::string, std::string>> env_;
 };
 
+// The measured render in DIR: its statistics (main.json, read into `stats`), its image and
+// its variance image
+void take_main_render(const nlohmann::json& stats, const fs::path& dir, DeviceRun* r) {
+  r->build_cached = stats.value("kernel_build_seconds", 0.0);
+  r->cached_hit = stats.value("kernel_from_cache", false);
+  r->render_seconds = stats.value("seconds", 0.0);
+  r->samples_per_second = stats.value("samples_per_second", 0.0);
+  r->spp = stats.value("spp", 0u);
+  r->image = read_rgb_image((dir / "main.exr").string(), "render");
+  r->variance = read_rgb_image((dir / "main-variance.exr").string(), "variance image");
+}
+
 // A 1 spp render that builds the kernel cold, then the measured one with its variance
 void render_cold_and_main(const CompareArgs& args, const DeviceRenders& renders, const fs::path& dir, DeviceRun* r) {
   if (!args.quiet) std::fprintf(stderr, "compare: %s: cold kernel build...\n", r->selector.c_str());
@@ -247,14 +259,7 @@ void render_cold_and_main(const CompareArgs& args, const DeviceRenders& renders,
   if (!args.quiet)
     std::fprintf(stderr, "compare: %s: %u spp with seed %u...\n", r->selector.c_str(), args.spp, r->seed);
   renders.render("main", args.spp, r->seed, true);
-  nlohmann::json stats = read_json((dir / "main.json").string());
-  r->build_cached = stats.value("kernel_build_seconds", 0.0);
-  r->cached_hit = stats.value("kernel_from_cache", false);
-  r->render_seconds = stats.value("seconds", 0.0);
-  r->samples_per_second = stats.value("samples_per_second", 0.0);
-  r->spp = stats.value("spp", 0u);
-  r->image = read_rgb_image((dir / "main.exr").string(), "render");
-  r->variance = read_rgb_image((dir / "main-variance.exr").string(), "variance image");
+  take_main_render(read_json((dir / "main.json").string()), dir, r);
 }
 
 // The determinism check: the first device's seed rendered on another device
@@ -308,15 +313,11 @@ void read_kept(const CompareArgs& args, const DeviceRun& first, size_t i, Device
   mismatch("width", stats.value("width", int64_t(-1)), args.width);
   if (args.height > 0) mismatch("height", stats.value("height", int64_t(-1)), args.height);
   r->description = stats.value("device", r->selector);
-  r->build_cached = stats.value("kernel_build_seconds", 0.0);
-  r->cached_hit = stats.value("kernel_from_cache", false);
-  r->render_seconds = stats.value("seconds", 0.0);
-  r->samples_per_second = stats.value("samples_per_second", 0.0);
-  r->spp = stats.value("spp", 0u);
   if (fs::is_regular_file(dir / "cold.json"))
     r->build_cold = read_json((dir / "cold.json").string()).value("kernel_build_seconds", 0.0);
-  r->image = read_rgb_image(file("main.exr"), "render");
-  r->variance = read_rgb_image(file("main-variance.exr"), "variance image");
+  file("main.exr");
+  file("main-variance.exr");
+  take_main_render(stats, dir, r);
   if (i > 0 && args.determinism_check && fs::is_regular_file(dir / "same-seed.exr")) {
     r->same_seed_image = r->seed == first.seed ? r->image : read_rgb_image((dir / "same-seed.exr").string(), "render");
     r->has_same_seed = true;
