@@ -22,7 +22,12 @@
 // (cdf[0] = 0, cdf[h] = total, not normalized), then row r's conditional CDF over its
 // columns at (h + 1) + r (w + 1), w + 1 floats each. A step of zero is a cell that is never
 // sampled (and has pdf 0). The solid-angle pdf is p(u, v) / (2 pi^2 sin theta), since
-// dw = sin(theta) dtheta dphi = 2 pi^2 sin(theta) du dv.
+// dw = sin(theta) dtheta dphi = 2 pi^2 sin(theta) du dv. After the CDFs, at
+// G = (h + 1) + h (w + 1), their guide tables (Chen & Asau 1974, the cutpoint method):
+// the marginal's g(h) cells, then row r's g(w) cells at G + g(h) + r g(w), g(n) =
+// environment_guide_cells(n) = max(1, (n + 3) / 4); cell k of a CDF of n cells holds (as an
+// integer-valued float) the largest i < n with cdf[i] <= k / g(n) x cdf[n], where the search
+// for a u in [k / g(n), (k + 1) / g(n)) starts.
 
 // The light's map (a TextureInfo index), or NO_TEXTURE for a constant environment
 int environment_map(__global const Light* light) { return (int)light->params[0]; }
@@ -49,11 +54,21 @@ int2 environment_texel(__global const TextureInfo* tex, float2 uv) {
   return (int2)(clamp((int)(uv.x * (float)w), 0, w - 1), clamp((int)(uv.y * (float)h), 0, h - 1));
 }
 
+// The texel that unit direction dir falls in
+int2 environment_texel_of(__global const TextureInfo* tex, float3 dir, float rotation) {
+  return environment_texel(tex, environment_uv(dir, rotation));
+}
+
+// Radiance of texel t: strength x the texel
+float3 environment_radiance_at(const SceneData* sc, __global const Light* light, __global const TextureInfo* tex,
+                               int2 t) {
+  return light->params[1] * texture_texel(sc, tex, t.x, t.y).xyz;
+}
+
 // Radiance arriving along -dir: strength x the nearest texel
 float3 environment_radiance(const SceneData* sc, __global const Light* light, float3 dir) {
   __global const TextureInfo* tex = &sc->textures[environment_map(light)];
-  int2 t = environment_texel(tex, environment_uv(dir, light->params[2]));
-  return light->params[1] * texture_texel(sc, tex, t.x, t.y).xyz;
+  return environment_radiance_at(sc, light, tex, environment_texel_of(tex, dir, light->params[2]));
 }
 
 // Density in (u, v) of texel t: (marginal step / total) h x (conditional step / total) w
@@ -67,28 +82,34 @@ float environment_pdf_uv(const SceneData* sc, __global const TextureInfo* tex, i
   return p_row * p_col * (float)w * (float)h;
 }
 
-// Solid-angle pdf with which environment_sample picks dir
-float environment_pdf(const SceneData* sc, __global const Light* light, float3 dir) {
-  __global const TextureInfo* tex = &sc->textures[environment_map(light)];
+// Solid-angle pdf with which environment_sample picks dir, t being dir's texel
+float environment_pdf_at(const SceneData* sc, __global const TextureInfo* tex, float3 dir, int2 t) {
   float sin_theta = sqrt(dir.x * dir.x + dir.z * dir.z);  // accurate near the poles
   if (!(sin_theta > 0.0f)) return 0.0f;
-  int2 t = environment_texel(tex, environment_uv(dir, light->params[2]));
   return environment_pdf_uv(sc, tex, t) / (2.0f * PI_F * PI_F * sin_theta);
 }
 
+// Solid-angle pdf with which environment_sample picks dir
+float environment_pdf(const SceneData* sc, __global const Light* light, float3 dir) {
+  __global const TextureInfo* tex = &sc->textures[environment_map(light)];
+  return environment_pdf_at(sc, tex, dir, environment_texel_of(tex, dir, light->params[2]));
+}
+
+// Cells of the guide table of a CDF of n cells (the layout above)
+int environment_guide_cells(int n) { return max(1, (n + 3) / 4); }
+
 // A coordinate in [0, 1) distributed by one CDF of n cells: the cell i with
-// cdf[i] <= x < cdf[i+1] for x = u cdf[n] (binary search), then uniform within it
-float environment_sample_cdf(__global const float* cdf, int n, float u, int* index) {
+// cdf[i] <= x < cdf[i+1] for x = u cdf[n], then uniform within it. The search starts at
+// the guide's cell of u and steps down while cdf[i] > x, then up while cdf[i + 1] <= x: the
+// largest i < n with cdf[i] <= x (as a binary search finds it) whatever the guide says, in
+// about n / g(n) steps over neighbouring floats.
+float environment_sample_cdf(__global const float* cdf, int n, __global const float* guide, float u, int* index) {
   float total = cdf[n];
   float x = fmin(u * total, nextafter(total, 0.0f));  // x < total: a cell of positive step
-  int lo = 0, hi = n - 1;                             // the largest i with cdf[i] <= x
-  while (lo < hi) {
-    int mid = (lo + hi + 1) / 2;
-    if (cdf[mid] <= x)
-      lo = mid;
-    else
-      hi = mid - 1;
-  }
+  int cells = environment_guide_cells(n);
+  int lo = (int)guide[clamp((int)(u * (float)cells), 0, cells - 1)];
+  while (lo > 0 && cdf[lo] > x) --lo;
+  while (lo < n - 1 && cdf[lo + 1] <= x) ++lo;
   *index = lo;
   float t = (x - cdf[lo]) / (cdf[lo + 1] - cdf[lo]);
   return ((float)lo + clamp(t, 0.0f, 1.0f)) / (float)n;
@@ -96,16 +117,20 @@ float environment_sample_cdf(__global const float* cdf, int n, float u, int* ind
 
 // A direction distributed by the map's luminance x sin(theta): a row by the marginal CDF
 // (u.y), a column within it by the row's conditional CDF (u.x). *pdf is environment_pdf of
-// the returned direction (0 when it should not be used).
-float3 environment_sample(const SceneData* sc, __global const Light* light, float2 u, float* pdf) {
+// the returned direction (0 when it should not be used), *radiance environment_radiance.
+float3 environment_sample(const SceneData* sc, __global const Light* light, float2 u, float* pdf, float3* radiance) {
   __global const TextureInfo* tex = &sc->textures[environment_map(light)];
   int w = (int)tex->width, h = (int)tex->height;
   int row, col;
-  float v = environment_sample_cdf(sc->env_distribution, h, u.y, &row);
-  float uu = environment_sample_cdf(sc->env_distribution + (h + 1) + row * (w + 1), w, u.x, &col);
+  __global const float* guides = sc->env_distribution + (h + 1) + h * (w + 1);
+  float v = environment_sample_cdf(sc->env_distribution, h, guides, u.y, &row);
+  float uu = environment_sample_cdf(sc->env_distribution + (h + 1) + row * (w + 1), w,
+                                    guides + environment_guide_cells(h) + row * environment_guide_cells(w), u.x, &col);
   float3 dir = environment_direction((float2)(uu, v), light->params[2]);
-  // Evaluated from the direction itself, so that sample and pdf agree exactly even where
-  // rounding puts dir across a texel edge
-  *pdf = environment_pdf(sc, light, dir);
+  // Both from the direction itself (its texel found once), so that sample, pdf and radiance
+  // agree exactly even where rounding puts dir across a texel edge
+  int2 t = environment_texel_of(tex, dir, light->params[2]);
+  *pdf = environment_pdf_at(sc, tex, dir, t);
+  *radiance = environment_radiance_at(sc, light, tex, t);
   return dir;
 }

@@ -83,8 +83,7 @@ bool lights_environment_sample(const SceneData* sc, __global const Light* light,
                                float2 u, LightSample* ls) {
   __global const Light* env = lights_environment(sc);
   if (env && environment_map(env) != NO_TEXTURE) {
-    ls->wi = environment_sample(sc, env, u, &ls->pdf);
-    ls->radiance = environment_radiance(sc, env, ls->wi);
+    ls->wi = environment_sample(sc, env, u, &ls->pdf, &ls->radiance);
     ls->at_infinity = true;
     return ls->pdf > 0.0f;
   }

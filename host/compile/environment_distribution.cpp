@@ -25,6 +25,21 @@ void append_cdf(const double* weights, int n, std::vector<float>* out) {
   }
 }
 
+// Guide table of the CDF of n cells at cdf (n + 1 floats), appended as
+// environment_guide_cells(n) floats: cell k holds, as an integer-valued float, the largest
+// i < n with cdf[i] <= k / cells x cdf[n], where the kernel starts its search for a sample
+// u in [k / cells, (k + 1) / cells). Any start in [0, n) gives the same answer (the kernel
+// corrects it both ways); this one leaves about n / cells steps to take.
+void append_guide(const float* cdf, int n, std::vector<float>* out) {
+  int cells = environment_guide_cells(n);
+  double total = cdf[n];
+  for (int k = 0; k < cells; ++k) {
+    float t = float(double(k) / cells * total);
+    int i = int(std::upper_bound(cdf, cdf + n, t) - cdf) - 1;  // cdf[0] = 0 <= t
+    out->push_back(float(std::clamp(i, 0, n - 1)));
+  }
+}
+
 double texel_luminance(const TextureDesc& map, size_t i) {
   const float* t = &map.rgbaf[4 * i];
   return dev::luminance_rgb(t[0], t[1], t[2]);
@@ -32,11 +47,14 @@ double texel_luminance(const TextureDesc& map, size_t i) {
 
 }  // namespace
 
+int environment_guide_cells(int n) { return std::max(1, (n + 3) / 4); }
+
 std::vector<float> environment_distribution(const TextureDesc& map) {
   int w = map.width, h = map.height;
   std::vector<double> row_weight(static_cast<size_t>(h)), weights(static_cast<size_t>(w));
   std::vector<float> out;
-  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1));
+  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1) + size_t(environment_guide_cells(h)) +
+              size_t(h) * size_t(environment_guide_cells(w)));
   out.resize(size_t(h) + 1);  // the marginal CDF goes here once the rows are known
   for (int r = 0; r < h; ++r) {
     double sin_theta = std::sin(kPi * (r + 0.5) / h);
@@ -53,6 +71,10 @@ std::vector<float> environment_distribution(const TextureDesc& map) {
   std::vector<float> marginal;
   append_cdf(row_weight.data(), h, &marginal);
   std::copy(marginal.begin(), marginal.end(), out.begin());
+  std::vector<float> guides;
+  append_guide(out.data(), h, &guides);
+  for (int r = 0; r < h; ++r) append_guide(out.data() + (size_t(h) + 1) + size_t(r) * (size_t(w) + 1), w, &guides);
+  out.insert(out.end(), guides.begin(), guides.end());
   return out;
 }
 

@@ -8,10 +8,13 @@
 
 namespace candela {
 
-// Sampling CDFs of a map, laid out as cl/lights/environment.cl reads them: texel weights
-// luminance x sin(theta at the row centre); every texel of positive luminance keeps a
-// float CDF step > 0, so its pdf is > 0.
+// Sampling CDFs of a map and their guide tables, laid out as cl/lights/environment.cl reads
+// them: texel weights luminance x sin(theta at the row centre); every texel of positive
+// luminance keeps a float CDF step > 0, so its pdf is > 0.
 std::vector<float> environment_distribution(const TextureDesc& map);
+
+// Cells of the guide table of a CDF of n cells (cl/lights/environment.cl)
+int environment_guide_cells(int n);
 
 // What the strategy choice (cl/integrator/integrator_path.cl) needs of a map, L its texel
 // luminance: its effective solid angle (integral L)^2 / integral L^2 over the sphere (4 pi

@@ -17,6 +17,7 @@
 #include <memory>
 
 #include "base/error.hpp"
+#include "compile/environment_distribution.hpp"
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
@@ -207,7 +208,20 @@ TEST_P(EnvironmentKernels, SamplePdfAndRadianceMatchHostReference) {
   TextureDesc map = sky_and_sun(kMapW, kMapH);
   use(env_of(map, strength, rotation));
   const std::vector<float>& cdf = compiled_.buffers.env_distribution;
-  ASSERT_EQ(cdf.size(), size_t(kMapH + 1) + size_t(kMapH) * (kMapW + 1));
+  const size_t guides_at = size_t(kMapH + 1) + size_t(kMapH) * (kMapW + 1);
+  ASSERT_EQ(cdf.size(), guides_at + size_t(environment_guide_cells(kMapH)) +
+                            size_t(kMapH) * size_t(environment_guide_cells(kMapW)));
+  // Row 3's guide: cell k starts at the largest column whose CDF value is <= k / cells of the total
+  const float* row3 = cdf.data() + (kMapH + 1) + 3 * (kMapW + 1);
+  const float* guide3 = cdf.data() + guides_at + environment_guide_cells(kMapH) + 3 * environment_guide_cells(kMapW);
+  for (int k = 0; k < environment_guide_cells(kMapW); ++k) {
+    int i = int(guide3[k]);
+    float t = float(double(k) / environment_guide_cells(kMapW) * row3[kMapW]);
+    ASSERT_LE(row3[i], t) << "cell " << k;
+    if (i + 1 < kMapW) {
+      ASSERT_GT(row3[i + 1], t) << "cell " << k;
+    }
+  }
   std::vector<cl_float4> s = sample(5, 1 << 16);
   size_t compared = 0, mismatched = 0;
   for (size_t i = 0; i < s.size() / 2; ++i) {

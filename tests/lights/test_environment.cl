@@ -9,8 +9,9 @@ float3 test_environment_direction(float theta, float phi) {
   return (float3)(-st * sp, ct, st * cp);
 }
 
-// One sample per work-item: out[2i] = (dir, pdf), out[2i+1] = (environment_pdf(dir),
-// radiance rgb); the light is the scene's environment light
+// One sample per work-item: out[2i] = (dir, pdf), out[2i+1] = (environment_pdf(dir), the
+// sample's radiance rgb), the pdf slot NaN when that radiance is not environment_radiance(dir);
+// the light is the scene's environment light
 __kernel void test_environment_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, uint seed,
                                       __global float4* out) {
   uint i = get_global_id(0);
@@ -21,10 +22,12 @@ __kernel void test_environment_sample(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global 
   u.x = rng_next(&rng);
   u.y = rng_next(&rng);
   float pdf = 0.0f;
-  float3 dir = environment_sample(&sc, env, u, &pdf);
-  float3 l = environment_radiance(&sc, env, dir);
+  float3 l;
+  float3 dir = environment_sample(&sc, env, u, &pdf, &l);
+  // The sample's radiance is the one a ray along dir sees (else the pdf slot says NaN)
+  bool same = all(l == environment_radiance(&sc, env, dir));
   out[2 * i] = (float4)(dir, pdf);
-  out[2 * i + 1] = (float4)(environment_pdf(&sc, env, dir), l);
+  out[2 * i + 1] = (float4)(same ? environment_pdf(&sc, env, dir) : NAN, l);
 }
 
 // Integral of environment_pdf over each cell (cos0, cos1, phi0, phi1) of (cos theta, phi)
