@@ -13,6 +13,29 @@ float luminance(float3 c) { return luminance_rgb(c.x, c.y, c.z); }
 
 bool all_finite(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
+// atan2(y, x) for finite y and x, within 4e-7 radians of the exact angle, signed zeros as
+// atan2's: atan(a) = a P(a^2) on a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], then the
+// octant. P is the project's own fit (least squares, reweighted toward a minimax relative
+// error: 1.0e-7 in exact arithmetic). Inlined arithmetic instead of the library call that
+// every ray leaving an environment-lit scene makes (docs/performance.md).
+float atan2_fast(float y, float x) {
+  float ax = fabs(x), ay = fabs(y);
+  float hi = fmax(ax, ay), lo = fmin(ax, ay);
+  float a = hi > 0.0f ? lo / hi : 0.0f, s = a * a;
+  float p = -0.004680493380874395f;
+  p = p * s + 0.024210669100284576f;
+  p = p * s - 0.059433430433273315f;
+  p = p * s + 0.09911005944013596f;
+  p = p * s - 0.14018453657627106f;
+  p = p * s + 0.19969575107097626f;
+  p = p * s - 0.33331984281539917f;
+  p = p * s + 0.9999998807907104f;
+  float r = a * p;
+  if (ay > ax) r = 0.5f * PI_F - r;
+  if (signbit(x)) r = PI_F - r;  // -0 too, as atan2(0, -0) = pi
+  return copysign(r, y);
+}
+
 // Orthonormal frame (t, b, n); local coordinates have z along n
 typedef struct {
   float3 t, b, n;

@@ -34,17 +34,17 @@ int environment_map(__global const Light* light) { return (int)light->params[0];
 
 // (u, v) of a unit direction: the mapping above
 float2 environment_uv(float3 dir, float rotation) {
-  float u = (atan2(-dir.x, dir.z) + rotation) * (0.5f * INV_PI_F);
+  float u = (atan2_fast(-dir.x, dir.z) + rotation) * (0.5f * INV_PI_F);
   u -= floor(u);
-  float v = acos(clamp(dir.y, -1.0f, 1.0f)) * INV_PI_F;
+  float v = atan2_fast(sqrt(dir.x * dir.x + dir.z * dir.z), dir.y) * INV_PI_F;  // theta
   return (float2)(u, v);
 }
 
 // The unit direction of (u, v): the inverse of environment_uv
 float3 environment_direction(float2 uv, float rotation) {
-  float phi = 2.0f * PI_F * uv.x - rotation;
-  float cos_theta, sin_theta = sincos(PI_F * uv.y, &cos_theta);
-  float cos_phi, sin_phi = sincos(phi, &cos_phi);
+  // theta = pi v, phi = 2 pi (u - rotation / 2 pi): sinpi/cospi reduce exactly (sincos_turn)
+  float cos_theta = cospi(uv.y), sin_theta = sinpi(uv.y);
+  float cos_phi, sin_phi = sincos_turn(uv.x - rotation * (0.5f * INV_PI_F), &cos_phi);
   return (float3)(-sin_theta * sin_phi, cos_theta, sin_theta * cos_phi);
 }
 

@@ -34,3 +34,9 @@ __kernel void test_light_select(__global const AliasBin* bins, uint n, uint seed
   Rng rng = rng_init(i, 0u, seed);
   out[i] = sample_discrete_alias(bins, n, mode ? i * stride : rng_next_uint(&rng));
 }
+
+// atan2_fast (cl/core/geometry.cl) of each (y, x) pair: out[i] = atan2_fast(in[i].x, in[i].y)
+__kernel void test_atan2_fast(__global const float2* in, __global float* out) {
+  uint i = get_global_id(0);
+  out[i] = atan2_fast(in[i].x, in[i].y);
+}
