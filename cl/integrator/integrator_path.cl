@@ -106,7 +106,7 @@ float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const
 // (1 / W) / (1 + pi d^2 / W)^2 (D of the half vector at small angles, whose tail falls as
 // d^-4: a light beside a sharp lobe still gets much of its reflection)
 float path_lobe_pdf(float omega, float d) {
-  if (omega >= PI_F) return fmax(cos(d), 0.0f) * INV_PI_F;
+  if (omega >= PI_F) return fmax(cospi(d * INV_PI_F), 0.0f) * INV_PI_F;  // cospi: no general reduction
   float x = 1.0f + PI_F * d * d / omega;
   return 1.0f / (omega * x * x);
 }
