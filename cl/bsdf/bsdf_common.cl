@@ -99,15 +99,16 @@ typedef struct {
 
 void bsdf_lobes_add(BsdfLobes* l, float3 dir, float omega, float weight) {
   if (!(weight > 0.0f) || !(omega > 0.0f)) return;  // absent, or a delta lobe
-  uint nearest = 0u;
   for (uint k = 0u; k < l->count; ++k) {
     if (l->omega[k] == omega && all(l->dir[k] == dir)) {
       l->weight[k] += weight;
       return;
     }
-    if (fabs(log(l->omega[k] / omega)) < fabs(log(l->omega[nearest] / omega))) nearest = k;
   }
-  if (l->count == BSDF_MAX_LOBES) {
+  if (l->count == BSDF_MAX_LOBES) {  // the logarithms only here: the common case has room
+    uint nearest = 0u;
+    for (uint k = 1u; k < l->count; ++k)
+      if (fabs(log(l->omega[k] / omega)) < fabs(log(l->omega[nearest] / omega))) nearest = k;
     l->weight[nearest] += weight;
     return;
   }
