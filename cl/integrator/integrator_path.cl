@@ -189,9 +189,14 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
   uint x_select = rng_next_uint(rng);
   float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;  // no dimension spent without a tree
   float2 u = rng_next_2d(rng);
+  uint light;
+  float pmf;
+  if (!lights_select(sc, ctx, x_select, u_select, &light, &pmf)) return (float3)(0.0f);
+  // The choice depends on the light and the vertex, not on the direction: a light left to
+  // BSDF sampling costs no direction sample (a delta light is always taken)
+  if (lobes && !path_nee_takes(sc, lobes, ctx, light, pmf)) return (float3)(0.0f);
   LightSample ls;
-  if (!lights_sample(sc, ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);
-  if (lobes && !ls.is_delta && !path_nee_takes(sc, lobes, ctx, ls.light, ls.pmf)) return (float3)(0.0f);
+  if (!lights_sample_selected(sc, ctx, light, pmf, u, &ls)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
   float cos_i = fabs(dot(ls.wi, ctx->ns));
   float3 contrib = f * ls.radiance * (cos_i / ls.pdf);

@@ -538,15 +538,24 @@ bool lights_select(const SceneData* sc, const LightSampleContext* ctx, uint x_se
   return *pmf > 0.0f;
 }
 
+// Samples a direction toward light `index`, which lights_select picked with probability pmf
+bool lights_sample_selected(const SceneData* sc, const LightSampleContext* ctx, uint index, float pmf, float2 u,
+                            LightSample* ls) {
+  ls->light = index;
+  ls->pmf = pmf;
+  ls->is_delta = false;
+  bool ok = lights_sample_light(sc, &sc->lights[index], ctx, u, ls);
+  ls->pdf *= pmf;
+  return ok;
+}
+
 // Picks a light (lights_select) and samples a direction toward it
 bool lights_sample(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float u_select, float2 u,
                    LightSample* ls) {
-  if (!lights_select(sc, ctx, x_select, u_select, &ls->light, &ls->pmf)) return false;
-  __global const Light* light = &sc->lights[ls->light];
-  ls->is_delta = false;
-  bool ok = lights_sample_light(sc, light, ctx, u, ls);
-  ls->pdf *= ls->pmf;
-  return ok;
+  uint light;
+  float pmf;
+  if (!lights_select(sc, ctx, x_select, u_select, &light, &pmf)) return false;
+  return lights_sample_selected(sc, ctx, light, pmf, u, ls);
 }
 
 // The pdf with which lights_sample picks light `index` and direction wi from ctx
