@@ -186,8 +186,10 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
 // `interior`, the medium inside the surface.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
                          const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
-  uint x_select = rng_next_uint(rng);
-  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;  // no dimension spent without a tree
+  // No dimension spent on what selection does not use: the alias table's draw when the tree
+  // holds every light, the tree's without a tree
+  uint x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
+  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
   float2 u = rng_next_2d(rng);
   uint light;
   float pmf;
@@ -229,8 +231,10 @@ float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 w
   ctx.p = p;
   ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
   ctx.transmits = true;
-  uint x_select = rng_next_uint(rng);
-  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;  // no dimension spent without a tree
+  // No dimension spent on what selection does not use: the alias table's draw when the tree
+  // holds every light, the tree's without a tree
+  uint x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
+  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
   float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, &ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);

@@ -25,7 +25,7 @@
 // dw = sin(theta) dtheta dphi = 2 pi^2 sin(theta) du dv. After the CDFs, at
 // G = (h + 1) + h (w + 1), their guide tables (Chen & Asau 1974, the cutpoint method):
 // the marginal's g(h) cells, then row r's g(w) cells at G + g(h) + r g(w), g(n) =
-// environment_guide_cells(n) = max(1, (n + 3) / 4); cell k of a CDF of n cells holds (as an
+// environment_guide_cells(n) = max(1, (n + 3) / 4) (cl/shared); cell k of a CDF of n cells holds (as an
 // integer-valued float) the largest i < n with cdf[i] <= k / g(n) x cdf[n], where the search
 // for a u in [k / g(n), (k + 1) / g(n)) starts.
 
@@ -94,9 +94,6 @@ float environment_pdf(const SceneData* sc, __global const Light* light, float3 d
   __global const TextureInfo* tex = &sc->textures[environment_map(light)];
   return environment_pdf_at(sc, tex, dir, environment_texel_of(tex, dir, light->params[2]));
 }
-
-// Cells of the guide table of a CDF of n cells (the layout above)
-int environment_guide_cells(int n) { return max(1, (n + 3) / 4); }
 
 // A coordinate in [0, 1) distributed by one CDF of n cells: the cell i with
 // cdf[i] <= x < cdf[i+1] for x = u cdf[n], then uniform within it. The search starts at

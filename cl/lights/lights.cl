@@ -371,8 +371,8 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // proportional to its importance at the shading point, an estimate of the irradiance its
 // lights can send there; the selection pmf is the product of those probabilities. A child's
 // importance is I cos(theta') cos(theta_i') / d^2: I its summed peak intensity, d the
-// distance to its box's centre (the radius r of its bounding sphere when ctx.p lies inside
-// the sphere, where both cosines are 1), theta' the smallest angle its emission cone can make
+// distance to the centre of its bounding sphere (the sphere's radius r when ctx.p lies
+// inside it, where both cosines are 1), theta' the smallest angle its emission cone can make
 // with the direction to ctx.p (the angle from the cone's axis less theta_o and less the angle
 // theta_b the sphere subtends; 0 importance beyond theta_e: no light of the child emits
 // toward ctx.p), and theta_i' the smallest angle between the shading normal and a direction
@@ -380,11 +380,11 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // are kept at least LIGHT_TREE_MIN_COS and the cut-off has a margin of the same size, so
 // float rounding never gives 0 to a light that can contribute. A node's four children are
 // weighed at once, one child per float4 lane. Every child of nonzero importance is given a
-// share of at least the root's `min_prob` before the shares are renormalized, so a
-// probability of at least min_prob / (1 + 4 min_prob) (also when another child's importance
-// is infinite); the host sets min_prob so that the product over the
-// deepest trail, times the tree's share, stays above 2^-124: no light's pmf underflows (to
-// 0 on devices that flush denormals). Sampling and the pmf of a given light
+// weight of at least the root's `min_prob` times the sum of the importances before the
+// weights are normalized, so a probability of at least min_prob / (1 + 4 min_prob) (also
+// when another child's importance is infinite); the host sets min_prob so that the product
+// over the deepest trail, times the tree's share, stays above 2^-124: no light's pmf
+// underflows (to 0 on devices that flush denormals). Sampling and the pmf of a given light
 // (lights_tree_pmf, along its trail) run the same arithmetic, contraction off, so
 // STRATEGY_AUTO's two evaluations of a light's selection probability agree exactly.
 // Inside a planar emitter of several triangles (cluster nodes) the children are taken by
@@ -394,24 +394,22 @@ float lights_directional_pdf(const SceneData* sc, __global const Light* light, c
 // The importances of node's four children at ctx (0 in empty slots)
 float4 lights_tree_importance(__global const LightTreeNode* node, const LightSampleContext* ctx) {
 #pragma OPENCL FP_CONTRACT OFF
-  float4 intensity = vload4(0, node->intensity);
-  float4 lo_x = vload4(0, node->lo[0]), lo_y = vload4(0, node->lo[1]), lo_z = vload4(0, node->lo[2]);
-  float4 hi_x = vload4(0, node->hi[0]), hi_y = vload4(0, node->hi[1]), hi_z = vload4(0, node->hi[2]);
-  float4 ex = hi_x - lo_x, ey = hi_y - lo_y, ez = hi_z - lo_z;
-  float4 r2 = 0.25f * (ex * ex + ey * ey + ez * ez);  // bounding sphere radius^2
-  float4 dx = ctx->p.x - 0.5f * (lo_x + hi_x), dy = ctx->p.y - 0.5f * (lo_y + hi_y),
-         dz = ctx->p.z - 0.5f * (lo_z + hi_z);
-  float4 dist2 = dx * dx + dy * dy + dz * dz;
+  float4 intensity = vload4(0, node->intensity), r = vload4(0, node->radius);
+  float4 dx = ctx->p.x - vload4(0, node->centre[0]), dy = ctx->p.y - vload4(0, node->centre[1]),
+         dz = ctx->p.z - vload4(0, node->centre[2]);
+  float4 dist2 = dx * dx + dy * dy + dz * dz, r2 = r * r;
   int4 outside = isgreater(dist2, r2);
-  // theta_b, the angle the sphere subtends: its sine and cosine both from r^2 / d^2; the
-  // sine of each difference of angles below comes from the addition formula, not from a
-  // square root of its cosine
-  float4 sin2_b = select((float4)(1.0f), r2 / fmax(dist2, 1e-30f), outside);
-  float4 cos_b = sqrt(fmax(1.0f - sin2_b, 0.0f)), sin_b = sqrt(fmin(sin2_b, 1.0f));
-  float4 inv_d = rsqrt(fmax(dist2, 1e-30f));
+  // 1 / max(d, r): one reciprocal square root serves the direction to ctx.p (outside the
+  // sphere, the only place it is used) and the importance's 1 / max(d^2, r^2)
+  float4 inv_d = rsqrt(fmax(fmax(dist2, r2), 1e-30f));
+  // theta_b, the angle the sphere subtends: its sine r / d and its cosine; the sine of each
+  // difference of angles below comes from the addition formula, not from a square root of
+  // its cosine
+  float4 sin_b = select((float4)(1.0f), fmin(r * inv_d, 1.0f), outside);
+  float4 cos_b = sqrt(fmax(1.0f - sin_b * sin_b, 0.0f));
   float4 wx = dx * inv_d, wy = dy * inv_d, wz = dz * inv_d;  // from the child to ctx.p
   // Emitter side: theta' = max(0, theta_w - theta_o - theta_b)
-  float4 cos_o = vload4(0, node->cos_o), sin_o = sqrt(fmax(1.0f - cos_o * cos_o, 0.0f));
+  float4 cos_o = vload4(0, node->cos_o), sin_o = vload4(0, node->sin_o);
   float4 cos_w = vload4(0, node->axis[0]) * wx + vload4(0, node->axis[1]) * wy + vload4(0, node->axis[2]) * wz;
   cos_w = clamp(cos_w, -1.0f, 1.0f);
   float4 sin_w = sqrt(fmax(1.0f - cos_w * cos_w, 0.0f));
@@ -428,12 +426,15 @@ float4 lights_tree_importance(__global const LightTreeNode* node, const LightSam
     float4 cos_r = select(cos_i * cos_b + sin_i * sin_b, (float4)(1.0f), isgreaterequal(cos_i, cos_b));
     importance *= fmax(cos_r, LIGHT_TREE_MIN_COS);
   }
-  importance = select(intensity / fmax(r2, 1e-30f), importance / fmax(dist2, 1e-30f), outside);
+  // I cos cos / d^2 outside the sphere, I / r^2 inside
+  importance = select(intensity, importance, outside) * (inv_d * inv_d);
   return select((float4)(0.0f), importance, isgreater(intensity, (float4)(0.0f)));
 }
 
-// The probabilities of taking each of node's children at ctx; false when none can light ctx.p
-bool lights_tree_children(const SceneData* sc, uint node, const LightSampleContext* ctx, float4* p) {
+// The weights of taking each of node's children at ctx, unnormalized, each nonzero one
+// floored at min_prob times their sum (a child is taken with probability q / (q.x + q.y +
+// q.z + q.w)); false when none can light ctx.p
+bool lights_tree_children(const SceneData* sc, uint node, const LightSampleContext* ctx, float min_prob, float4* q) {
 #pragma OPENCL FP_CONTRACT OFF
   __global const LightTreeNode* n = &sc->light_tree[node];
   float4 w = n->cluster ? vload4(0, n->intensity) : lights_tree_importance(n, ctx);
@@ -446,8 +447,7 @@ bool lights_tree_children(const SceneData* sc, uint node, const LightSampleConte
     sum = w.x + w.y + w.z + w.w;
   }
   if (!(sum > 0.0f)) return false;
-  float4 q = select((float4)(0.0f), fmax(w / sum, sc->light_tree[0].min_prob), can_light);
-  *p = q * (1.0f / (q.x + q.y + q.z + q.w));
+  *q = select((float4)(0.0f), fmax(w, min_prob * sum), can_light);
   return true;
 }
 
@@ -455,26 +455,34 @@ bool lights_tree_children(const SceneData* sc, uint node, const LightSampleConte
 // compiled for it)
 bool lights_tree_used(const SceneData* sc) { return CD_FEATURE_LIGHT_TREE && sc->light_tree[0].share > 0.0f; }
 
+// Whether the tree is used and holds every light: lights_select then needs no draw from the
+// alias table (x_select is ignored)
+bool lights_tree_holds_all(const SceneData* sc) { return lights_tree_used(sc) && sc->light_tree[0].holds_all; }
+
 // A light of the tree chosen with u, and its probability within the tree; false when no
 // light of the tree can light ctx.p
 bool lights_tree_sample(const SceneData* sc, const LightSampleContext* ctx, float u, uint* light, float* pmf) {
 #pragma OPENCL FP_CONTRACT OFF
   uint node = 0u;
-  float prob = 1.0f;
+  float prob = 1.0f, min_prob = sc->light_tree[0].min_prob;
   for (uint level = 0u; level < LIGHT_TREE_MAX_DEPTH; ++level) {
-    float4 p;
-    if (!lights_tree_children(sc, node, ctx, &p)) return false;
-    // The slot whose interval of the running sum holds u; the last nonzero one when
-    // rounding leaves u past them all (slots of probability 0 have empty intervals)
-    float c1 = p.x, c2 = c1 + p.y, c3 = c2 + p.z;
-    uint slot = u < c1 ? 0u : (u < c2 ? 1u : (u < c3 ? 2u : 3u));
-    uint last = p.w > 0.0f ? 3u : (p.z > 0.0f ? 2u : (p.y > 0.0f ? 1u : 0u));
+    __global const LightTreeNode* n = &sc->light_tree[node];
+    // The next node is one of these: its loads overlap this node's arithmetic
+    for (uint k = 0u; k < LIGHT_TREE_WIDTH; ++k)
+      if (n->leaf[k] == LIGHT_TREE_INTERIOR)
+        prefetch((__global const float*)&sc->light_tree[n->child[k]], sizeof(LightTreeNode) / sizeof(float));
+    float4 q;
+    if (!lights_tree_children(sc, node, ctx, min_prob, &q)) return false;
+    // The slot whose interval of the running sum holds t = u x the sum; the last nonzero
+    // one when rounding leaves t past them all (slots of weight 0 have empty intervals)
+    float c1 = q.x, c2 = c1 + q.y, c3 = c2 + q.z, total = c3 + q.w, t = u * total;
+    uint slot = (t >= c1 ? 1u : 0u) + (t >= c2 ? 1u : 0u) + (t >= c3 ? 1u : 0u);
+    uint last = q.w > 0.0f ? 3u : (q.z > 0.0f ? 2u : (q.y > 0.0f ? 1u : 0u));
     slot = min(slot, last);
     float below = slot == 0u ? 0.0f : (slot == 1u ? c1 : (slot == 2u ? c2 : c3));
-    float taken = slot == 0u ? p.x : (slot == 1u ? p.y : (slot == 2u ? p.z : p.w));
-    u = fmin(fmax(u - below, 0.0f) / taken, 0x1.fffffep-1f);
-    prob *= taken;
-    __global const LightTreeNode* n = &sc->light_tree[node];
+    float taken = slot == 0u ? q.x : (slot == 1u ? q.y : (slot == 2u ? q.z : q.w));
+    u = fmin(fmax(t - below, 0.0f) / taken, 0x1.fffffep-1f);
+    prob *= taken / total;
     if (n->leaf[slot] == LIGHT_TREE_LEAF) {
       *light = n->child[slot];
       *pmf = prob;
@@ -490,12 +498,13 @@ float lights_tree_pmf(const SceneData* sc, const LightSampleContext* ctx, uint l
 #pragma OPENCL FP_CONTRACT OFF
   __global const LightTreeTrail* trail = &sc->light_trails[light];
   uint node = 0u;
-  float prob = 1.0f;
+  float prob = 1.0f, min_prob = sc->light_tree[0].min_prob;
   for (uint k = 0u; k < trail->depth; ++k) {
-    float4 p;
-    if (!lights_tree_children(sc, node, ctx, &p)) return 0.0f;
+    float4 q;
+    if (!lights_tree_children(sc, node, ctx, min_prob, &q)) return 0.0f;
     uint slot = (trail->bits[k >> 4] >> (2u * (k & 15u))) & 3u;
-    prob *= slot == 0u ? p.x : (slot == 1u ? p.y : (slot == 2u ? p.z : p.w));
+    float c1 = q.x, c2 = c1 + q.y, c3 = c2 + q.z, total = c3 + q.w;
+    prob *= (slot == 0u ? q.x : (slot == 1u ? q.y : (slot == 2u ? q.z : q.w))) / total;
     node = sc->light_tree[node].child[slot];
   }
   return prob;
@@ -523,12 +532,13 @@ bool lights_sample_light(const SceneData* sc, __global const Light* light, const
 // Picks a light: x_select draws from the alias table (probabilities proportional to
 // power); when it falls on a light of the light tree and the tree is used, u_select
 // descends the tree instead (lights_tree_sample), so the lights outside it (directional,
-// environment) keep their share by power. *pmf = lights_select_pmf(ctx, *light).
+// environment) keep their share by power. A tree that holds every light is descended
+// without the alias table's draw. *pmf = lights_select_pmf(ctx, *light).
 bool lights_select(const SceneData* sc, const LightSampleContext* ctx, uint x_select, float u_select, uint* light,
                    float* pmf) {
   uint n = sc->params->num_lights;
   if (n == 0u) return false;
-  *light = sample_discrete_alias(sc->light_alias, n, x_select);
+  *light = lights_tree_holds_all(sc) ? 0u : sample_discrete_alias(sc->light_alias, n, x_select);
   *pmf = sc->lights[*light].pmf;
   if (lights_tree_used(sc) && sc->light_trails[*light].depth != LIGHT_TREE_NONE) {
     float tree_pmf;

@@ -350,35 +350,37 @@ typedef struct {
   float params[8];    // per-type parameters, see above
 } Light;
 
-// A node of the light tree, 240 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
+// A node of the light tree, 224 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
 // Importance Sampling of Many Lights with Adaptive Tree Splitting). The tree holds the
 // finite lights (triangles, points, spots), one per leaf; a node has up to four children,
-// stored by field across its slots (lo[axis][slot], ...) so that the kernel weighs all four
-// in one pass of float4 arithmetic; the root is node 0. Each slot bounds its child's
-// lights: their positions (lo, hi), the directions they emit in (every light's emission
-// axis lies within theta_o of `axis`, and each emits only within theta_e beyond its axis)
-// and their summed peak radiant intensity (luminance; a triangle: L A); intensity 0 marks an
-// empty slot. A node inside a planar emitter made of several triangles (a quad light;
-// host/compile/light_tree.cpp) is a cluster: it takes its children by their share of its
-// intensity instead of by importance. A scene without finite lights, or one compiled for
-// power selection, has one node of share 0: every light goes through the alias table.
+// stored by field across its slots (centre[axis][slot], ...) so that the kernel weighs all
+// four in one pass of float4 arithmetic; the root is node 0. Each slot bounds its child's
+// lights: their positions (a sphere about `centre`, the one around their bounding box), the
+// directions they emit in (every light's emission axis lies within theta_o of `axis`, and
+// each emits only within theta_e beyond its axis) and their summed peak radiant intensity
+// (luminance; a triangle: L A); intensity 0 marks an empty slot. A node inside a planar
+// emitter made of several triangles (a quad light; host/compile/light_tree.cpp) is a
+// cluster: it takes its children by their share of its intensity instead of by importance.
+// A scene without finite lights, or one compiled for power selection, has one node of share
+// 0: every light goes through the alias table.
 #define LIGHT_TREE_INTERIOR 0u
 #define LIGHT_TREE_LEAF 1u
 #define LIGHT_TREE_WIDTH 4u
 typedef struct {
-  float lo[3][4];         // [axis][slot]
-  float hi[3][4];         // [axis][slot]
-  float axis[3][4];       // [axis][slot]
-  float intensity[4];     // 0: no child in the slot
-  float cos_o[4];         // cos theta_o
-  float cos_e[4];         // cos theta_e
-  unsigned int child[4];  // LIGHT_TREE_LEAF slot: its light; LIGHT_TREE_INTERIOR: the child node
-  unsigned int leaf[4];   // LIGHT_TREE_INTERIOR or LIGHT_TREE_LEAF
-  unsigned int cluster;   // 1: children by their share of the intensity, not by importance
-  unsigned int pad;
-  float share;     // root: probability that selection goes into the tree
-  float min_prob;  // root: least probability of a child that can light the point, before
-                   // renormalization (see lights.cl)
+  float centre[3][4];      // [axis][slot]
+  float radius[4];         // of the sphere about centre that holds the child's lights
+  float axis[3][4];        // [axis][slot]
+  float intensity[4];      // 0: no child in the slot
+  float cos_o[4];          // cos theta_o
+  float sin_o[4];          // sin theta_o
+  float cos_e[4];          // cos theta_e
+  unsigned int child[4];   // LIGHT_TREE_LEAF slot: its light; LIGHT_TREE_INTERIOR: the child node
+  unsigned int leaf[4];    // LIGHT_TREE_INTERIOR or LIGHT_TREE_LEAF
+  unsigned int cluster;    // 1: children by their share of the intensity, not by importance
+  unsigned int holds_all;  // root: 1 when every light is in the tree (share is then 1)
+  float share;             // root: probability that selection goes into the tree
+  float min_prob;          // root: least probability of a child that can light the point, before
+                           // renormalization (see lights.cl)
 } LightTreeNode;
 
 // The path from the root of the light tree to a light's leaf, 32 bytes: step k (k < depth)
@@ -458,6 +460,11 @@ typedef struct {
   unsigned int filter;               // FILTER_*: the density of film sample offsets (filter.cl)
 } RenderParams;
 
+// Cells of the guide table that follows each CDF of n cells in env_distribution (one per
+// four cells, at least one; cl/lights/environment.cl reads them, the host's
+// environment_distribution writes them)
+static inline int environment_guide_cells(int n) { return (n + 3) / 4 > 1 ? (n + 3) / 4 : 1; }
+
 // Every scene buffer, in kernel-argument order: X(element type, name). This one list
 // generates the kernel's parameters and SceneData (cl/scene/scene_data.cl) and the host's
 // SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
@@ -526,10 +533,11 @@ typedef struct {
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                                                 \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)                      \
     FIELD(Light, params, 32)                                                                                  \
-  SIZE(LightTreeNode, 240) FIELD(LightTreeNode, hi, 48) FIELD(LightTreeNode, axis, 96)                      \
-    FIELD(LightTreeNode, intensity, 144) FIELD(LightTreeNode, cos_o, 160) FIELD(LightTreeNode, cos_e, 176)    \
-    FIELD(LightTreeNode, child, 192) FIELD(LightTreeNode, leaf, 208) FIELD(LightTreeNode, cluster, 224)       \
-    FIELD(LightTreeNode, share, 232) FIELD(LightTreeNode, min_prob, 236)                                      \
+  SIZE(LightTreeNode, 224) FIELD(LightTreeNode, radius, 48) FIELD(LightTreeNode, axis, 64)                    \
+    FIELD(LightTreeNode, intensity, 112) FIELD(LightTreeNode, cos_o, 128) FIELD(LightTreeNode, sin_o, 144)    \
+    FIELD(LightTreeNode, cos_e, 160) FIELD(LightTreeNode, child, 176) FIELD(LightTreeNode, leaf, 192)         \
+    FIELD(LightTreeNode, cluster, 208) FIELD(LightTreeNode, holds_all, 212) FIELD(LightTreeNode, share, 216)  \
+    FIELD(LightTreeNode, min_prob, 220)                                                                       \
   SIZE(LightTreeTrail, 32) FIELD(LightTreeTrail, depth, 16)                                                   \
   SIZE(Medium, 128) FIELD(Medium, sigma_s, 16) FIELD(Medium, emission, 32) FIELD(Medium, g, 48)               \
     FIELD(Medium, emission_grid, 44) FIELD(Medium, majorant, 60) FIELD(Medium, grid_size, 68)                 \

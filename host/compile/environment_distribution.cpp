@@ -31,7 +31,7 @@ void append_cdf(const double* weights, int n, std::vector<float>* out) {
 // u in [k / cells, (k + 1) / cells). Any start in [0, n) gives the same answer (the kernel
 // corrects it both ways); this one leaves about n / cells steps to take.
 void append_guide(const float* cdf, int n, std::vector<float>* out) {
-  int cells = environment_guide_cells(n);
+  int cells = dev::environment_guide_cells(n);
   double total = cdf[n];
   for (int k = 0; k < cells; ++k) {
     float t = float(double(k) / cells * total);
@@ -47,14 +47,12 @@ double texel_luminance(const TextureDesc& map, size_t i) {
 
 }  // namespace
 
-int environment_guide_cells(int n) { return std::max(1, (n + 3) / 4); }
-
 std::vector<float> environment_distribution(const TextureDesc& map) {
   int w = map.width, h = map.height;
   std::vector<double> row_weight(static_cast<size_t>(h)), weights(static_cast<size_t>(w));
   std::vector<float> out;
-  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1) + size_t(environment_guide_cells(h)) +
-              size_t(h) * size_t(environment_guide_cells(w)));
+  out.reserve(size_t(h) + 1 + size_t(h) * (size_t(w) + 1) + size_t(dev::environment_guide_cells(h)) +
+              size_t(h) * size_t(dev::environment_guide_cells(w)));
   out.resize(size_t(h) + 1);  // the marginal CDF goes here once the rows are known
   for (int r = 0; r < h; ++r) {
     double sin_theta = std::sin(kPi * (r + 0.5) / h);

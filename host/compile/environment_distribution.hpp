@@ -13,9 +13,6 @@ namespace candela {
 // luminance keeps a float CDF step > 0, so its pdf is > 0.
 std::vector<float> environment_distribution(const TextureDesc& map);
 
-// Cells of the guide table of a CDF of n cells (cl/lights/environment.cl)
-int environment_guide_cells(int n);
-
 // What the strategy choice (cl/integrator/integrator_path.cl) needs of a map, L its texel
 // luminance: its effective solid angle (integral L)^2 / integral L^2 over the sphere (4 pi
 // for a constant, the solid angle of the lit part for a map lit uniformly over part of the

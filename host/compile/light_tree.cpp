@@ -213,14 +213,25 @@ struct Widener {
 
   void write(uint32_t index, uint32_t slot, const LightBounds& b) {
     dev::LightTreeNode& n = tree->nodes[index];
+    // The sphere about the box's centre (as rounded to float) through its farthest corner,
+    // its radius rounded up: it holds the box
+    glm::vec3 centre = b.centroid();
+    double r2 = 0.0;
     for (int k = 0; k < 3; ++k) {
-      n.lo[k][slot] = b.lo[k];
-      n.hi[k][slot] = b.hi[k];
+      double far = std::max(double(centre[k]) - double(b.lo[k]), double(b.hi[k]) - double(centre[k]));
+      r2 += far * far;
+    }
+    for (int k = 0; k < 3; ++k) {
+      n.centre[k][slot] = centre[k];
       n.axis[k][slot] = float(b.axis[k]);
     }
+    n.radius[slot] = r2 > 0.0 ? std::nextafter(float(std::sqrt(r2)), INFINITY) : 0.0f;
     float intensity = float(std::min(b.intensity, double(std::numeric_limits<float>::max())));
     n.intensity[slot] = std::max(intensity, std::numeric_limits<float>::min());
     n.cos_o[slot] = b.theta_o >= kPi ? -1.0f : cos_down(b.theta_o);
+    // The sine of the angle whose cosine is stored (that angle, not theta_o, is the cone)
+    double c = double(n.cos_o[slot]);
+    n.sin_o[slot] = float(std::sqrt(std::max(1.0 - c * c, 0.0)));
     n.cos_e[slot] = cos_down(b.theta_e);
   }
 };
@@ -372,7 +383,9 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
   // One light, or one planar emitter: the tree would pick as the alias table does, by power
   if (builder.nodes[0].kind != LIGHT_TREE_INTERIOR) return tree;
   Widener{builder.nodes, &tree}.widen(0, dev::LightTreeTrail{});
-  tree.nodes[0].share = float(std::min(share, 1.0));
+  // Every light in the tree: the alias table's draw has nothing left to decide
+  tree.nodes[0].holds_all = order.size() == buffers.lights.size() ? 1u : 0u;
+  tree.nodes[0].share = tree.nodes[0].holds_all ? 1.0f : float(std::min(share, 1.0));
   // Least share of a child before renormalization, min_prob: after it a child gets at least
   // q = min_prob / (1 + 4 min_prob); q^depth x share >= 2^-124 (a normal float), with a
   // margin for rounding. A tree too deep for any floor to keep that (q near 1/4: some 60

@@ -209,14 +209,15 @@ TEST_P(EnvironmentKernels, SamplePdfAndRadianceMatchHostReference) {
   use(env_of(map, strength, rotation));
   const std::vector<float>& cdf = compiled_.buffers.env_distribution;
   const size_t guides_at = size_t(kMapH + 1) + size_t(kMapH) * (kMapW + 1);
-  ASSERT_EQ(cdf.size(), guides_at + size_t(environment_guide_cells(kMapH)) +
-                            size_t(kMapH) * size_t(environment_guide_cells(kMapW)));
+  ASSERT_EQ(cdf.size(), guides_at + size_t(dev::environment_guide_cells(kMapH)) +
+                            size_t(kMapH) * size_t(dev::environment_guide_cells(kMapW)));
   // Row 3's guide: cell k starts at the largest column whose CDF value is <= k / cells of the total
   const float* row3 = cdf.data() + (kMapH + 1) + 3 * (kMapW + 1);
-  const float* guide3 = cdf.data() + guides_at + environment_guide_cells(kMapH) + 3 * environment_guide_cells(kMapW);
-  for (int k = 0; k < environment_guide_cells(kMapW); ++k) {
+  const float* guide3 =
+      cdf.data() + guides_at + dev::environment_guide_cells(kMapH) + 3 * dev::environment_guide_cells(kMapW);
+  for (int k = 0; k < dev::environment_guide_cells(kMapW); ++k) {
     int i = int(guide3[k]);
-    float t = float(double(k) / environment_guide_cells(kMapW) * row3[kMapW]);
+    float t = float(double(k) / dev::environment_guide_cells(kMapW) * row3[kMapW]);
     ASSERT_LE(row3[i], t) << "cell " << k;
     if (i + 1 < kMapW) {
       ASSERT_GT(row3[i + 1], t) << "cell " << k;

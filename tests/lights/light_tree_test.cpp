@@ -34,19 +34,38 @@ const double kAlpha = sidak_alpha(0.01, kChiSquareTests);
 
 CompiledScene compiled(const std::string& file) { return compile_scene(load_gltf(scene_path(file))); }
 
-// What a node's slot bounds: its child's box, emission cone and intensity
+// What a node's slot bounds: its child's sphere (and the box around that sphere), emission
+// cone and intensity
 struct Slot {
-  glm::dvec3 lo, hi, axis;
-  double cos_o, cos_e, intensity;
+  glm::dvec3 centre, axis;
+  double radius, cos_o, sin_o, cos_e, intensity;
+  glm::dvec3 lo() const { return centre - radius; }
+  glm::dvec3 hi() const { return centre + radius; }
 };
 
 Slot slot_of(const dev::LightTreeNode& n, uint32_t k) {
-  return {{n.lo[0][k], n.lo[1][k], n.lo[2][k]},
-          {n.hi[0][k], n.hi[1][k], n.hi[2][k]},
+  return {{n.centre[0][k], n.centre[1][k], n.centre[2][k]},
           {n.axis[0][k], n.axis[1][k], n.axis[2][k]},
+          n.radius[k],
           n.cos_o[k],
+          n.sin_o[k],
           n.cos_e[k],
           n.intensity[k]};
+}
+
+// The points a light's bounds must hold: a triangle's corners, a point or spot's position
+std::vector<glm::dvec3> light_points(const CompiledScene& c, const dev::Light& light) {
+  std::vector<glm::dvec3> points;
+  if (light.type == LIGHT_TRIANGLE) {
+    const dev::Prim& p = c.buffers.prims[light.index];
+    for (int k = 0; k < 3; ++k) {
+      size_t v = 3 * size_t(p.v[k]);
+      points.emplace_back(c.buffers.positions[v], c.buffers.positions[v + 1], c.buffers.positions[v + 2]);
+    }
+  } else {
+    points.emplace_back(light.params[0], light.params[1], light.params[2]);
+  }
+  return points;
 }
 
 // Whether cone (axis a, cos_o a) holds cone b: the angle between the axes plus b's theta_o
@@ -83,6 +102,11 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
       ASSERT_GT(nodes[node].intensity[slot], 0.0f) << "light " << l << "'s trail enters an empty slot";
       bool last = k + 1 == trails[l].depth;
       ASSERT_EQ(nodes[node].leaf[slot], last ? LIGHT_TREE_LEAF : LIGHT_TREE_INTERIOR) << "light " << l;
+      // Every slot on the trail holds the light in its sphere, and stores its cone's sine
+      Slot s = slot_of(nodes[node], slot);
+      for (const glm::dvec3& q : light_points(c, light))
+        EXPECT_LE(glm::length(q - s.centre), s.radius) << "light " << l << " outside its ancestor's sphere";
+      EXPECT_NEAR(s.sin_o, std::sqrt(std::max(1.0 - s.cos_o * s.cos_o, 0.0)), 1e-6);
       if (last) {
         EXPECT_EQ(nodes[node].child[slot], l) << "light " << l << "'s trail ends at another light's leaf";
       }
@@ -126,8 +150,7 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
       for (uint32_t j = 0; j < LIGHT_TREE_WIDTH; ++j) {
         if (!(m.intensity[j] > 0.0f)) continue;
         Slot ch = slot_of(m, j);
-        EXPECT_TRUE(glm::all(glm::lessThanEqual(s.lo, ch.lo)));
-        EXPECT_TRUE(glm::all(glm::greaterThanEqual(s.hi, ch.hi)));
+        EXPECT_LE(glm::length(ch.centre - s.centre), s.radius) << "node " << i << ": a child's centre outside";
         EXPECT_TRUE(cone_holds(s, ch)) << "node " << i;
         EXPECT_LE(s.cos_e, ch.cos_e);
         EXPECT_GE(s.intensity, 0.999 * ch.intensity);
@@ -249,8 +272,8 @@ void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* 
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
   for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k) {
     if (!(root.intensity[k] > 0.0f)) continue;
-    lo = glm::min(lo, slot_of(root, k).lo);
-    hi = glm::max(hi, slot_of(root, k).hi);
+    lo = glm::min(lo, slot_of(root, k).lo());
+    hi = glm::max(hi, slot_of(root, k).hi());
   }
   glm::dvec3 mid = 0.5 * (lo + hi), half = 0.75 * (hi - lo) + 0.5;
   if (deep) {
