@@ -442,8 +442,10 @@ bool lights_tree_children(const SceneData* sc, uint node, const LightSampleConte
   int4 infinite = isinf(w);
   if (any(infinite)) w = select((float4)(0.0f), (float4)(1.0f), infinite);  // the finite get the floor
   float sum = w.x + w.y + w.z + w.w;
-  if (isinf(sum)) {  // finite weights whose sum overflows
-    w *= 0.25f;
+  // Finite weights whose sum overflows, or whose sum with the floors below could (the
+  // floors add at most 4 min_prob < 1 times the sum): scaled into range
+  if (!(sum <= 0x1p126f)) {
+    w *= 0.125f;
     sum = w.x + w.y + w.z + w.w;
   }
   if (!(sum > 0.0f)) return false;
