@@ -442,10 +442,15 @@ bool lights_tree_children(const SceneData* sc, uint node, const LightSampleConte
   int4 infinite = isinf(w);
   if (any(infinite)) w = select((float4)(0.0f), (float4)(1.0f), infinite);  // the finite get the floor
   float sum = w.x + w.y + w.z + w.w;
-  // Finite weights whose sum overflows, or whose sum with the floors below could (the
-  // floors add at most 4 min_prob < 1 times the sum): scaled into range
-  if (!(sum <= 0x1p126f)) {
-    w *= 0.125f;
+  // Weights scaled so that their sum lies in [2^-100, 2^100]: the floors below add at most
+  // 4 min_prob times the sum (min_prob is at most about 6, the host's bound), so the total the caller
+  // divides by neither overflows (also when finite weights overflow their sum) nor loses
+  // bits to denormals; lanes flushed by the scaling keep their floor (can_light)
+  if (!(sum <= 0x1p100f)) {
+    w *= 0x1p-30f;
+    sum = w.x + w.y + w.z + w.w;
+  } else if (sum > 0.0f && sum < 0x1p-100f) {
+    w *= 0x1p100f;
     sum = w.x + w.y + w.z + w.w;
   }
   if (!(sum > 0.0f)) return false;
@@ -471,7 +476,7 @@ bool lights_tree_sample(const SceneData* sc, const LightSampleContext* ctx, floa
     __global const LightTreeNode* n = &sc->light_tree[node];
     // The next node is one of these: its loads overlap this node's arithmetic
     for (uint k = 0u; k < LIGHT_TREE_WIDTH; ++k)
-      if (n->leaf[k] == LIGHT_TREE_INTERIOR)
+      if (n->leaf[k] == LIGHT_TREE_INTERIOR && n->intensity[k] > 0.0f)
         prefetch((__global const float*)&sc->light_tree[n->child[k]], sizeof(LightTreeNode) / sizeof(float));
     float4 q;
     if (!lights_tree_children(sc, node, ctx, min_prob, &q)) return false;

@@ -379,8 +379,8 @@ typedef struct {
   unsigned int cluster;    // 1: children by their share of the intensity, not by importance
   unsigned int holds_all;  // root: 1 when every light is in the tree (share is then 1)
   float share;             // root: probability that selection goes into the tree
-  float min_prob;          // root: least probability of a child that can light the point, before
-                           // renormalization (see lights.cl)
+  float min_prob;          // root: least weight of a child that can light the point, as a
+                           // fraction of the sum of the importances (see lights.cl)
 } LightTreeNode;
 
 // The path from the root of the light tree to a light's leaf, 32 bytes: step k (k < depth)

@@ -386,7 +386,8 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
   // Every light in the tree: the alias table's draw has nothing left to decide
   tree.nodes[0].holds_all = order.size() == buffers.lights.size() ? 1u : 0u;
   tree.nodes[0].share = tree.nodes[0].holds_all ? 1.0f : float(std::min(share, 1.0));
-  // Least share of a child before renormalization, min_prob: after it a child gets at least
+  // Least weight of a child, as a fraction of the sum of the importances, min_prob (at most
+  // about 6, where q nears 0.24): after it a child gets at least
   // q = min_prob / (1 + 4 min_prob); q^depth x share >= 2^-124 (a normal float), with a
   // margin for rounding. A tree too deep for any floor to keep that (q near 1/4: some 60
   // levels) is not used: selection by power instead.

@@ -18,9 +18,9 @@ struct LightTree {
 
 // The tree over the triangle, point and spot lights of `buffers.lights`; `power` is each
 // light's light_power, `pmf` the probability the alias table picks it (the root's share is
-// the sum over the tree's lights). Nodes are split where Conty & Kulla's surface area orientation heuristic is
-// lowest over 12 buckets of the centroids on each axis. No tree (empty nodes) without
-// finite lights.
+// the sum over the tree's lights, exactly 1 when the tree holds every light: holds_all). Nodes are split where Conty &
+// Kulla's surface area orientation heuristic is lowest over 12 buckets of the centroids on each axis. No tree (empty
+// nodes) without finite lights.
 LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<double>& power,
                            const std::vector<double>& pmf);
 

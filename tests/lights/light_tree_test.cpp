@@ -85,6 +85,8 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
   ASSERT_EQ(trails.size(), c.buffers.lights.size());
   size_t in_tree = 0;
   double share = 0.0;
+  // Per slot (node x width + slot): the farthest point of a light below it from its centre
+  std::vector<double> farthest(nodes.size() * LIGHT_TREE_WIDTH, 0.0);
   for (size_t l = 0; l < trails.size(); ++l) {
     const dev::Light& light = c.buffers.lights[l];
     bool finite = light.type == LIGHT_TRIANGLE || light.type == LIGHT_POINT || light.type == LIGHT_SPOT;
@@ -104,8 +106,11 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
       ASSERT_EQ(nodes[node].leaf[slot], last ? LIGHT_TREE_LEAF : LIGHT_TREE_INTERIOR) << "light " << l;
       // Every slot on the trail holds the light in its sphere, and stores its cone's sine
       Slot s = slot_of(nodes[node], slot);
-      for (const glm::dvec3& q : light_points(c, light))
+      for (const glm::dvec3& q : light_points(c, light)) {
         EXPECT_LE(glm::length(q - s.centre), s.radius) << "light " << l << " outside its ancestor's sphere";
+        double& f = farthest[node * LIGHT_TREE_WIDTH + slot];
+        f = std::max(f, glm::length(q - s.centre));
+      }
       EXPECT_NEAR(s.sin_o, std::sqrt(std::max(1.0 - s.cos_o * s.cos_o, 0.0)), 1e-6);
       if (last) {
         EXPECT_EQ(nodes[node].child[slot], l) << "light " << l << "'s trail ends at another light's leaf";
@@ -126,6 +131,16 @@ void check_tree(const CompiledScene& c, size_t* clusters) {
   double q = double(nodes[0].min_prob) / (1.0 + 4.0 * double(nodes[0].min_prob));
   EXPECT_GE(depth * std::log2(q) + std::log2(double(nodes[0].share)), -124.01);
   EXPECT_NEAR(nodes[0].share, share, 1e-5);
+  EXPECT_EQ(nodes[0].holds_all, in_tree == c.buffers.lights.size() ? 1u : 0u);
+  // No sphere larger than the one around its lights' box can be: each coordinate of the box's
+  // farthest corner is some light point's, so that corner is within sqrt(3) x the farthest
+  // point's distance
+  for (size_t i = 0; i < nodes.size(); ++i)
+    for (uint32_t k = 0; k < LIGHT_TREE_WIDTH; ++k)
+      if (nodes[i].intensity[k] > 0.0f) {
+        EXPECT_LE(nodes[i].radius[k], std::sqrt(3.0) * farthest[i * LIGHT_TREE_WIDTH + k] * (1.0 + 1e-6) + 1e-30)
+            << "node " << i << " slot " << k;
+      }
   // A tree of one light or one planar emitter would pick as the alias table does: none is built
   EXPECT_EQ(nodes[0].cluster, 0u);
   *clusters = 0;
@@ -263,7 +278,7 @@ class LightTreeTest : public DeviceTest {
 };
 
 // Random shading points over the lights' bounds grown by half (so some lie inside node
-// boxes, some outside), with random normals; every fourth in a medium (n = 0). In the deep
+// spheres, some outside), with random normals; every fourth in a medium (n = 0). In the deep
 // tree's scene (`deep`), points in front of every triangle (x beyond the largest's plane),
 // so that every light can light them, down to the deepest trail.
 void random_contexts(const CompiledScene& c, int count, std::vector<cl_float4>* ps, std::vector<cl_float4>* ns,

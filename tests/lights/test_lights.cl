@@ -107,7 +107,8 @@ __kernel void test_lights_select_pmf(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global c
   out[i] = lights_select_pmf(&sc, &ctx, l);
 }
 
-// One light selection (lights_select, with the integrator's random numbers) per work-item
+// One light selection (lights_select; x_select is drawn even where the integrator, for a
+// tree that holds every light, does not draw it) per work-item
 // from (p, n): out[i] = (light, pmf, lights_select_pmf(light), selected ? 1 : 0)
 __kernel void test_lights_select(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 p,
                                  float4 n, uint seed, __global float4* out) {
