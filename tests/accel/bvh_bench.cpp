@@ -2,7 +2,8 @@
 // builds its BVH again with each thread count, alternating, and prints one JSON line per
 // build: seconds, triangles per second, SAH cost, depth, and whether the tree is
 // byte-identical to the first count's; cpu_seconds: user + system time of the build
-// (the builder promises the same tree for any count).
+// (the builder promises the same tree for any count); digest: FNV-1a of the nodes and
+// leaf triangles, to compare the trees of two builder versions.
 //
 // Usage: candela_bvh_bench SCENE.gltf [ROUNDS (3)] [THREADS,... (1,all)]
 #include <sys/resource.h>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "base/hash.hpp"
 #include "compile/bvh_builder.hpp"
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
@@ -64,13 +66,17 @@ int main(int argc, char** argv) {
                  std::memcmp(bvh.nodes.data(), first.nodes.data(), bvh.nodes.size() * sizeof(bvh.nodes[0])) == 0 &&
                  std::memcmp(bvh.tris.data(), first.tris.data(), bvh.tris.size() * sizeof(bvh.tris[0])) == 0;
         }
+        uint64_t digest = fnv1a64(
+            std::string_view(reinterpret_cast<const char*>(bvh.tris.data()), bvh.tris.size() * sizeof(bvh.tris[0])),
+            fnv1a64(std::string_view(reinterpret_cast<const char*>(bvh.nodes.data()),
+                                     bvh.nodes.size() * sizeof(bvh.nodes[0]))));
         std::printf(
             "{\"scene\": \"%s\", \"triangles\": %zu, \"threads\": %d, \"round\": %d, \"seconds\": %.4f, "
             "\"cpu_seconds\": %.4f, "
             "\"triangles_per_second\": %.0f, \"sah_cost\": %.4f, \"depth\": %d, \"nodes\": %zu, "
-            "\"same_tree\": %s}\n",
+            "\"same_tree\": %s, \"digest\": \"%016llx\"}\n",
             argv[1], prims.size(), threads, round, s, cpu, double(prims.size()) / s, sah_cost(bvh), bvh.depth,
-            bvh.nodes.size(), same ? "true" : "false");
+            bvh.nodes.size(), same ? "true" : "false", (unsigned long long)digest);
         std::fflush(stdout);
       }
   } catch (const std::exception& e) {
