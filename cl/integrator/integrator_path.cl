@@ -151,7 +151,7 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
   float m_bsdf = 0.0f, j[BSDF_MAX_LOBES];
   for (uint k = 0u; k < lobes->count; ++k) {
     float w = lobes->weight[k], omega = lobes->omega[k];
-    float d = e.radius >= PI_F ? 0.0f : fmax(acos(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
+    float d = e.radius >= PI_F ? 0.0f : fmax(acos_fast(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
     float q = path_lobe_pdf(omega, d);
     float mass = fmin(e.omega * q, 1.0f);
     float whole = path_lobe_pdf_squared(omega);
@@ -170,7 +170,7 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
     m_nee += wa * wa * j[a];
     for (uint b = a + 1u; b < lobes->count; ++b) {
       float wide = fmax(lobes->omega[a], lobes->omega[b]);
-      float x = path_lobe_pdf(wide, acos(clamp(dot(lobes->dir[a], lobes->dir[b]), -1.0f, 1.0f)));
+      float x = path_lobe_pdf(wide, acos_fast(clamp(dot(lobes->dir[a], lobes->dir[b]), -1.0f, 1.0f)));
       float sab = sqrt(path_lobe_pdf_squared(lobes->omega[a]) * path_lobe_pdf_squared(lobes->omega[b]));
       m_nee += 2.0f * wa * lobes->weight[b] * fmin(x / sab, 1.0f) * sqrt(j[a] * j[b]);
     }

@@ -109,7 +109,7 @@ void lights_environment_extent(const SceneData* sc, __global const Light* light,
   e->omega = light->params[3];
   e->everywhere = true;
   e->dir = (float3)(light->params[4], light->params[5], light->params[6]);
-  e->radius = dot(e->dir, e->dir) > 0.0f ? acos(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
+  e->radius = dot(e->dir, e->dir) > 0.0f ? acos_fast(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
   bool map = environment_map(light) != NO_TEXTURE;
   e->integral = light->params[7] * (map ? light->params[1] : luminance(load3(light->radiance)));
 }
@@ -279,10 +279,10 @@ void lights_triangle_extent(const SceneData* sc, __global const Light* light, fl
     return;
   }
   float den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
-  e->omega = clamp(2.0f * atan2(fabs(dot(a, cross(b, c))), den), 1e-12f, 2.0f * PI_F);
+  e->omega = clamp(2.0f * atan2_fast(fabs(dot(a, cross(b, c))), den), 1e-12f, 2.0f * PI_F);
   e->dir = d / ld;
   float cos_min = fmin(fmin(dot(e->dir, a) / la, dot(e->dir, b) / lb), dot(e->dir, c) / lc);
-  e->radius = acos(clamp(cos_min, -1.0f, 1.0f));
+  e->radius = acos_fast(clamp(cos_min, -1.0f, 1.0f));
 }
 
 // Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <glm/glm.hpp>
 
 #include "compile/scene_compiler.hpp"
@@ -196,6 +197,13 @@ TEST_F(SamplingTest, ChiSquareRejectsAWrongPdf) {
   EXPECT_LT(r.p_value, 1e-6);
 }
 
+// A property's value with three significant digits (std::to_string gives six decimals)
+std::string format_double(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
 // atan2_fast against double-precision atan2 (within two float ulps of pi, 2.4e-7 each):
 // every direction of a fine circle at magnitudes from 1e-30 to 1e30, the axes and the
 // signed zeros
@@ -218,7 +226,32 @@ TEST_F(SamplingTest, Atan2FastIsWithinTwoUlpsOfPi) {
     worst = std::max(worst, std::fabs(double(got[i]) - want));
   }
   EXPECT_LT(worst, 4e-7);  // float pi's ulp is 2.4e-7
-  RecordProperty("max_error_radians", std::to_string(worst));
+  RecordProperty("max_error_radians", format_double(worst));
+}
+
+// acos_fast against double-precision acos over [-1, 1]: an even sweep, the float grid next
+// to -1, 0 and 1 (where the sine is a difference of nearly equal numbers), and the ends
+TEST_F(SamplingTest, AcosFastIsWithinTwoUlpsOfPi) {
+  std::vector<float> in;
+  for (int k = 0; k <= 200000; ++k) in.push_back(float(-1.0 + 2.0 * k / 200000.0));
+  for (float x : {-1.0f, 0.0f, 1.0f}) {
+    float lo = x, hi = x;
+    for (int k = 0; k < 2000; ++k) {
+      lo = std::nextafter(lo, -2.0f);
+      hi = std::nextafter(hi, 2.0f);
+      if (lo >= -1.0f) in.push_back(lo);
+      if (hi <= 1.0f) in.push_back(hi);
+    }
+  }
+  for (float x : {-1.0f, -0.5f, -0.0f, 0.0f, 0.5f, 1.0f}) in.push_back(x);
+  auto out = rig().output<float>(in.size());
+  rig().run("test_acos_fast", in.size(), rig().input(in), out);
+  std::vector<float> got = out.read();
+  double worst = 0.0;
+  for (size_t i = 0; i < in.size(); ++i) worst = std::max(worst, std::fabs(double(got[i]) - std::acos(double(in[i]))));
+  EXPECT_LT(worst, 5e-7);               // float pi's ulp is 2.4e-7
+  EXPECT_EQ(got[in.size() - 1], 0.0f);  // acos(1)
+  RecordProperty("max_error_radians", format_double(worst));
 }
 
 TEST(Stats, GammaQKnownValues) {

@@ -40,3 +40,9 @@ __kernel void test_atan2_fast(__global const float2* in, __global float* out) {
   uint i = get_global_id(0);
   out[i] = atan2_fast(in[i].x, in[i].y);
 }
+
+// acos_fast (cl/core/geometry.cl) of each x
+__kernel void test_acos_fast(__global const float* in, __global float* out) {
+  uint i = get_global_id(0);
+  out[i] = acos_fast(in[i]);
+}
