@@ -179,6 +179,14 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
   return AUTO_SHADOW_COST * scale * m_nee <= m_bsdf;
 }
 
+// The random numbers of one light selection (lights_select): x_select for the alias table,
+// u_select for the light tree. No dimension is spent on what selection does not use: the
+// alias table's draw when the tree holds every light, the tree's without a tree
+void path_light_select_numbers(const SceneData* sc, Rng* rng, uint* x_select, float* u_select) {
+  *x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
+  *u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
+}
+
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
 // `lobes` (STRATEGY_AUTO), only of a light the vertex takes by light sampling (the others
 // count when a sampled ray finds them: a sample of one contributes nothing here).
@@ -186,10 +194,9 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
 // `interior`, the medium inside the surface.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
                          const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
-  // No dimension spent on what selection does not use: the alias table's draw when the tree
-  // holds every light, the tree's without a tree
-  uint x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
-  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
+  uint x_select;
+  float u_select;
+  path_light_select_numbers(sc, rng, &x_select, &u_select);
   float2 u = rng_next_2d(rng);
   uint light;
   float pmf;
@@ -231,10 +238,9 @@ float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 w
   ctx.p = p;
   ctx.n = ctx.ns = (float3)(0.0f);  // a point in a medium: light from the whole sphere
   ctx.transmits = true;
-  // No dimension spent on what selection does not use: the alias table's draw when the tree
-  // holds every light, the tree's without a tree
-  uint x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
-  float u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
+  uint x_select;
+  float u_select;
+  path_light_select_numbers(sc, rng, &x_select, &u_select);
   float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, &ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);
