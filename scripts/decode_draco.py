@@ -6,14 +6,15 @@ loads). Benchmark scripts use it; candela itself reads Draco.
   python3 scripts/decode_draco.py IN.gltf OUT.gltf
 
 Each compressed primitive's bufferView goes through Debian's `draco_decoder` (package draco) to a binary PLY;
-its positions, normals and texture coordinates and its triangles become new accessors in OUT.bin, beside
-OUT.gltf. The input's own buffers and images stay where they are (referred to by relative paths). A compressed
-primitive with another attribute (a second texture coordinate set, joints, weights, tangents, colours) is an
-error: the PLY carries only those three.
+its positions and normals and its triangles become new accessors in OUT.bin, beside OUT.gltf. The input's own
+buffers and images stay where they are (referred to by relative paths). Only triangle primitives with POSITION
+and NORMAL are decoded; any other attribute (texture coordinates, which draco_decoder writes per face corner,
+tangents, colours, joints, weights) or primitive mode is an error.
 """
 
 import json
 import os
+import urllib.parse
 import shutil
 import struct
 import subprocess
@@ -24,8 +25,7 @@ PLY_TYPES = {"char": "b", "uchar": "B", "short": "h", "ushort": "H", "int": "i",
              "double": "d", "int8": "b", "uint8": "B", "int16": "h", "uint16": "H", "int32": "i", "uint32": "I",
              "float32": "f", "float64": "d"}
 # PLY vertex properties -> glTF attribute and its width
-PLY_ATTRIBUTES = {("x", "y", "z"): ("POSITION", 3), ("nx", "ny", "nz"): ("NORMAL", 3), ("s", "t"): ("TEXCOORD_0", 2),
-                  ("u", "v"): ("TEXCOORD_0", 2)}
+PLY_ATTRIBUTES = {("x", "y", "z"): ("POSITION", 3), ("nx", "ny", "nz"): ("NORMAL", 3)}
 
 
 def fail(msg):
@@ -61,9 +61,10 @@ def read_ply(path):
                 vertices.append(struct.unpack_from(fmt, data, pos))
                 pos += size
         elif el["name"] == "face":
-            (kind, count_type, index_type, _), = el["props"]
-            if kind != "list":
-                fail("%s: faces are not a list" % path)
+            if len(el["props"]) != 1 or el["props"][0][0] != "list" or el["props"][0][-1] != "vertex_indices":
+                fail("%s: faces carry more than their vertex indices (per-corner texture coordinates?), which this "
+                     "script does not decode" % path)
+            (_, count_type, index_type, _), = el["props"]
             cf, xf = "<" + PLY_TYPES[count_type], PLY_TYPES[index_type]
             for i in range(el["count"]):
                 (n,) = struct.unpack_from(cf, data, pos)
@@ -96,7 +97,10 @@ def main():
     def view_bytes(index):
         if index not in blobs:
             bv = g["bufferViews"][index]
-            path = os.path.join(dst_dir, g["buffers"][bv["buffer"]]["uri"])
+            uri = g["buffers"][bv["buffer"]].get("uri", "")
+            if not uri or uri.startswith("data:"):
+                fail("%s: a Draco buffer embedded in the file (data: URI) is not supported" % src)
+            path = os.path.join(dst_dir, urllib.parse.unquote(uri))
             with open(path, "rb") as f:
                 f.seek(bv.get("byteOffset", 0))
                 blobs[index] = f.read(bv["byteLength"])
@@ -131,6 +135,8 @@ def main():
                     continue
                 if not prim["extensions"]:
                     del prim["extensions"]
+                if prim.get("mode", 4) != 4:
+                    fail("%s: a Draco primitive of mode %d (only triangles, mode 4, are decoded)" % (src, prim["mode"]))
                 drc, ply = os.path.join(tmp, "p.drc"), os.path.join(tmp, "p.ply")
                 with open(drc, "wb") as f:
                     f.write(view_bytes(ext["bufferView"]))
