@@ -36,11 +36,15 @@ float atan2_fast(float y, float x) {
   return copysign(r, y);
 }
 
-// acos(x) for x in [-1, 1] by atan2_fast: within 5e-7 radians of the exact angle (the sine
-// as sqrt((1 - x)(1 + x)) keeps its relative precision near x = +-1). For the estimates of
-// the auto strategy, where the library's acos and atan2 were an eighth of the Cornell box's
-// render time (docs/performance.md)
-float acos_fast(float x) { return atan2_fast(sqrt((1.0f - x) * (1.0f + x)), x); }
+// acos(x) by atan2_fast, x clamped to [-1, 1] (a dot product of unit vectors can round
+// past them): within 5e-7 radians of the exact angle (the sine as sqrt((1 - x)(1 + x))
+// keeps its relative precision near x = +-1). For the estimates of the auto strategy,
+// where the library's acos and atan2 were an eighth of the Cornell box's render time
+// (docs/performance.md)
+float acos_fast(float x) {
+  float c = clamp(x, -1.0f, 1.0f);
+  return atan2_fast(sqrt((1.0f - c) * (1.0f + c)), c);
+}
 
 // Orthonormal frame (t, b, n); local coordinates have z along n
 typedef struct {

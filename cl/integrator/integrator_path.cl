@@ -151,7 +151,7 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
   float m_bsdf = 0.0f, j[BSDF_MAX_LOBES];
   for (uint k = 0u; k < lobes->count; ++k) {
     float w = lobes->weight[k], omega = lobes->omega[k];
-    float d = e.radius >= PI_F ? 0.0f : fmax(acos_fast(clamp(dot(e.dir, lobes->dir[k]), -1.0f, 1.0f)) - e.radius, 0.0f);
+    float d = e.radius >= PI_F ? 0.0f : fmax(acos_fast(dot(e.dir, lobes->dir[k])) - e.radius, 0.0f);
     float q = path_lobe_pdf(omega, d);
     float mass = fmin(e.omega * q, 1.0f);
     float whole = path_lobe_pdf_squared(omega);
@@ -170,21 +170,13 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
     m_nee += wa * wa * j[a];
     for (uint b = a + 1u; b < lobes->count; ++b) {
       float wide = fmax(lobes->omega[a], lobes->omega[b]);
-      float x = path_lobe_pdf(wide, acos_fast(clamp(dot(lobes->dir[a], lobes->dir[b]), -1.0f, 1.0f)));
+      float x = path_lobe_pdf(wide, acos_fast(dot(lobes->dir[a], lobes->dir[b])));
       float sab = sqrt(path_lobe_pdf_squared(lobes->omega[a]) * path_lobe_pdf_squared(lobes->omega[b]));
       m_nee += 2.0f * wa * lobes->weight[b] * fmin(x / sab, 1.0f) * sqrt(j[a] * j[b]);
     }
   }
   float scale = e.everywhere ? e.integral / e.pmf : e.omega / e.pmf;
   return AUTO_SHADOW_COST * scale * m_nee <= m_bsdf;
-}
-
-// The random numbers of one light selection (lights_select): x_select for the alias table,
-// u_select for the light tree. No dimension is spent on what selection does not use: the
-// alias table's draw when the tree holds every light, the tree's without a tree
-void path_light_select_numbers(const SceneData* sc, Rng* rng, uint* x_select, float* u_select) {
-  *x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
-  *u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
 }
 
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
@@ -196,7 +188,7 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
                          const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
   uint x_select;
   float u_select;
-  path_light_select_numbers(sc, rng, &x_select, &u_select);
+  lights_select_numbers(sc, rng, &x_select, &u_select);
   float2 u = rng_next_2d(rng);
   uint light;
   float pmf;
@@ -240,7 +232,7 @@ float3 path_medium_direct_light(const SceneData* sc, float3 p, float g, float3 w
   ctx.transmits = true;
   uint x_select;
   float u_select;
-  path_light_select_numbers(sc, rng, &x_select, &u_select);
+  lights_select_numbers(sc, rng, &x_select, &u_select);
   float2 u = rng_next_2d(rng);
   LightSample ls;
   if (!lights_sample(sc, &ctx, x_select, u_select, u, &ls)) return (float3)(0.0f);

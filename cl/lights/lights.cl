@@ -109,7 +109,7 @@ void lights_environment_extent(const SceneData* sc, __global const Light* light,
   e->omega = light->params[3];
   e->everywhere = true;
   e->dir = (float3)(light->params[4], light->params[5], light->params[6]);
-  e->radius = dot(e->dir, e->dir) > 0.0f ? acos_fast(clamp(1.0f - e->omega * (0.5f * INV_PI_F), -1.0f, 1.0f)) : PI_F;
+  e->radius = dot(e->dir, e->dir) > 0.0f ? acos_fast(1.0f - e->omega * (0.5f * INV_PI_F)) : PI_F;
   bool map = environment_map(light) != NO_TEXTURE;
   e->integral = light->params[7] * (map ? light->params[1] : luminance(load3(light->radiance)));
 }
@@ -282,7 +282,7 @@ void lights_triangle_extent(const SceneData* sc, __global const Light* light, fl
   e->omega = clamp(2.0f * atan2_fast(fabs(dot(a, cross(b, c))), den), 1e-12f, 2.0f * PI_F);
   e->dir = d / ld;
   float cos_min = fmin(fmin(dot(e->dir, a) / la, dot(e->dir, b) / lb), dot(e->dir, c) / lc);
-  e->radius = acos_fast(clamp(cos_min, -1.0f, 1.0f));
+  e->radius = acos_fast(cos_min);
 }
 
 // Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries
@@ -553,6 +553,14 @@ bool lights_select(const SceneData* sc, const LightSampleContext* ctx, uint x_se
     *pmf = sc->light_tree[0].share * tree_pmf;
   }
   return *pmf > 0.0f;
+}
+
+// The random numbers of one light selection (lights_select): x_select for the alias table,
+// u_select for the light tree. No dimension is spent on what selection does not use: the
+// alias table's draw when the tree holds every light, the tree's without a tree
+void lights_select_numbers(const SceneData* sc, Rng* rng, uint* x_select, float* u_select) {
+  *x_select = lights_tree_holds_all(sc) ? 0u : rng_next_uint(rng);
+  *u_select = lights_tree_used(sc) ? rng_next(rng) : 0.0f;
 }
 
 // Samples a direction toward light `index`, which lights_select picked with probability pmf

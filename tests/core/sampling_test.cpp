@@ -230,7 +230,8 @@ TEST_F(SamplingTest, Atan2FastIsWithinTwoUlpsOfPi) {
 }
 
 // acos_fast against double-precision acos over [-1, 1]: an even sweep, the float grid next
-// to -1, 0 and 1 (where the sine is a difference of nearly equal numbers), and the ends
+// to -1, 0 and 1 (where the sine is a difference of nearly equal numbers), and the ends;
+// beyond them (a dot product of unit vectors a rounding past 1) the ends' angles
 TEST_F(SamplingTest, AcosFastIsWithinTwoUlpsOfPi) {
   std::vector<float> in;
   for (int k = 0; k <= 200000; ++k) in.push_back(float(-1.0 + 2.0 * k / 200000.0));
@@ -252,6 +253,15 @@ TEST_F(SamplingTest, AcosFastIsWithinTwoUlpsOfPi) {
   EXPECT_LT(worst, 4.8e-7);             // two ulps of float pi (2.4e-7 each)
   EXPECT_EQ(got[in.size() - 1], 0.0f);  // acos(1)
   RecordProperty("max_error_radians", format_double(worst));
+
+  std::vector<float> beyond = {std::nextafter(1.0f, 2.0f), 1.5f, std::nextafter(-1.0f, -2.0f), -1.5f};
+  auto beyond_out = rig().output<float>(beyond.size());
+  rig().run("test_acos_fast", beyond.size(), rig().input(beyond), beyond_out);
+  std::vector<float> ends = beyond_out.read();
+  EXPECT_EQ(ends[0], 0.0f);
+  EXPECT_EQ(ends[1], 0.0f);
+  EXPECT_NEAR(ends[2], M_PI, 4.8e-7);
+  EXPECT_NEAR(ends[3], M_PI, 4.8e-7);
 }
 
 TEST(Stats, GammaQKnownValues) {

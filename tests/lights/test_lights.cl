@@ -107,17 +107,18 @@ __kernel void test_lights_select_pmf(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global c
   out[i] = lights_select_pmf(&sc, &ctx, l);
 }
 
-// One light selection (lights_select; x_select is drawn even where the integrator, for a
-// tree that holds every light, does not draw it) per work-item
-// from (p, n): out[i] = (light, pmf, lights_select_pmf(light), selected ? 1 : 0)
+// One light selection (lights_select, its numbers drawn as the integrator draws them:
+// lights_select_numbers) per work-item from (p, n):
+// out[i] = (light, pmf, lights_select_pmf(light), selected ? 1 : 0)
 __kernel void test_lights_select(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, float4 p,
                                  float4 n, uint seed, __global float4* out) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   LightSampleContext ctx = test_lights_context(p, n, 0u);
   Rng rng = rng_init(i, 0u, seed);
-  uint x_select = rng_next_uint(&rng);
-  float u_select = rng_next(&rng);
+  uint x_select;
+  float u_select;
+  lights_select_numbers(&sc, &rng, &x_select, &u_select);
   uint light = 0u;
   float pmf = 0.0f;
   bool ok = lights_select(&sc, &ctx, x_select, u_select, &light, &pmf);
