@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -124,135 +123,23 @@ struct Binner {
   }
 };
 
-// A triangle's box in ref form (lane 3 zero)
-struct Box {
-  v4f lo, hi;
-  bool empty() const { return lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]; }
-  float area() const { return surface_area(lo, hi); }
-};
-
-// Pre-splitting (Karras & Aila 2013, Fast Parallel Construction of High-Quality Bounding
-// Volume Hierarchies): a triangle whose box is much larger than the triangle (a long
-// diagonal sliver, a large tilted face) enters the build as several refs, each with the box
-// of the part of the triangle on one side of a plane, so that the binned SAH can separate it
-// from its neighbours; the leaves hold one copy of the triangle per ref. A triangle's excess
-// is its box's area beyond twice its "ideal" area, the limit of its pieces' boxes
-// (|cross.x| + |cross.y| + |cross.z|: the sum of its projections, both faces), and the
-// scene's extra refs are shared out in proportion to the excess. The planes lie on a
-// power-of-two grid over the scene's box, the coarsest that cuts the piece along its longest
-// axis, where the tree's own splits tend to fall.
-class PreSplitter {
- public:
-  PreSplitter(v4f scene_lo, v4f scene_hi) : lo_(scene_lo), size_(scene_hi - scene_lo) {}
-
-  static float excess(v4f a, v4f b, v4f c) {
-    v4f e1 = b - a, e2 = c - a;
-    float cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
-    float ideal = std::fabs(cx) + std::fabs(cy) + std::fabs(cz);
-    return std::max(0.0f, surface_area(vmin(vmin(a, b), c), vmax(vmax(a, b), c)) - 2.0f * ideal);
-  }
-
-  // The boxes of up to `pieces` pieces of triangle (a, b, c), each given to emit(Box);
-  // returns how many (fewer where a piece is too small to cut)
-  template <class Emit>
-  int split(v4f a, v4f b, v4f c, int pieces, Emit emit) const {
-    Box box{vmin(vmin(a, b), c), vmax(vmax(a, b), c)};
-    // Room for the rounding of an edge's crossing point, in the axes it is not clamped in
-    v4f m = vmax(vmax(vabs(a), vabs(b)), vabs(c));
-    float pad = 8.0f * FLT_EPSILON * std::max(m[0], std::max(m[1], m[2]));
-    const v4f v[3] = {a, b, c};
-    return piece(v, pad, box, pieces, 0, emit);
-  }
-
- private:
-  static v4f vabs(v4f x) { return x < 0.0f ? -x : x; }
-
-  template <class Emit>
-  int piece(const v4f* v, float pad, Box box, int pieces, int depth, Emit& emit) const {
-    for (; pieces > 1 && depth < 48; ++depth) {
-      v4f d = box.hi - box.lo;
-      int axis = d[0] >= d[1] && d[0] >= d[2] ? 0 : (d[1] >= d[2] ? 1 : 2);
-      float s;
-      if (!plane(axis, box.lo[axis], box.hi[axis], &s)) break;
-      Box side[2] = {clip(v, pad, box, axis, s, false), clip(v, pad, box, axis, s, true)};
-      if (side[0].empty() || side[1].empty()) {  // the triangle misses one side of the box
-        box = side[0].empty() ? side[1] : side[0];
-        if (box.empty()) break;
-        continue;
-      }
-      float a0 = side[0].area(), a1 = side[1].area();
-      int left = int(std::lround(float(pieces) * a0 / std::max(a0 + a1, 1e-30f)));
-      left = std::min(std::max(left, 1), pieces - 1);
-      int made = piece(v, pad, side[0], left, depth + 1, emit);
-      return made + piece(v, pad, side[1], pieces - left, depth + 1, emit);
-    }
-    emit(box);
-    return 1;
-  }
-
-  // The coarsest plane of the scene's power-of-two grid on `axis` strictly inside (lo, hi)
-  bool plane(int axis, float lo, float hi, float* s) const {
-    float size = size_[axis];
-    if (!(size > 0.0f)) return false;
-    for (int level = 1; level <= 24; ++level) {
-      float cell = std::ldexp(size, -level);
-      float k = std::floor((lo - lo_[axis]) / cell) + 1.0f;
-      float x = lo_[axis] + k * cell;
-      if (x > lo && x < hi) {
-        *s = x;
-        return true;
-      }
-      if (cell < (hi - lo) * 0.25f) break;  // a plane inside would have been found
-    }
-    float mid = 0.5f * (lo + hi);
-    if (!(mid > lo && mid < hi)) return false;
-    *s = mid;
-    return true;
-  }
-
-  // The box of the triangle's part on one side of plane `axis` = s (upper: the side above),
-  // within `box`: its corners there and its edges' crossings of the plane
-  static Box clip(const v4f* v, float pad, const Box& box, int axis, float s, bool upper) {
-    v4f lo{kEmptyLo, kEmptyLo, kEmptyLo, 0.0f}, hi{kEmptyHi, kEmptyHi, kEmptyHi, 0.0f};
-    v4f padding{pad, pad, pad, 0.0f};
-    padding[axis] = 0.0f;
-    for (int k = 0; k < 3; ++k) {
-      v4f p = v[k], q = v[(k + 1) % 3];
-      bool p_in = upper ? p[axis] >= s : p[axis] <= s;
-      if (p_in) lo = vmin(lo, p), hi = vmax(hi, p);
-      if ((p[axis] < s && q[axis] > s) || (p[axis] > s && q[axis] < s)) {
-        float t = (s - p[axis]) / (q[axis] - p[axis]);
-        v4f x = p + t * (q - p);
-        x[axis] = s;
-        lo = vmin(lo, x - padding);
-        hi = vmax(hi, x + padding);
-      }
-    }
-    Box out{vmax(lo, box.lo), vmin(hi, box.hi)};
-    if (upper)
-      out.lo[axis] = std::max(out.lo[axis], s);
-    else
-      out.hi[axis] = std::min(out.hi[axis], s);
-    return out;
-  }
-
-  v4f lo_, size_;
-};
-
 class Builder {
  public:
   Builder(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-          const std::vector<bool>& alpha_tested, int threads, float presplit)
+          const std::vector<bool>& alpha_tested, int threads)
       : positions_(positions), prims_(prims), alpha_tested_(alpha_tested), threads_(std::max(1, threads)) {
     refs_.resize(prims.size());
     parallel_for(prims.size(), [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) {
         const dev::Prim& p = prims[i];
         v4f a = vertex(p.v[0]), b = vertex(p.v[1]), c = vertex(p.v[2]);
-        set_ref(refs_[i], uint32_t(i), Box{vmin(vmin(a, b), c), vmax(vmax(a, b), c)});
+        Ref& r = refs_[i];
+        r.lo = vmin(vmin(a, b), c);
+        r.hi = vmax(vmax(a, b), c);
+        uint32_t prim = uint32_t(i);
+        std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &prim, 4);
       }
     });
-    if (presplit > 0.0f && prims.size() > 1) pre_split(presplit);
   }
 
   // The binary binned-SAH tree, collapsed as it is built: a 4-wide node's children are
@@ -327,65 +214,6 @@ class Builder {
   v4f vertex(uint32_t v) const {
     const float* p = &positions_[3 * size_t(v)];
     return v4f{p[0], p[1], p[2], 0.0f};
-  }
-
-  static void set_ref(Ref& r, uint32_t prim, const Box& b) {
-    r.lo = b.lo;
-    r.hi = b.hi;
-    r.hi[3] = 0.0f;
-    std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &prim, 4);
-  }
-
-  // Replaces the refs by the pre-split ones (PreSplitter): budget x the triangle count
-  // extra refs at most, shared out by excess area; a triangle's refs stay together, in
-  // primitive order (the same refs on any thread count)
-  void pre_split(float budget) {
-    size_t n = prims_.size();
-    v4f slo{kEmptyLo, kEmptyLo, kEmptyLo, 0.0f}, shi{kEmptyHi, kEmptyHi, kEmptyHi, 0.0f};
-    std::vector<float> excess(n);
-    double total = 0.0;
-    for (size_t i = 0; i < n; ++i) {  // serial: the sum is then the same on any thread count
-      const Ref& r = refs_[i];
-      slo = vmin(slo, r.box_lo());
-      shi = vmax(shi, r.hi);
-      const dev::Prim& p = prims_[i];
-      excess[i] = PreSplitter::excess(vertex(p.v[0]), vertex(p.v[1]), vertex(p.v[2]));
-      total += excess[i];
-    }
-    double extra = std::floor(double(budget) * double(n));
-    if (!(total > 0.0) || extra < 1.0) return;
-    PreSplitter splitter(slo, shi);
-    // Pieces per triangle, then where each triangle's refs start
-    std::vector<uint32_t> pieces(n);
-    parallel_for(n, [&](size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i) {
-        int want = 1 + int(std::min(64.0, std::floor(extra * double(excess[i]) / total)));
-        if (want == 1) {
-          pieces[i] = 1;
-          continue;
-        }
-        const dev::Prim& p = prims_[i];
-        pieces[i] = uint32_t(splitter.split(vertex(p.v[0]), vertex(p.v[1]), vertex(p.v[2]), want, [](const Box&) {}));
-      }
-    });
-    std::vector<size_t> first(n + 1, 0);
-    for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + pieces[i];
-    if (first[n] == n) return;
-    UninitVector<Ref> split_refs;
-    split_refs.resize(first[n]);
-    parallel_for(n, [&](size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i) {
-        if (pieces[i] == 1) {
-          split_refs[first[i]] = refs_[i];
-          continue;
-        }
-        const dev::Prim& p = prims_[i];
-        size_t at = first[i];
-        splitter.split(vertex(p.v[0]), vertex(p.v[1]), vertex(p.v[2]), int(pieces[i]),
-                       [&](const Box& b) { set_ref(split_refs[at++], uint32_t(i), b); });
-      }
-    });
-    refs_ = std::move(split_refs);
   }
 
   // fn(begin, end) over [0, n) in up to threads_ contiguous chunks of at least `grain`
@@ -846,20 +674,9 @@ double sah_cost(const Bvh& bvh) {
   return cost;
 }
 
-float bvh_presplit_budget() {
-  if (const char* env = std::getenv("CANDELA_BVH_PRESPLIT")) {
-    char* end = nullptr;
-    float b = std::strtof(env, &end);
-    if (end != env && b >= 0.0f && b <= 4.0f) return b;
-  }
-  return kPreSplitBudget;
-}
-
 Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-              const std::vector<bool>& alpha_tested, int threads, float presplit) {
-  return Builder(positions, prims, alpha_tested, threads > 0 ? threads : bvh_build_threads(),
-                 presplit >= 0.0f ? presplit : bvh_presplit_budget())
-      .build();
+              const std::vector<bool>& alpha_tested, int threads) {
+  return Builder(positions, prims, alpha_tested, threads > 0 ? threads : bvh_build_threads()).build();
 }
 
 }  // namespace candela

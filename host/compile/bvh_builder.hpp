@@ -21,25 +21,15 @@ struct Bvh {
 // (BVH_STACK_SIZE entries, 3 per 4-wide node on a path).
 constexpr int kMaxBvhDepth = 60;
 
-// Extra refs of pre-split triangles per triangle, at most (bvh_presplit_budget)
-constexpr float kPreSplitBudget = 0.3f;
-
 // `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order);
 // `alpha_tested`: by Prim::material, whether hits on its triangles call the kernel's alpha
 // test (BVH_TRI_ALPHA_TEST); empty for none. `threads`: 0 for bvh_build_threads(); the
 // tree is the same for any thread count (the workers build disjoint subtrees).
-// `presplit`: extra refs per triangle for triangles whose boxes are much larger than they
-// are, split into pieces before the build (0: none; negative: bvh_presplit_budget()); a
-// triangle then sits in the leaves once per piece.
 Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-              const std::vector<bool>& alpha_tested = {}, int threads = 0, float presplit = -1.0f);
+              const std::vector<bool>& alpha_tested = {}, int threads = 0);
 
 // Threads build_bvh uses by default: CANDELA_BVH_THREADS when set (> 0), else every core
 int bvh_build_threads();
-
-// Pre-split budget build_bvh uses by default: CANDELA_BVH_PRESPLIT when set (0 to 4),
-// else kPreSplitBudget
-float bvh_presplit_budget();
 
 // Surface-area-heuristic cost of the 4-wide tree, relative to one triangle test: 1 (the
 // root) + the sum over child slots of (slot box area / root box area) x (1 for an inner

@@ -102,26 +102,16 @@ class BvhTest : public DeviceTest {};
 
 }  // namespace
 
-// Every leaf triangle in exactly one leaf run (ending at a BVH_TRI_LAST triangle), every
-// triangle in at least one, child boxes holding their nodes and triangles: a triangle in
-// one leaf lies inside its box; the pieces of a pre-split triangle (one per leaf it is in)
-// together cover it, checked at points spread over it. No path pushes more than the
-// kernel's traversal stack holds. Returns how many triangles were pre-split.
-static int check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
+// Every triangle in exactly one leaf run (ending at a BVH_TRI_LAST triangle), child
+// boxes holding their triangles and nodes, and no path pushing more than the kernel's
+// traversal stack holds
+static void check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
   EXPECT_LE(bvh.depth, kMaxBvhDepth);
-  EXPECT_GE(bvh.tris.size(), tris.size());
+  ASSERT_EQ(bvh.tris.size(), tris.size());
   std::vector<int> seen(tris.size(), 0);
-  for (const auto& t : bvh.tris) {
-    EXPECT_LT(t.prim, tris.size());
-    if (t.prim < tris.size()) seen[t.prim]++;
-  }
-  int split = 0;
-  for (int s : seen) {
-    EXPECT_GE(s, 1);
-    split += s > 1;
-  }
-  std::vector<std::vector<std::pair<glm::dvec3, glm::dvec3>>> pieces(tris.size());  // leaf boxes of split ones
-  std::vector<int> covered(bvh.tris.size(), 0), node_seen(bvh.nodes.size(), 0);
+  for (const auto& t : bvh.tris) seen[t.prim]++;
+  for (int s : seen) ASSERT_EQ(s, 1);
+  std::vector<int> covered(tris.size(), 0), node_seen(bvh.nodes.size(), 0);
   int max_pushes = 0;
   struct Item {
     int node, pushes;
@@ -130,10 +120,9 @@ static int check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
   while (!todo.empty()) {
     Item item = todo.back();
     todo.pop_back();
-    if (item.node < 0 || item.node >= int(bvh.nodes.size()) || node_seen[item.node]++ != 0) {
-      ADD_FAILURE() << "node " << item.node << " out of range or reached twice";
-      return split;
-    }
+    ASSERT_GE(item.node, 0);
+    ASSERT_LT(item.node, int(bvh.nodes.size()));
+    ASSERT_EQ(node_seen[item.node]++, 0) << "node reached twice";
     const dev::BvhNode& node = bvh.nodes[item.node];
     int used = 0;
     for (int i = 0; i < 4; ++i) used += node.lo_x[i] <= node.hi_x[i];
@@ -142,8 +131,8 @@ static int check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
     for (int i = 0; i < 4; ++i) {
       glm::vec3 lo(node.lo_x[i], node.lo_y[i], node.lo_z[i]), hi(node.hi_x[i], node.hi_y[i], node.hi_z[i]);
       if (lo.x > hi.x) {  // unused slot: empty on every axis
-        EXPECT_GT(lo.y, hi.y);
-        EXPECT_GT(lo.z, hi.z);
+        ASSERT_GT(lo.y, hi.y);
+        ASSERT_GT(lo.z, hi.z);
         continue;
       }
       auto inside = [&](const glm::vec3& p) {
@@ -154,54 +143,26 @@ static int check_bvh(const Bvh& bvh, const std::vector<Tri>& tris) {
       int c = node.child[i];
       if (c < 0) {
         for (int t = ~c;; ++t) {
-          if (t >= int(bvh.tris.size())) {
-            ADD_FAILURE() << "leaf run past the end";
-            return split;
-          }
+          ASSERT_LT(t, int(bvh.tris.size()));
           covered[t]++;
-          uint32_t prim = bvh.tris[t].prim;
-          if (prim < tris.size() && seen[prim] == 1) {
-            for (const auto& p : tris[prim].p) EXPECT_TRUE(inside(p)) << "triangle " << prim;
-          } else if (prim < tris.size()) {
-            pieces[prim].push_back({glm::dvec3(lo), glm::dvec3(hi)});
-          }
+          for (const auto& p : tris[bvh.tris[t].prim].p) ASSERT_TRUE(inside(p));
           if (bvh.tris[t].flags & BVH_TRI_LAST) break;
         }
       } else {
-        EXPECT_GT(c, 0);
-        if (c <= 0 || c >= int(bvh.nodes.size())) return split;
+        ASSERT_GT(c, 0);
         const dev::BvhNode& child = bvh.nodes[c];
         for (int k = 0; k < 4; ++k) {
           if (child.lo_x[k] > child.hi_x[k]) continue;
-          EXPECT_TRUE(inside(glm::vec3(child.lo_x[k], child.lo_y[k], child.lo_z[k])));
-          EXPECT_TRUE(inside(glm::vec3(child.hi_x[k], child.hi_y[k], child.hi_z[k])));
+          ASSERT_TRUE(inside(glm::vec3(child.lo_x[k], child.lo_y[k], child.lo_z[k])));
+          ASSERT_TRUE(inside(glm::vec3(child.hi_x[k], child.hi_y[k], child.hi_z[k])));
         }
         todo.push_back({c, pushes});
       }
     }
   }
-  for (int c : covered) EXPECT_EQ(c, 1);
-  for (int n : node_seen) EXPECT_EQ(n, 1);
+  for (int c : covered) ASSERT_EQ(c, 1);
+  for (int n : node_seen) ASSERT_EQ(n, 1);
   EXPECT_LE(max_pushes, BVH_STACK_SIZE);
-  // The pieces cover their triangle: points on a 24-step barycentric grid (corners and
-  // edges included), each inside one of the boxes (a tolerance of double rounding only)
-  for (size_t i = 0; i < tris.size(); ++i) {
-    if (pieces[i].empty()) continue;
-    glm::dvec3 a = tris[i].p[0], b = tris[i].p[1], c = tris[i].p[2];
-    double tol = 1e-12 * (1.0 + std::max({glm::length(a), glm::length(b), glm::length(c)}));
-    int missed = 0;
-    for (int u = 0; u <= 24; ++u)
-      for (int v = 0; u + v <= 24; ++v) {
-        glm::dvec3 p = a + (b - a) * (u / 24.0) + (c - a) * (v / 24.0);
-        bool in = false;
-        for (const auto& box : pieces[i])
-          in = in || (glm::all(glm::greaterThanEqual(p, box.first - tol)) &&
-                      glm::all(glm::lessThanEqual(p, box.second + tol)));
-        missed += !in;
-      }
-    EXPECT_EQ(missed, 0) << "pre-split triangle " << i << " not covered by its " << pieces[i].size() << " pieces";
-  }
-  return split;
 }
 
 TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
@@ -229,59 +190,6 @@ TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
   Bvh bvh = Soup(tris).bvh;
   EXPECT_GT(bvh.depth, 30);
   check_bvh(bvh, tris);
-}
-
-// Long thin triangles across a box, in every direction, and small ones among them
-static std::vector<Tri> slivers(uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<Tri> tris;
-  for (int i = 0; i < 1500; ++i) {
-    glm::vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
-    glm::vec3 side = 0.05f * glm::vec3(u(rng), u(rng), u(rng));
-    tris.push_back(make_tri(a, b, 0.5f * (a + b) + side));
-  }
-  for (int i = 0; i < 3000; ++i) {
-    glm::vec3 c(u(rng), u(rng), u(rng));
-    tris.push_back(
-        make_tri(c, c + 0.03f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.03f * glm::vec3(u(rng), u(rng), u(rng))));
-  }
-  return tris;
-}
-
-// Pre-splitting cuts the long diagonal triangles (whose boxes are mostly empty) into pieces
-// that cover them, within the budget of extra refs, and lowers the tree's SAH cost; the
-// axis-aligned right triangles of a grid (boxes no larger than they need be) stay whole.
-TEST(BvhBuilder, PreSplitPiecesCoverTheirTrianglesAndLowerTheCost) {
-  std::vector<Tri> tris = slivers(21);
-  Soup soup(tris);
-  Bvh whole = build_bvh(soup.positions, soup.prims, {}, 0, 0.0f);
-  Bvh split = build_bvh(soup.positions, soup.prims, {}, 0, 0.3f);
-  EXPECT_EQ(check_bvh(whole, tris), 0);
-  EXPECT_EQ(whole.tris.size(), tris.size());
-  int n_split = check_bvh(split, tris);
-  EXPECT_GT(n_split, 100);
-  EXPECT_GT(split.tris.size(), tris.size() + tris.size() / 10);
-  EXPECT_LE(split.tris.size(), tris.size() + size_t(0.3 * double(tris.size())));
-  double cost_whole = sah_cost(whole), cost_split = sah_cost(split);
-  EXPECT_LT(cost_split, 0.8 * cost_whole);
-  RecordProperty("sah_cost_whole", std::to_string(cost_whole));
-  RecordProperty("sah_cost_split", std::to_string(cost_split));
-  for (int threads : {1, 3}) {
-    Bvh again = build_bvh(soup.positions, soup.prims, {}, threads, 0.3f);
-    ASSERT_EQ(again.tris.size(), split.tris.size());
-    EXPECT_EQ(0, std::memcmp(again.tris.data(), split.tris.data(), split.tris.size() * sizeof(split.tris[0])));
-  }
-
-  std::vector<Tri> grid;
-  for (int i = 0; i < 40; ++i)
-    for (int j = 0; j < 40; ++j) {
-      glm::vec3 o(float(i), float(j), 0.0f);
-      grid.push_back(make_tri(o, o + glm::vec3(1, 0, 0), o + glm::vec3(0, 1, 0)));
-      grid.push_back(make_tri(o + glm::vec3(1, 0, 0), o + glm::vec3(1, 1, 0), o + glm::vec3(0, 1, 0)));
-    }
-  Soup flat(grid);
-  EXPECT_EQ(build_bvh(flat.positions, flat.prims, {}, 0, 0.3f).tris.size(), grid.size());
 }
 
 // The parallel builder gives the same tree, byte for byte, on any number of threads: the
@@ -373,13 +281,6 @@ TEST_P(BvhTest, RandomRaysMatchBruteForceReference) {
     scene.push_back(make_tri(c, c + s * glm::vec3(u(rng), u(rng), u(rng)), c + s * glm::vec3(u(rng), u(rng), u(rng))));
   }
   EXPECT_GT(check_random_rays(rig(), scene, glm::vec3(-1.5f), glm::vec3(1.5f), 20000, 12), 3000);
-}
-
-// The same on the slivers, whose BVH holds pre-split pieces
-TEST_P(BvhTest, RandomRaysThroughPreSplitTrianglesMatchBruteForceReference) {
-  std::vector<Tri> scene = slivers(22);
-  ASSERT_GT(Soup(scene).bvh.tris.size(), scene.size());
-  EXPECT_GT(check_random_rays(rig(), scene, glm::vec3(-1.2f), glm::vec3(1.2f), 20000, 23), 3000);
 }
 
 // The same on real meshes: every mesh of the shipped materials scene (spheres, a ground,
