@@ -264,13 +264,25 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
 // those features read).
 Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& settings,
                        const std::vector<DeviceEntry>& devices) {
-  auto compiled =
-      std::make_shared<CompiledScene>(a.generic ? compile_scene(*scene, SceneFeatures::all()) : compile_scene(*scene));
+  // The kernels build while the BVH does: a cold build (seconds) overlaps the scene's
+  // compile, and the renderers below find the programs in the kernel cache
+  KernelPrebuild prebuild;
+  auto features_known = [&](const CompiledScene& c) {
+    SceneFeatures features = c.features;
+    if (!a.generic) features.light_tree = !c.buffers.light_tree.empty() && a.light_selection != "power";
+    for (const DeviceEntry& d : devices) prebuild.start(d, features, settings);
+  };
+  auto compiled = std::make_shared<CompiledScene>(
+      a.generic ? compile_scene(*scene, SceneFeatures::all(), features_known) : compile_scene(*scene, features_known));
   if (a.light_selection == "power") drop_light_tree(&compiled->buffers);
   if (!a.generic) compiled->features.light_tree = !compiled->buffers.light_tree.empty();
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
   *scene = Scene();
-  return Renderer(devices, std::move(compiled), camera, settings, true);
+  prebuild.wait();
+  Renderer renderer(devices, std::move(compiled), camera, settings, true);
+  for (size_t i = 0; i < prebuild.size() && i < renderer.worker_count(); ++i)
+    renderer.worker(i).count_prebuild(prebuild.result(i));
+  return renderer;
 }
 
 // The render with its progress bar; Ctrl-C stops it between launches

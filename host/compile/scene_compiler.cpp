@@ -575,7 +575,9 @@ std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::
   return bins;
 }
 
-CompiledScene compile_scene(const Scene& scene) { return compile_scene(scene, scene.features()); }
+CompiledScene compile_scene(const Scene& scene, const FeaturesKnown& features_known) {
+  return compile_scene(scene, scene.features(), features_known);
+}
 
 void CompiledScene::release_host_arrays() {
   auto lights = std::move(buffers.lights);
@@ -583,7 +585,7 @@ void CompiledScene::release_host_arrays() {
   buffers.lights = std::move(lights);
 }
 
-CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
+CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features, const FeaturesKnown& features_known) {
   auto start = Clock::now();
   CompiledScene c;
   c.features = features;
@@ -596,6 +598,7 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features) {
   compile_media(scene, c.features, &c.buffers, &c.grids);
   c.environment_light = compile_lights(scene, &c.buffers);
   c.features.light_tree = features.light_tree || !c.buffers.light_tree.empty();  // a scene's need only known here
+  if (features_known) features_known(c);
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;
   for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());

@@ -3,6 +3,7 @@
 // device that renders the scene.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "compile/compiled_scene.hpp"
@@ -10,11 +11,17 @@
 
 namespace candela {
 
-CompiledScene compile_scene(const Scene& scene);
+// Called by compile_scene once the kernel features are final (after the lights and their
+// light tree, before the BVH), with the scene compiled so far: the kernel can be built
+// while the rest compiles
+using FeaturesKnown = std::function<void(const CompiledScene&)>;
+
+CompiledScene compile_scene(const Scene& scene, const FeaturesKnown& features_known = {});
 // With kernel features that include the scene's (e.g. SceneFeatures::all(), the generic
 // kernel of --generic): the optional vertex arrays of every feature on are filled, with
 // the defaults where a mesh has none. Throws Error when `features` lack one the scene needs.
-CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features);
+CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features,
+                            const FeaturesKnown& features_known = {});
 
 // Alias table (Walker 1977, Vose 1991) for selecting index i with probability ~ weights[i]
 // (all > 0) from a uniform 32-bit integer (sample_discrete_alias in sampling.cl); the exact

@@ -1,10 +1,13 @@
 // Rendering a compiled scene on devices (renderer.hpp): the device workers and the sample scheduler.
 #include "render/renderer.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 
@@ -53,6 +56,40 @@ void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
 
 }  // namespace
 
+std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings) {
+  std::string options = "-cl-std=CL1.2 " + features.build_options();
+  options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
+  return options;
+}
+
+void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& features, const RenderSettings& settings) {
+  results_.push_back(std::make_unique<Result>());
+  // Only into a cache the renderer can read back: else the program would be built twice
+  std::string dir = kernel_cache_dir();
+  std::error_code ec;
+  if (dir.empty() || (std::filesystem::create_directories(dir, ec), ::access(dir.c_str(), W_OK) != 0)) return;
+  std::string options = render_kernel_options(features, settings);
+  std::function<void(const std::string&)> note = settings.before_kernel_compile;
+  Result* result = results_.back().get();
+  threads_.emplace_back([device, options, note, result] {
+    try {
+      cl::Context context(device.device);
+      ProgramBuild build = build_program(context, device, renderer_program_source(), options, [&] {
+        if (note) note(device.description());
+      });
+      result->seconds = build.seconds;
+      result->from_cache = build.from_cache;
+      result->built = true;
+    } catch (...) {  // the renderer's own build reports it
+    }
+  });
+}
+
+void KernelPrebuild::wait() {
+  for (std::thread& t : threads_) t.join();
+  threads_.clear();
+}
+
 DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const dev::Camera& camera,
                                const RenderSettings& settings, CompiledScene* release)
     : device_(device), settings_(settings) {
@@ -63,11 +100,10 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
-  std::string options = "-cl-std=CL1.2 " + scene.features.build_options();
-  options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
-  ProgramBuild build = build_program(context_, device_, renderer_program_source(), options, [&] {
-    if (settings.before_kernel_compile) settings.before_kernel_compile(device_.description());
-  });
+  ProgramBuild build =
+      build_program(context_, device_, renderer_program_source(), render_kernel_options(scene.features, settings), [&] {
+        if (settings.before_kernel_compile) settings.before_kernel_compile(device_.description());
+      });
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");

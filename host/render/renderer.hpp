@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "base/device_types.hpp"
@@ -77,6 +78,35 @@ struct RenderResult {
   std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
 };
 
+// The render kernel program's build options for kernel features and settings
+std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings);
+
+// Builds the render kernel program into the kernel cache on threads of their own (one per
+// start), while the caller goes on (compiling the scene): a DeviceRenderer made after
+// wait() finds the program there. Errors are left to that renderer's own build, which
+// reports them. Nothing is built without a writable kernel cache directory.
+class KernelPrebuild {
+ public:
+  struct Result {
+    bool built = false;  // the build ran and succeeded
+    double seconds = 0.0;
+    bool from_cache = false;
+  };
+  KernelPrebuild() = default;
+  KernelPrebuild(const KernelPrebuild&) = delete;
+  KernelPrebuild& operator=(const KernelPrebuild&) = delete;
+  ~KernelPrebuild() { wait(); }
+  void start(const DeviceEntry& device, const SceneFeatures& features, const RenderSettings& settings);
+  void wait();
+  // The i-th start's build, once wait() returned
+  const Result& result(size_t i) const { return *results_.at(i); }
+  size_t size() const { return results_.size(); }
+
+ private:
+  std::vector<std::thread> threads_;
+  std::vector<std::unique_ptr<Result>> results_;
+};
+
 // One device's worker: renders ranges of sample indices of a compiled scene into its film
 class DeviceRenderer {
  public:
@@ -103,6 +133,13 @@ class DeviceRenderer {
   Film film();  // reads the film back from the device
   double kernel_build_seconds() const { return kernel_build_seconds_; }
   bool kernel_from_cache() const { return kernel_from_cache_; }
+  // This worker's program came from the cache that a KernelPrebuild filled: that build's
+  // time and whether it was itself from the cache count as this worker's kernel build
+  void count_prebuild(const KernelPrebuild::Result& r) {
+    if (!r.built || !kernel_from_cache_) return;
+    kernel_build_seconds_ += r.seconds;
+    kernel_from_cache_ = r.from_cache;
+  }
   const DeviceEntry& device() const { return device_; }
 
  private:

@@ -506,8 +506,10 @@ fi
 
 # ---- A kernel build from source is announced (a wait of minutes on rusticl); a cached one is not ----
 kc=$tmp/kcache-note
-CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n1.png" --width 16 --spp 1 --device pocl >/dev/null 2>"$tmp/n1"
-CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n2.png" --width 16 --spp 1 --device pocl >/dev/null 2>"$tmp/n2"
+CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n1.png" --width 16 --spp 1 --device pocl --stats "$tmp/n1.json" \
+  >/dev/null 2>"$tmp/n1"
+CANDELA_CACHE_DIR=$kc "$bin" render "$scene" -o "$tmp/n2.png" --width 16 --spp 1 --device pocl --stats "$tmp/n2.json" \
+  >/dev/null 2>"$tmp/n2"
 CANDELA_CACHE_DIR=$tmp/kcache-quiet "$bin" render "$scene" -o "$tmp/n3.png" --width 16 --spp 1 --device pocl -q \
   >/dev/null 2>"$tmp/n3"
 if [ "$(grep -c '^compiling the render kernel for .*not in the kernel cache' "$tmp/n1")" -eq 1 ] &&
@@ -516,6 +518,18 @@ if [ "$(grep -c '^compiling the render kernel for .*not in the kernel cache' "$t
 else
   fail "the kernel build note"
   cat "$tmp/n1" "$tmp/n2" "$tmp/n3"
+fi
+# The build made while the scene compiles is reported as the render's: from source the
+# first time (PoCL's own cache may make it quick), from the cache the second
+if python3 -c "
+import json, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert a['kernel_from_cache'] is False and a['kernel_build_seconds'] > 0.0, a
+assert b['kernel_from_cache'] is True and b['kernel_build_seconds'] > 0.0, b
+" "$tmp/n1.json" "$tmp/n2.json"; then
+  pass "a kernel built while the scene compiles is reported as built from source, then as cached"
+else
+  fail "the kernel build's report (kernel_from_cache, kernel_build_seconds)"
 fi
 
 echo "$passes passed, $fails failed"
