@@ -258,6 +258,14 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
   }
 }
 
+// The kernel features the renderer builds with: the compiled scene's, without the light
+// tree when --light-selection power leaves it out (the generic kernel keeps every feature)
+SceneFeatures kernel_features(const CompiledScene& c, const RenderArgs& a) {
+  SceneFeatures features = c.features;
+  if (!a.generic) features.light_tree = !c.buffers.light_tree.empty() && a.light_selection != "power";
+  return features;
+}
+
 // The renderer of the scene through its camera, on the devices. Host memory: the loaded
 // scene's arrays go once compiled, the compiled scene's as the devices take their copies
 // (README, Performance: Memory). --generic: every kernel feature on (and the vertex arrays
@@ -268,14 +276,12 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
   // compile, and the renderers below find the programs in the kernel cache
   KernelPrebuild prebuild;
   auto features_known = [&](const CompiledScene& c) {
-    SceneFeatures features = c.features;
-    if (!a.generic) features.light_tree = !c.buffers.light_tree.empty() && a.light_selection != "power";
-    for (const DeviceEntry& d : devices) prebuild.start(d, features, settings);
+    for (const DeviceEntry& d : devices) prebuild.start(d, kernel_features(c, a), settings);
   };
   auto compiled = std::make_shared<CompiledScene>(
       a.generic ? compile_scene(*scene, SceneFeatures::all(), features_known) : compile_scene(*scene, features_known));
+  compiled->features = kernel_features(*compiled, a);
   if (a.light_selection == "power") drop_light_tree(&compiled->buffers);
-  if (!a.generic) compiled->features.light_tree = !compiled->buffers.light_tree.empty();
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
   *scene = Scene();
   prebuild.wait();

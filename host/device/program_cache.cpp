@@ -131,12 +131,16 @@ std::string kernel_cache_dir() {
   return "";
 }
 
+std::string program_cache_file(const DeviceEntry& device, const std::string& source, const std::string& options) {
+  std::string dir = kernel_cache_dir();
+  return dir.empty() ? "" : dir + "/" + cache_key(device, source, options) + ".bin";
+}
+
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
                            const std::string& options, const std::function<void()>& before_compile) {
   auto start = std::chrono::steady_clock::now();
   ProgramBuild result;
-  std::string dir = kernel_cache_dir();
-  if (!dir.empty()) result.cache_file = dir + "/" + cache_key(device, source, options) + ".bin";
+  result.cache_file = program_cache_file(device, source, options);
 
   if (!result.cache_file.empty()) {
     std::vector<unsigned char> binary = read_entry(result.cache_file);

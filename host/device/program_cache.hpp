@@ -30,6 +30,10 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
 
 std::string kernel_cache_dir();
 
+// The cache entry build_program uses for `source` built with `options` on the device
+// (empty: no cache)
+std::string program_cache_file(const DeviceEntry& device, const std::string& source, const std::string& options);
+
 // Other data kept in the cache beside a program (e.g. under ProgramBuild::cache_file plus a
 // suffix), with the binaries' checks: the payload, or empty when missing or corrupt (a
 // corrupt entry is removed); writing is atomic and an unwritable cache is not an error

@@ -64,25 +64,37 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
 
 void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& features, const RenderSettings& settings) {
   results_.push_back(std::make_unique<Result>());
-  // Only into a cache the renderer can read back: else the program would be built twice
+  try {
+    check_settings(device, settings);
+  } catch (const Error&) {
+    return;  // the renderer reports it
+  }
+  // Only into a cache the renderer can read back (else the program would be built twice),
+  // and only what is not there yet
   std::string dir = kernel_cache_dir();
   std::error_code ec;
   if (dir.empty() || (std::filesystem::create_directories(dir, ec), ::access(dir.c_str(), W_OK) != 0)) return;
   std::string options = render_kernel_options(features, settings);
+  std::string entry = program_cache_file(device, renderer_program_source(), options);
+  if (std::filesystem::exists(entry, ec) || ec) return;
+  if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return;
   std::function<void(const std::string&)> note = settings.before_kernel_compile;
   Result* result = results_.back().get();
-  threads_.emplace_back([device, options, note, result] {
-    try {
-      cl::Context context(device.device);
-      ProgramBuild build = build_program(context, device, renderer_program_source(), options, [&] {
-        if (note) note(device.description());
-      });
-      result->seconds = build.seconds;
-      result->from_cache = build.from_cache;
-      result->built = true;
-    } catch (...) {  // the renderer's own build reports it
-    }
-  });
+  try {
+    threads_.emplace_back([device, options, note, result] {
+      try {
+        cl::Context context(device.device);
+        ProgramBuild build = build_program(context, device, renderer_program_source(), options, [&] {
+          if (note) note(device.description());
+        });
+        result->seconds = build.seconds;
+        result->built = !build.from_cache;
+      } catch (...) {  // the renderer's own build reports it
+      }
+    });
+    started_.push_back(entry);
+  } catch (const std::system_error&) {  // no thread: the renderer builds it
+  }
 }
 
 void KernelPrebuild::wait() {

@@ -81,16 +81,17 @@ struct RenderResult {
 // The render kernel program's build options for kernel features and settings
 std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings);
 
-// Builds the render kernel program into the kernel cache on threads of their own (one per
-// start), while the caller goes on (compiling the scene): a DeviceRenderer made after
-// wait() finds the program there. Errors are left to that renderer's own build, which
-// reports them. Nothing is built without a writable kernel cache directory.
+// Builds the render kernel program into the kernel cache on threads of their own, while
+// the caller goes on (compiling the scene): a DeviceRenderer made after wait() finds the
+// program there. Only programs not in the cache yet are built, each once (a device listed
+// twice, or two alike, share a cache entry). Nothing is built without a writable kernel
+// cache directory, or for a device the renderer would refuse; a failed build is left to
+// the renderer's own, which reports it.
 class KernelPrebuild {
  public:
   struct Result {
-    bool built = false;  // the build ran and succeeded
+    bool built = false;  // this start built the program from source, successfully
     double seconds = 0.0;
-    bool from_cache = false;
   };
   KernelPrebuild() = default;
   KernelPrebuild(const KernelPrebuild&) = delete;
@@ -105,6 +106,7 @@ class KernelPrebuild {
  private:
   std::vector<std::thread> threads_;
   std::vector<std::unique_ptr<Result>> results_;
+  std::vector<std::string> started_;  // cache entries being built
 };
 
 // One device's worker: renders ranges of sample indices of a compiled scene into its film
@@ -133,12 +135,12 @@ class DeviceRenderer {
   Film film();  // reads the film back from the device
   double kernel_build_seconds() const { return kernel_build_seconds_; }
   bool kernel_from_cache() const { return kernel_from_cache_; }
-  // This worker's program came from the cache that a KernelPrebuild filled: that build's
-  // time and whether it was itself from the cache count as this worker's kernel build
+  // A KernelPrebuild built this worker's program from source and this worker loaded it
+  // from the cache: that build counts as this worker's (its time added to the load's)
   void count_prebuild(const KernelPrebuild::Result& r) {
     if (!r.built || !kernel_from_cache_) return;
     kernel_build_seconds_ += r.seconds;
-    kernel_from_cache_ = r.from_cache;
+    kernel_from_cache_ = false;
   }
   const DeviceEntry& device() const { return device_; }
 
