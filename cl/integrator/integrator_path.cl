@@ -272,13 +272,20 @@ void path_cross_boundary(const SceneData* sc, PathState* ps, const SurfaceHit* s
 }
 #endif
 
-// Radiance along one camera ray
-float3 path_trace(const SceneData* sc, Ray camera_ray, Rng* rng) {
+// Radiance along one camera ray; `first`: the camera ray's closest hit when it is known
+// already (traced in a packet), else 0
+float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng) {
   __global const RenderParams* params = sc->params;
   const uint strategy = params->strategy;
   PathState ps = path_start(sc, camera_ray);
   for (;; ++ps.depth) {
-    Hit hit = scene_intersect(sc, ps.ray, INFINITY);
+    Hit hit;
+    if (first) {
+      hit = *first;
+      first = 0;
+    } else {
+      hit = scene_intersect(sc, ps.ray, INFINITY);
+    }
 #if CD_FEATURE_MEDIA
     // Medium step: emission and free flight up to the surface; scattering in the medium
     // (the phase function is never near-specular: auto light-samples there, like nee)
@@ -397,6 +404,84 @@ uint pixel_of_launch_index(uint i, uint width, uint height) {
   return (8u * band + ly) * width + 8u * tile + lx;
 }
 
+// A sample's radiance into the pixel's running mean and sum of squared deviations
+// (Welford): mean.w counts kept samples, m2.w dropped (non-finite) ones
+void film_add(float4* mean, float4* m2, float3 l) {
+  if (!all_finite(l)) {
+    m2->w += 1.0f;
+    return;
+  }
+  float n = mean->w + 1.0f;
+  float3 delta = l - mean->xyz;
+  float3 new_mean = mean->xyz + delta / n;
+  m2->xyz += delta * (l - new_mean);
+  *mean = (float4)(new_mean, n);
+}
+
+// The camera ray of a pixel's sample, from its first random numbers
+Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng* rng) {
+  float jx = rng_next(rng), jy = rng_next(rng);
+  float2 film = filter_sample(params->filter, jx, jy);
+  float2 lens = (float2)(0.0f);
+  if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(rng), rng_next(rng));
+  return camera_ray(params, (float)px + film.x, (float)py + film.y, lens);
+}
+
+// CD_PACKETS=1 (CPU devices, set by the host): a work-item takes eight consecutive launch
+// indices (a 4x2 block of a tile) and traces their camera rays as one packet
+// (bvh_intersect8), then each path on its own. The same samples, bit for bit, as one
+// work-item per index, up to a tie between two triangles at exactly the same distance.
+#ifndef CD_PACKETS
+#define CD_PACKETS 0
+#endif
+
+#if CD_PACKETS
+// (Loops over the eight lanes have a fixed trip count, and structs reach the arrays from
+// locals: llvmpipe mistranslated a lane loop with a data-dependent bound and a struct
+// returned straight into an array element.)
+__kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
+                           __global float4* film_mean, __global float4* film_m2) {
+  uint first = params->pixel_begin + 8u * (uint)get_global_id(0);
+  if (first >= params->pixel_end) return;
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
+  uint pixel[8];
+  float4 mean[8], m2[8];
+  for (uint l = 0u; l < 8u; ++l) {
+    // A lane past the launch's end repeats the first lane's pixel, and is never written
+    pixel[l] = pixel_of_launch_index(first + l < params->pixel_end ? first + l : first, params->width, params->height);
+    mean[l] = film_mean[pixel[l]];
+    m2[l] = film_m2[pixel[l]];
+  }
+  for (uint k = 0u; k < params->sample_count; ++k) {
+    Rng rng[8];
+    Ray rays[8];
+    float tmax[8];
+    for (uint l = 0u; l < 8u; ++l) {
+      Rng r = rng_init(pixel[l], params->sample_begin + k, params->seed);
+      Ray ray = pixel_camera_ray(params, pixel[l] % params->width, pixel[l] / params->width, &r);
+      rng[l] = r;
+      rays[l].org = ray.org;
+      rays[l].dir = ray.dir;
+      tmax[l] = first + l < params->pixel_end ? INFINITY : 0.0f;  // past the end: finds nothing
+    }
+    Hit hits[8];
+    scene_intersect8(&sc, rays, tmax, hits);
+    for (uint l = 0u; l < 8u; ++l) {
+      if (first + l >= params->pixel_end) continue;
+      Ray ray = rays[l];
+      Hit hit = hits[l];
+      Rng r = rng[l];
+      film_add(&mean[l], &m2[l], path_trace(&sc, ray, &hit, &r));
+    }
+  }
+  for (uint l = 0u; l < 8u; ++l) {
+    if (first + l >= params->pixel_end) continue;
+    film_mean[pixel[l]] = mean[l];
+    film_m2[pixel[l]] = m2[l];
+  }
+}
+#else
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
                            __global float4* film_mean, __global float4* film_m2) {
   uint index = params->pixel_begin + (uint)get_global_id(0);
@@ -405,28 +490,14 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint px = pixel % params->width, py = pixel / params->width;
-
-  // Welford state: mean.w counts kept samples, m2.w counts dropped (non-finite) ones
   float4 mean = film_mean[pixel];
   float4 m2 = film_m2[pixel];
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
-    float jx = rng_next(&rng), jy = rng_next(&rng);
-    float2 film = filter_sample(params->filter, jx, jy);
-    float2 lens = (float2)(0.0f);
-    if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(&rng), rng_next(&rng));
-    Ray ray = camera_ray(params, (float)px + film.x, (float)py + film.y, lens);
-    float3 l = path_trace(&sc, ray, &rng);
-    if (!all_finite(l)) {
-      m2.w += 1.0f;
-      continue;
-    }
-    float n = mean.w + 1.0f;
-    float3 delta = l - mean.xyz;
-    float3 new_mean = mean.xyz + delta / n;
-    m2.xyz += delta * (l - new_mean);
-    mean = (float4)(new_mean, n);
+    Ray ray = pixel_camera_ray(params, px, py, &rng);
+    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng));
   }
   film_mean[pixel] = mean;
   film_m2[pixel] = m2;
 }
+#endif

@@ -16,6 +16,12 @@ Hit scene_intersect(const SceneData* sc, Ray ray, float tmax) {
   return bvh_intersect(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax);
 }
 
+// Closest hits of eight rays at once, as scene_intersect finds each (bvh_intersect8: for
+// coherent rays)
+void scene_intersect8(const SceneData* sc, const Ray* rays, const float* tmax, Hit* hits) {
+  bvh_intersect8(sc, sc->bvh_nodes, sc->bvh_tris, rays, tmax, hits);
+}
+
 // Anything in (0, tmax) along the ray, by the same alpha tests?
 bool scene_occluded(const SceneData* sc, Ray ray, float tmax) {
   return bvh_occluded(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax);

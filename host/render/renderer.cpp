@@ -56,9 +56,15 @@ void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
 
 }  // namespace
 
-std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings) {
+bool render_packets(const DeviceEntry& device) {
+  return (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+}
+
+std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings,
+                                  const DeviceEntry& device) {
   std::string options = "-cl-std=CL1.2 " + features.build_options();
   options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
+  if (render_packets(device)) options += " -DCD_PACKETS=1";
   return options;
 }
 
@@ -74,7 +80,7 @@ void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& featu
   std::string dir = kernel_cache_dir();
   std::error_code ec;
   if (dir.empty() || (std::filesystem::create_directories(dir, ec), ::access(dir.c_str(), W_OK) != 0)) return;
-  std::string options = render_kernel_options(features, settings);
+  std::string options = render_kernel_options(features, settings, device);
   std::string entry = program_cache_file(device, renderer_program_source(), options);
   if (std::filesystem::exists(entry, ec) || ec) return;
   if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return;
@@ -112,10 +118,11 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("creating a context on " + device_.description(), e.err()));
   }
-  ProgramBuild build =
-      build_program(context_, device_, renderer_program_source(), render_kernel_options(scene.features, settings), [&] {
-        if (settings.before_kernel_compile) settings.before_kernel_compile(device_.description());
-      });
+  ProgramBuild build = build_program(context_, device_, renderer_program_source(),
+                                     render_kernel_options(scene.features, settings, device_), [&] {
+                                       if (settings.before_kernel_compile)
+                                         settings.before_kernel_compile(device_.description());
+                                     });
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
@@ -125,6 +132,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
                 " arguments, but the host binds " + std::to_string(want_args) +
                 " (CD_SCENE_BUFFERS out of step with the kernel)");
   local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
+  pixels_per_item_ = render_packets(device_) ? 8 : 1;
 
   const AnisotropicAlbedo anisotropic = anisotropic_albedo(scene.features.anisotropy, scene.buffers.materials);
 #define CD_UPLOAD(type, name)                                                     \
@@ -176,8 +184,10 @@ void DeviceRenderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_
   params_host_.pixel_end = uint32_t(pixel_end);
   try {
     queue_.enqueueWriteBuffer(params_, CL_TRUE, 0, sizeof params_host_, &params_host_);
-    // Work-groups of local_size_ work-items; the kernel skips the padding at the end
-    size_t global = (pixel_end - pixel_begin + local_size_ - 1) / local_size_ * local_size_;
+    // Work-groups of local_size_ work-items, each taking pixels_per_item_ launch indices;
+    // the kernel skips the padding at the end
+    size_t items = (pixel_end - pixel_begin + pixels_per_item_ - 1) / pixels_per_item_;
+    size_t global = (items + local_size_ - 1) / local_size_ * local_size_;
     queue_.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(local_size_));
     queue_.finish();
   } catch (const cl::Error& e) {

@@ -78,8 +78,12 @@ struct RenderResult {
   std::vector<uint64_t> worker_samples;  // per worker: samples it added, summed over pixels
 };
 
-// The render kernel program's build options for kernel features and settings
-std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings);
+// The render kernel program's build options for kernel features, settings and device
+std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings,
+                                  const DeviceEntry& device);
+// Whether render_paths traces camera rays in packets of eight on the device (CD_PACKETS):
+// on CPU devices, where packets are what puts the traversal's tests in SIMD lanes
+bool render_packets(const DeviceEntry& device);
 
 // Builds the render kernel program into the kernel cache on threads of their own, while
 // the caller goes on (compiling the scene): a DeviceRenderer made after wait() finds the
@@ -156,9 +160,10 @@ class DeviceRenderer {
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
-  size_t chunk_ = 1;           // launch indices (pixels) per launch
-  uint32_t batch_ = 1;         // samples per pixel for the next range
-  double pass_seconds_ = 0.0;  // one sample of every pixel, measured; 0 = not yet
+  size_t pixels_per_item_ = 1;  // 8 with packets (render_packets)
+  size_t chunk_ = 1;            // launch indices (pixels) per launch
+  uint32_t batch_ = 1;          // samples per pixel for the next range
+  double pass_seconds_ = 0.0;   // one sample of every pixel, measured; 0 = not yet
   double kernel_build_seconds_ = 0.0;
   bool kernel_from_cache_ = false;
 };

@@ -34,3 +34,22 @@ __kernel void test_trace_brute(__global const BvhTriangle* tris, uint num_tris, 
   }
   out[i] = result;
 }
+
+// The same rays eight at a time through bvh_intersect8 (the packets of CD_PACKETS); rays past
+// the end (num_rays) pad the last packet with tmax 0 and are not written
+__kernel void test_trace_bvh8(__global const BvhNode* nodes, __global const BvhTriangle* tris,
+                              __global const float4* rays, uint num_rays, __global float4* out) {
+  uint first = 8u * (uint)get_global_id(0);
+  Ray r[8];
+  float tmax[8];
+  for (uint l = 0u; l < 8u; ++l) {
+    uint i = first + l < num_rays ? first + l : num_rays - 1u;
+    r[l].org = rays[2u * i].xyz;
+    r[l].dir = rays[2u * i + 1u].xyz;
+    tmax[l] = first + l < num_rays ? rays[2u * i].w : 0.0f;
+  }
+  Hit h[8];
+  bvh_intersect8(0, nodes, tris, r, tmax, h);
+  for (uint l = 0u; l < 8u; ++l)
+    if (first + l < num_rays) out[first + l] = (float4)(h[l].t, h[l].b1, h[l].b2, (float)h[l].prim);
+}

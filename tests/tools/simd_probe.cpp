@@ -1,15 +1,19 @@
 // What a CPU OpenCL driver's work-group vectorizer makes of a loop, as the renderer's path
-// loop is one (a benchmark, not a test): three kernels do the same useful work, n_i steps of a
+// loop is one (a benchmark, not a test): the kernels do the same useful work, n_i steps of a
 // short float computation per work-item, with
 //   uniform:   the same trip count in every work-item (n);
+//   unrolled:  64 steps, the loop unrolled (a kernel body without a loop);
 //   divergent: a trip count of its own in each work-item (n/2 + hash(i) mod n, mean about n),
 //              as a path's bounce count is;
 //   masked:    the divergent counts, but every work-item loops to the largest (3n/2 - 1) and
-//              keeps a step's result only while k < n_i: uniform control flow, 1.5x the steps.
-// It prints one JSON line per kernel and round: seconds (wall, launch to finish) and nanoseconds per
-// useful step and work-item. On PoCL a loop whose trip count is the same in every work-item
-// gets the work-item loop inside it, which its vectorizer turns into SIMD across work-items;
-// a per-work-item trip count keeps every work-item scalar.
+//              keeps a step's result only while k < n_i: uniform control flow, 1.5x the steps;
+//   barrier:   masked, to the work-group's largest count, with a barrier after every step;
+//   lanes8:    explicit lanes, eight work-items' values in float8 in one work-item.
+// It prints one JSON line per kernel and round: seconds (wall, launch to finish), nanoseconds
+// per useful step and work-item, and whether the result equals the divergent kernel's bit for
+// bit. On PoCL a kernel whose body has a loop runs each work-item alone (whatever its trip
+// counts); the code between two barriers runs as a loop over the work-items with nothing
+// inside it, which its vectorizer turns into SIMD across work-items.
 //
 // Usage: candela_simd_probe [DEVICE_SUBSTRING (pocl)] [ROUNDS (3)] [N (64)] [WORK_ITEMS (1048576)]
 #include <CL/opencl.hpp>
@@ -71,6 +75,30 @@ __kernel void probe_divergent(__global float* out, uint n) {
   for (uint k = 0u; k < m; ++k) x = probe_step(x, a);
   out[i] = x;
 }
+// The masked loop with a barrier in it: the trip count is the work-group's largest (one
+// work-item finds it), so every work-item reaches each barrier; PoCL then runs each region
+// between barriers as a loop over the group's work-items, which has no loop inside it
+__kernel void probe_barrier(__global float* out, uint n) {
+  __local uint counts[64];
+  __local uint group_top;
+  uint i = get_global_id(0), l = get_local_id(0), m = probe_count(i, n);
+  counts[l] = m;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (l == 0u) {
+    uint top = 0u;
+    for (uint j = 0u; j < 64u; ++j) top = max(top, counts[j]);
+    group_top = top;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  uint top = group_top;
+  float x = (float)i * 1e-3f, a = 1.0f + (float)(i & 7u) * 0.01f;
+  for (uint k = 0u; k < top; ++k) {
+    float y = probe_step(x, a);
+    x = k < m ? y : x;
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  out[i] = x;
+}
 __kernel void probe_masked(__global float* out, uint n) {
   uint i = get_global_id(0), m = probe_count(i, n), top = n / 2u + n - 1u;
   float x = (float)i * 1e-3f, a = 1.0f + (float)(i & 7u) * 0.01f;
@@ -122,7 +150,8 @@ int main(int argc, char** argv) {
     cl::Program program(context, kSource);
     program.build({device}, "-cl-std=CL1.2");
     cl::Buffer out(context, CL_MEM_WRITE_ONLY, items * sizeof(float));
-    double useful = 0.0;  // steps the divergent counts ask for
+    std::vector<float> reference;  // probe_divergent's result
+    double useful = 0.0;           // steps the divergent counts ask for
     {
       cl::Buffer counts(context, CL_MEM_WRITE_ONLY, items * sizeof(cl_uint));
       cl::Kernel k(program, "probe_counts");
@@ -133,7 +162,8 @@ int main(int argc, char** argv) {
       queue.enqueueReadBuffer(counts, CL_TRUE, 0, items * sizeof(cl_uint), m.data());
       for (cl_uint c : m) useful += double(c);
     }
-    const char* names[] = {"probe_uniform", "probe_unrolled", "probe_divergent", "probe_masked", "probe_lanes8"};
+    const char* names[] = {"probe_uniform", "probe_unrolled", "probe_divergent",
+                           "probe_masked",  "probe_barrier",  "probe_lanes8"};
     for (int round = 0; round <= rounds; ++round)  // round 0 warms the driver's lazy code generation up
       for (const char* name : names) {
         cl::Kernel k(program, name);
@@ -144,14 +174,20 @@ int main(int argc, char** argv) {
         queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(64));
         queue.finish();
         double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        // The kernels that do the divergent counts' steps must agree with probe_divergent bit for bit
+        std::vector<float> result(items);
+        queue.enqueueReadBuffer(out, CL_TRUE, 0, items * sizeof(float), result.data());
+        bool divergent_counts = std::strcmp(name, "probe_uniform") != 0 && std::strcmp(name, "probe_unrolled") != 0;
+        if (std::strcmp(name, "probe_divergent") == 0) reference = result;
+        const char* matches = !divergent_counts || reference.empty() ? "null" : result == reference ? "true" : "false";
         double steps = std::strcmp(name, "probe_uniform") == 0    ? double(n) * double(items)
                        : std::strcmp(name, "probe_unrolled") == 0 ? 64.0 * double(items)
                                                                   : useful;
         if (round > 0)
           std::printf(
               "{\"device\": \"%s\", \"kernel\": \"%s\", \"round\": %d, \"n\": %u, \"work_items\": %zu, "
-              "\"seconds\": %.4f, \"ns_per_useful_step\": %.3f}\n",
-              device.getInfo<CL_DEVICE_NAME>().c_str(), name + 6, round, n, items, s, 1e9 * s / steps);
+              "\"seconds\": %.4f, \"ns_per_useful_step\": %.3f, \"matches_divergent\": %s}\n",
+              device.getInfo<CL_DEVICE_NAME>().c_str(), name + 6, round, n, items, s, 1e9 * s / steps, matches);
       }
   } catch (const cl::BuildError& e) {
     for (const auto& log : e.getBuildLog()) std::fprintf(stderr, "%s\n", log.second.c_str());
