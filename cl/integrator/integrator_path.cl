@@ -1,4 +1,5 @@
-// Megakernel path tracer: one work-item per pixel traces `sample_count` whole paths, each
+// Megakernel path tracer: one work-item per pixel (eight with CD_PACKETS) traces `sample_count`
+// whole paths per pixel, each
 // from a point drawn with the pixel filter's density (filter.cl), and folds them into the
 // film with Welford's running mean and squared deviations.
 // Strategies (no MIS, each light path counted exactly once):
@@ -385,8 +386,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
 // the left; inside a whole tile the order is the Z-order (Morton 1966, A Computer Oriented
 // Geodetic Data Base and a New Technique in File Sequencing: x in the even bits of the
 // index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
-// Neighbouring work-items (a work-group of 64 is about one tile) trace neighbouring primary
-// rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
+// Neighbouring work-items (a work-group of 64 launch indices is about one tile) trace
+// neighbouring primary rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
 // the pixel only, so the order changes no image.
 uint pixel_of_launch_index(uint i, uint width, uint height) {
   uint band = i / (8u * width), in_band = i - band * 8u * width;
@@ -430,7 +431,8 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 // CD_PACKETS=1 (CPU devices, set by the host): a work-item takes eight consecutive launch
 // indices (a 4x2 block of a tile) and traces their camera rays as one packet
 // (bvh_intersect8), then each path on its own. The same samples, bit for bit, as one
-// work-item per index, up to a tie between two triangles at exactly the same distance.
+// work-item per index, but where a camera ray meets two triangles within rounding of one
+// distance (the packet may test them in another order and keep the other).
 #ifndef CD_PACKETS
 #define CD_PACKETS 0
 #endif

@@ -56,15 +56,15 @@ void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
 
 }  // namespace
 
-bool render_packets(const DeviceEntry& device) {
-  return (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+bool render_packets(const DeviceEntry& device, const RenderSettings& settings) {
+  return settings.packets && (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
 }
 
 std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings,
                                   const DeviceEntry& device) {
   std::string options = "-cl-std=CL1.2 " + features.build_options();
   options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
-  if (render_packets(device)) options += " -DCD_PACKETS=1";
+  if (render_packets(device, settings)) options += " -DCD_PACKETS=1";
   return options;
 }
 
@@ -131,8 +131,11 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
     throw Error("render_paths takes " + std::to_string(kernel_.getInfo<CL_KERNEL_NUM_ARGS>()) +
                 " arguments, but the host binds " + std::to_string(want_args) +
                 " (CD_SCENE_BUFFERS out of step with the kernel)");
-  local_size_ = std::min<size_t>(64, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
-  pixels_per_item_ = render_packets(device_) ? 8 : 1;
+  // Work-groups of 64 launch indices (with packets, 8 work-items of 8)
+  pixels_per_item_ = render_packets(device_, settings) ? 8 : 1;
+  local_size_ =
+      std::min<size_t>(64 / pixels_per_item_, kernel_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device));
+  group_pixels_ = local_size_ * pixels_per_item_;
 
   const AnisotropicAlbedo anisotropic = anisotropic_albedo(scene.features.anisotropy, scene.buffers.materials);
 #define CD_UPLOAD(type, name)                                                     \
@@ -160,7 +163,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.filter = uint32_t(settings.filter);
 
   size_t pixels = size_t(settings.width) * settings.height;
-  chunk_ = std::min(pixels, std::max<size_t>(local_size_, 4096));
+  chunk_ = std::min(pixels, std::max<size_t>(group_pixels_, 4096));
   size_t film_bytes = pixels * 4 * sizeof(float);
   try {
     params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
@@ -209,7 +212,8 @@ bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const s
     // Next launch: about launch_seconds of pixels at the measured cost
     double cost = dt / (double(end - begin) * count);
     size_t want = size_t(settings_.launch_seconds / std::max(cost * count, 1e-12));
-    chunk_ = std::clamp((want + local_size_ - 1) / local_size_ * local_size_, std::min(local_size_, pixels), pixels);
+    chunk_ =
+        std::clamp((want + group_pixels_ - 1) / group_pixels_ * group_pixels_, std::min(group_pixels_, pixels), pixels);
     if (end < pixels && progress) progress(double(end) / double(pixels));
   }
   // Next range: whole-image launches of several samples once one sample is cheap enough

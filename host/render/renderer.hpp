@@ -53,6 +53,9 @@ struct RenderSettings {
   PixelFilter filter = PixelFilter::Box;
   Sampler sampler = Sampler::Sobol;
   double launch_seconds = 0.2;  // target duration of one launch
+  // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
+  // work-item on every device (the same samples: tests compare the two kernels)
+  bool packets = true;
   // Called with the device's description before its kernel is built from source (not in
   // the kernel cache): seconds on PoCL, minutes on rusticl
   std::function<void(const std::string&)> before_kernel_compile;
@@ -82,8 +85,9 @@ struct RenderResult {
 std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings,
                                   const DeviceEntry& device);
 // Whether render_paths traces camera rays in packets of eight on the device (CD_PACKETS):
-// on CPU devices, where packets are what puts the traversal's tests in SIMD lanes
-bool render_packets(const DeviceEntry& device);
+// on CPU devices, where packets are what puts the traversal's tests in SIMD lanes, unless
+// the settings turn them off
+bool render_packets(const DeviceEntry& device, const RenderSettings& settings);
 
 // Builds the render kernel program into the kernel cache on threads of their own, while
 // the caller goes on (compiling the scene): a DeviceRenderer made after wait() finds the
@@ -161,6 +165,7 @@ class DeviceRenderer {
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
   size_t pixels_per_item_ = 1;  // 8 with packets (render_packets)
+  size_t group_pixels_ = 1;     // launch indices per work-group: local_size_ x pixels_per_item_
   size_t chunk_ = 1;            // launch indices (pixels) per launch
   uint32_t batch_ = 1;          // samples per pixel for the next range
   double pass_seconds_ = 0.0;   // one sample of every pixel, measured; 0 = not yet

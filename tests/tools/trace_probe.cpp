@@ -1,14 +1,18 @@
-// Closest-hit traversal two ways on one OpenCL device (a benchmark, not a test): the
-// renderer's bvh_intersect, one work-item walking alone, and bvh_intersect_group (below), the
-// same walk cut into loop-free steps with a barrier after each, which a CPU driver's
-// work-group vectorizer could run as SIMD across work-items. The scene's BVH as
-// `candela render` builds it; two ray sets of `rays` rays each:
+// Closest-hit traversal four ways on one OpenCL device (a benchmark, not a test), the same
+// hits from each:
+//   scalar:  the renderer's bvh_intersect, one ray per work-item;
+//   group:   bvh_intersect_group (below), the same walk cut into loop-free steps with a
+//            barrier after each, on scalars, which a CPU driver's work-group vectorizer could
+//            run as SIMD across work-items;
+//   lanes8:  eight rays per work-item in float8 lanes, each lane loading its own node or
+//            triangle and keeping its own stack;
+//   packet8: eight rays per work-item walking the same nodes, the renderer's bvh_intersect8.
+// The scene's BVH as `candela render` builds it; two ray sets of `rays` rays each:
 //   camera: a pinhole view of the whole scene from the +z side, in 8x8 pixel tiles (one
-//           work-group each), as the renderer's primary rays;
+//           work-group of the scalar walks each; the eight-ray walks take rows of 8 pixels);
 //   random: origins uniform in the scene's box, directions uniform on the sphere (bounce rays).
 // One JSON line per ray set, kernel and round: seconds (launch to finish), nanoseconds per ray,
-// the share of rays that hit, and whether the group walk's hits equal the scalar walk's bit
-// for bit.
+// the share of rays that hit, and how many rays' hits differ from the scalar walk's.
 //
 // Usage: candela_trace_probe SCENE.gltf [DEVICE_SUBSTRING (pocl)] [ROUNDS (3)] [RAYS (262144)]
 #include <chrono>
@@ -374,7 +378,7 @@ int main(int argc, char** argv) {
       for (const auto& log : e.getBuildLog()) std::fprintf(stderr, "%s\n", log.second.c_str());
       throw;
     }
-    // The scene's box from its root node's children
+    // The scene's box from its vertex positions
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i + 2 < b.positions.size(); i += 3)
       for (int a = 0; a < 3; ++a)
