@@ -19,6 +19,8 @@ constexpr float kTraversalCost = 1.0f;                // relative to one triangl
 constexpr float kEmptyLo = 1e30f, kEmptyHi = -1e30f;  // an unused child slot's box
 // Ranges of at least this many refs bin on every thread during the serial top phase
 constexpr uint32_t kParallelBinning = 32768;
+// Ranges of at least this many refs are binned into two sets of bins (Builder::bin)
+constexpr uint32_t kTwoBinSets = 256;
 // The top phase hands subtrees of at most max(kMinJobRefs, refs / kJobsPerTree) refs to
 // the workers: independent of the thread count, so that the tree (node order included) is
 constexpr uint32_t kMinJobRefs = 4096;
@@ -437,18 +439,33 @@ class Builder {
     }
   }
 
-  void bin(const Binner& b, uint32_t begin, uint32_t end, Bins* bins) const {
-    for (uint32_t i = begin; i < end; ++i) {
-      const Ref& ref = refs_[i];
+  void bin(const Binner& b, uint32_t begin, uint32_t end, int nbins, Bins* bins) const {
+    auto add = [&](const Ref& ref, Bins* to) {
       v4f lo = ref.box_lo(), hi = ref.hi;
       v4i k = b.index(lo + hi);
       for (int a = 0; a < 3; ++a) {
         int j = k[a];
-        bins->lo[a][j] = vmin(bins->lo[a][j], lo);
-        bins->hi[a][j] = vmax(bins->hi[a][j], hi);
-        bins->count[a][j]++;
+        to->lo[a][j] = vmin(to->lo[a][j], lo);
+        to->hi[a][j] = vmax(to->hi[a][j], hi);
+        to->count[a][j]++;
       }
+    };
+    if (end - begin < kTwoBinSets) {
+      for (uint32_t i = begin; i < end; ++i) add(refs_[i], bins);
+      return;
     }
+    // Neighbouring refs mostly share their bins (the partitions keep them in space order):
+    // even and odd refs go to separate sets, so that one ref's update does not wait for the
+    // store of the one before. min, max and counts do not depend on the order: the same bins
+    Bins odd;
+    odd.clear(nbins);
+    uint32_t i = begin;
+    for (; i + 1 < end; i += 2) {
+      add(refs_[i], bins);
+      add(refs_[i + 1], &odd);
+    }
+    if (i < end) add(refs_[i], bins);
+    bins->merge(odd, nbins);
   }
 
   // The bins of range r's centroid bounds; usable[a]: whether axis a can be binned
@@ -522,11 +539,11 @@ class Builder {
       std::vector<Bins> part(static_cast<size_t>(threads_));
       for (Bins& p : part) p.clear(nbins);
       parallel_for_indexed(count, [&](int t, size_t b, size_t e) {
-        bin(binner, r.begin + uint32_t(b), r.begin + uint32_t(e), &part[size_t(t)]);
+        bin(binner, r.begin + uint32_t(b), r.begin + uint32_t(e), nbins, &part[size_t(t)]);
       });
       for (const Bins& p : part) bins.merge(p, nbins);
     } else {
-      bin(binner, r.begin, r.end, &bins);
+      bin(binner, r.begin, r.end, nbins, &bins);
     }
     int best_axis = -1, best_plane = 0;
     float best_cost = 1e30f;
