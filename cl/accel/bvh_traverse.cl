@@ -383,3 +383,71 @@ void bvh_intersect8(const struct SceneData* sc, __global const BvhNode* nodes, _
     hits[l].prim = p[l] >= 0 ? (int)tris[p[l]].prim : -1;
   }
 }
+
+// Any hit in (0, tmax[l]) for each of rays[0..7] (bvh_occluded's answer, as a mask: -1 for an
+// occluded ray); a ray with tmax < 0 takes no part (0). A ray's bound becomes -1 once it is
+// occluded, so that it enters no more boxes and hits no more triangles; the walk ends when no
+// ray is left. Children are visited nearest first by the smallest entry over the rays.
+int8 bvh_occluded8(const struct SceneData* sc, __global const BvhNode* nodes, __global const BvhTriangle* tris,
+                   const Ray* rays, const float* tmax) {
+  BvhRays8 r = bvh_rays8(rays);
+  float8 bound = vload8(0, tmax);
+  int8 occluded = (int8)(0);
+  int stack[BVH_STACK_SIZE];
+  int sp = 0;
+  int ref = 0;  // >= 0: a node; < 0: a leaf starting at triangle ~ref
+  while (any(bound >= 0.0f)) {
+    if (ref >= 0) {
+      __global const float* b = (__global const float*)&nodes[ref];
+      float d0 = bvh_min8(bvh_child_entry8(b, 0, &r, bound));
+      float d1 = bvh_min8(bvh_child_entry8(b, 1, &r, bound));
+      float d2 = bvh_min8(bvh_child_entry8(b, 2, &r, bound));
+      float d3 = bvh_min8(bvh_child_entry8(b, 3, &r, bound));
+      int4 k = vload4(0, nodes[ref].child);
+      int c0 = k.s0, c1 = k.s1, c2 = k.s2, c3 = k.s3;
+      BVH_SORT2(d0, c0, d1, c1);
+      BVH_SORT2(d2, c2, d3, c3);
+      BVH_SORT2(d0, c0, d2, c2);
+      BVH_SORT2(d1, c1, d3, c3);
+      BVH_SORT2(d1, c1, d2, c2);
+      if (d0 != INFINITY) {
+        stack[sp] = c3;
+        sp += d3 != INFINITY;
+        stack[sp] = c2;
+        sp += d2 != INFINITY;
+        stack[sp] = c1;
+        sp += d1 != INFINITY;
+        ref = c0;
+        continue;
+      }
+    } else {
+      for (int i = ~ref;; ++i) {
+        __global const BvhTriangle* tri = &tris[i];
+        uint flags = tri->flags;
+        float8 v[9] = {(float8)(tri->v0[0]), (float8)(tri->v0[1]), (float8)(tri->v0[2]),
+                       (float8)(tri->v1[0]), (float8)(tri->v1[1]), (float8)(tri->v1[2]),
+                       (float8)(tri->v2[0]), (float8)(tri->v2[1]), (float8)(tri->v2[2])};
+        float8 t, b1, b2;
+        int8 hit = intersect_triangle8(&r, v, bound, &t, &b1, &b2);
+#if CD_FEATURE_ALPHA
+        if ((flags & BVH_TRI_ALPHA_TEST) && any(hit)) {
+          int h[8];
+          float vb1[8], vb2[8];
+          vstore8(hit, 0, h);
+          vstore8(b1, 0, vb1);
+          vstore8(b2, 0, vb2);
+          for (int l = 0; l < 8; ++l)
+            if (h[l]) h[l] = scene_alpha_passes(sc, tri->prim, vb1[l], vb2[l], rays[l]) ? -1 : 0;
+          hit = vload8(0, h);
+        }
+#endif
+        occluded |= hit;
+        bound = select(bound, (float8)(-1.0f), hit);
+        if (flags & BVH_TRI_LAST) break;
+      }
+    }
+    if (sp == 0) break;
+    ref = stack[--sp];
+  }
+  return occluded;
+}
