@@ -80,48 +80,27 @@ PathState path_start(const SceneData* sc, Ray ray) {
   return ps;
 }
 
-// The shadow ray of a light sample seen from ctx.p and its length (INFINITY toward a light at
-// infinity); false: none (the sample lies at ctx.p). It leaves from the side of the surface
-// that wi leaves from.
-bool path_shadow_ray_of(const LightSampleContext* ctx, const LightSample* ls, Ray* shadow, float* tmax) {
-  shadow->org = offset_ray_origin(ctx->p, ctx->n * (dot(ls->wi, ctx->n) >= 0.0f ? 1.0f : -1.0f));
-  *tmax = INFINITY;
-  shadow->dir = ls->wi;
-  if (!ls->at_infinity) {
-    float3 d = ls->target - shadow->org;
-    *tmax = length(d);
-    if (!(*tmax > 0.0f)) return false;
-    shadow->dir = d / *tmax;
-  }
-  return true;
-}
-
 // Fraction of a light sample's radiance that reaches ctx.p: 0 or 1 (blocked or not), and with
-// CD_FEATURE_MEDIA the transmittance of the media on the way (starting in `media`)
+// CD_FEATURE_MEDIA the transmittance of the media on the way (starting in `media`). The
+// shadow ray leaves from the side of the surface that wi leaves from.
 float3 path_shadow_ray(const SceneData* sc, const LightSampleContext* ctx, const LightSample* ls,
                        const MediumStack* media, Rng* rng) {
   Ray shadow;
-  float tmax;
-  if (!path_shadow_ray_of(ctx, ls, &shadow, &tmax)) return (float3)(0.0f);
+  shadow.org = offset_ray_origin(ctx->p, ctx->n * (dot(ls->wi, ctx->n) >= 0.0f ? 1.0f : -1.0f));
+  float tmax = INFINITY;
+  shadow.dir = ls->wi;
+  if (!ls->at_infinity) {
+    float3 d = ls->target - shadow.org;
+    tmax = length(d);
+    if (!(tmax > 0.0f)) return (float3)(0.0f);
+    shadow.dir = d / tmax;
+  }
 #if CD_FEATURE_MEDIA
   return media_shadow_transmittance(sc, shadow, tmax, *media, rng);
 #else
   return scene_occluded(sc, shadow, tmax) ? (float3)(0.0f) : (float3)(1.0f);
 #endif
 }
-
-// The light sample of a path's first vertex with its shadow ray not yet traced (without
-// CD_FEATURE_MEDIA, where a shadow ray is a yes-or-no test that draws no random number):
-// `weight` (the throughput times the unshadowed contribution) counts unless the ray meets
-// something in (0, tmax); tmax < 0: no shadow ray (weight 0). path_trace adds that term
-// last, so that a caller may trace the shadow rays of neighbouring paths together
-// (CD_PACKETS) and add weight x (0 or 1) for the same sum, bit for bit, as path_trace's
-// throughput x (contribution x (0 or 1)) (unless the product overflows).
-typedef struct {
-  Ray ray;
-  float tmax;
-  float3 weight;
-} PathShadow;
 
 // The pdf lobe c of solid angle W puts at angle d from its centre (normalized on the
 // plane of small angles): a cosine lobe's cos d / pi for W >= pi, else the GGX-shaped
@@ -205,13 +184,9 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
 // `lobes` (STRATEGY_AUTO), only of a light the vertex takes by light sampling (the others
 // count when a sampled ray finds them: a sample of one contributes nothing here).
 // `media`: the media on wo's side; a shadow ray through the surface enters (or leaves)
-// `interior`, the medium inside the surface. With `deferred` (never with CD_FEATURE_MEDIA),
-// the shadow ray is not traced: it goes to *deferred (tmax < 0: none), and the result is the
-// unshadowed contribution (0 when there is no shadow ray).
+// `interior`, the medium inside the surface.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
-                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng,
-                         PathShadow* deferred) {
-  if (deferred) deferred->tmax = -1.0f;
+                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
   uint x_select;
   float u_select;
   lights_select_numbers(sc, rng, &x_select, &u_select);
@@ -233,11 +208,6 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
   if (dot(ls.wi, ctx->n) < 0.0f) media_cross(&st, interior, bsdf->entering);
   return contrib * path_shadow_ray(sc, ctx, &ls, &st, rng);
 #else
-  if (deferred) {
-    if (path_shadow_ray_of(ctx, &ls, &deferred->ray, &deferred->tmax)) return contrib;
-    deferred->tmax = -1.0f;
-    return (float3)(0.0f);
-  }
   return contrib * path_shadow_ray(sc, ctx, &ls, media, rng);
 #endif
 }
@@ -304,18 +274,11 @@ void path_cross_boundary(const SceneData* sc, PathState* ps, const SurfaceHit* s
 #endif
 
 // Radiance along one camera ray; `first`: the camera ray's closest hit when it is known
-// already (traced in a packet), else 0. The term of the first vertex's light sample is added
-// last; with `first_shadow` (never with CD_FEATURE_MEDIA) it is left out, and its shadow ray
-// and weight go to *first_shadow for the caller to trace (PathShadow).
-float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng, PathShadow* first_shadow) {
+// already (traced in a packet), else 0
+float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng) {
   __global const RenderParams* params = sc->params;
   const uint strategy = params->strategy;
   PathState ps = path_start(sc, camera_ray);
-  float3 first_light = (float3)(0.0f);  // the first vertex's light sample (unshadowed with first_shadow)
-  if (first_shadow) {
-    first_shadow->ray = camera_ray;  // any finite ray: tmax < 0 until a light sample sets it
-    first_shadow->tmax = -1.0f;
-  }
   for (;; ++ps.depth) {
     Hit hit;
     if (first) {
@@ -390,12 +353,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     if (chooses) lobes = bsdf_lobes(&bsdf, wo);
     LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
     if (samples_lights) {
-      float3 l = ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
-                                             sc->materials[s.material].medium, rng, ps.depth == 0u ? first_shadow : 0);
-      if (ps.depth == 0u)
-        first_light = l;
-      else
-        ps.radiance += l;
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
+                                                 sc->materials[s.material].medium, rng);
     }
 
     // Continue the path by sampling the BSDF
@@ -419,11 +378,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     if (bs.flags & BSDF_TRANSMISSION) path_cross_boundary(sc, &ps, &s);
 #endif
   }
-  if (first_shadow) {
-    first_shadow->weight = first_light;
-    return ps.radiance;
-  }
-  return ps.radiance + first_light;
+  return ps.radiance;
 }
 
 // The pixel (row-major index) of launch index i, 0 <= i < width * height: launches hand out
@@ -483,10 +438,6 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 #endif
 
 #if CD_PACKETS
-// The first vertices' shadow rays go as a packet when each lies within this cosine of their
-// mean direction
-#define PACKET_SHADOW_COS 0.95f
-
 // (Loops over the eight lanes have a fixed trip count, and structs reach the arrays from
 // locals: llvmpipe mistranslated a lane loop with a data-dependent bound and a struct
 // returned straight into an array element.)
@@ -518,52 +469,13 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
     }
     Hit hits[8];
     scene_intersect8(&sc, rays, tmax, hits);
-#if CD_FEATURE_MEDIA
     for (uint l = 0u; l < 8u; ++l) {
       if (first + l >= params->pixel_end) continue;
       Ray ray = rays[l];
       Hit hit = hits[l];
       Rng r = rng[l];
-      film_add(&mean[l], &m2[l], path_trace(&sc, ray, &hit, &r, 0));
+      film_add(&mean[l], &m2[l], path_trace(&sc, ray, &hit, &r));
     }
-#else
-    // The paths, their first vertices' shadow rays left out; then those as one packet
-    float3 radiance[8], weight[8];
-    Ray shadow[8];
-    float shadow_tmax[8];
-    for (uint l = 0u; l < 8u; ++l) {
-      Ray ray = rays[l];
-      Hit hit = hits[l];
-      Rng r = rng[l];
-      PathShadow sh;
-      float3 radiance_l = path_trace(&sc, ray, &hit, &r, &sh);
-      radiance[l] = radiance_l;
-      weight[l] = sh.weight;
-      shadow[l].org = sh.ray.org;
-      shadow[l].dir = sh.ray.dir;
-      shadow_tmax[l] = first + l < params->pixel_end ? sh.tmax : -1.0f;
-    }
-    // As a packet when the rays point about the same way (toward a small light), else each on
-    // its own (a packet of rays in all directions, as toward an environment, walks the union
-    // of their subtrees): the same answers either way
-    float3 axis = (float3)(0.0f);
-    for (uint l = 0u; l < 8u; ++l)
-      if (shadow_tmax[l] >= 0.0f) axis += shadow[l].dir;
-    bool coherent = true;
-    for (uint l = 0u; l < 8u; ++l)
-      if (shadow_tmax[l] >= 0.0f && dot(shadow[l].dir, axis) < PACKET_SHADOW_COS * length(axis)) coherent = false;
-    int occluded[8];
-    if (coherent) {
-      vstore8(scene_occluded8(&sc, shadow, shadow_tmax), 0, occluded);
-    } else {
-      for (uint l = 0u; l < 8u; ++l)
-        occluded[l] = shadow_tmax[l] >= 0.0f && scene_occluded(&sc, shadow[l], shadow_tmax[l]);
-    }
-    for (uint l = 0u; l < 8u; ++l) {
-      if (first + l >= params->pixel_end) continue;
-      film_add(&mean[l], &m2[l], radiance[l] + weight[l] * (occluded[l] ? 0.0f : 1.0f));
-    }
-#endif
   }
   for (uint l = 0u; l < 8u; ++l) {
     if (first + l >= params->pixel_end) continue;
@@ -585,7 +497,7 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
     Ray ray = pixel_camera_ray(params, px, py, &rng);
-    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng, 0));
+    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng));
   }
   film_mean[pixel] = mean;
   film_m2[pixel] = m2;

@@ -22,11 +22,6 @@ void scene_intersect8(const SceneData* sc, const Ray* rays, const float* tmax, H
   bvh_intersect8(sc, sc->bvh_nodes, sc->bvh_tris, rays, tmax, hits);
 }
 
-// scene_occluded of eight rays at once (bvh_occluded8: -1 where occluded; tmax < 0: no ray, 0)
-int8 scene_occluded8(const SceneData* sc, const Ray* rays, const float* tmax) {
-  return bvh_occluded8(sc, sc->bvh_nodes, sc->bvh_tris, rays, tmax);
-}
-
 // Anything in (0, tmax) along the ray, by the same alpha tests?
 bool scene_occluded(const SceneData* sc, Ray ray, float tmax) {
   return bvh_occluded(sc, sc->bvh_nodes, sc->bvh_tris, ray, tmax);
