@@ -1,8 +1,11 @@
 // A std::vector whose resize() leaves trivially constructible elements uninitialized, for
 // large arrays that are written in full right after, by several threads: their memory is
 // then touched once, by the threads that fill it, instead of being zeroed first by one.
+// Its storage is aligned to kHostArrayAlignment bytes, so that an OpenCL CPU device can
+// use it as a buffer's memory (CL_MEM_USE_HOST_PTR; PoCL asks for 128).
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -10,6 +13,8 @@
 #include <vector>
 
 namespace candela {
+
+constexpr size_t kHostArrayAlignment = 128;
 
 template <class T>
 struct DefaultInitAllocator : std::allocator<T> {
@@ -21,6 +26,11 @@ struct DefaultInitAllocator : std::allocator<T> {
   DefaultInitAllocator() = default;
   template <class U>
   DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  T* allocate(size_t n) {
+    if (n > size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(kHostArrayAlignment)));
+  }
+  void deallocate(T* p, size_t) noexcept { ::operator delete(p, std::align_val_t(kHostArrayAlignment)); }
   // Default-initialization: nothing is written for a trivially constructible U
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {

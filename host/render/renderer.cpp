@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
 #include <thread>
 
 #include "base/error.hpp"
+#include "base/uninit_vector.hpp"
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
@@ -44,6 +46,40 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
   } catch (const cl::Error& e) {
     throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
   }
+}
+
+// A read-only buffer over the memory of `held` itself (CL_MEM_USE_HOST_PTR), which the
+// caller keeps alive as long as the buffer: for a CPU device, which reads host memory, where
+// a copy would cost the time and the memory of the array once more
+template <typename T, typename A>
+cl::Buffer adopt(const cl::Context& ctx, const DeviceEntry& device, std::vector<T, A>& held, const char* what) {
+  size_t bytes = held.size() * sizeof(T);
+  if (bytes > device.max_alloc)
+    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +
+                device.description() + " allows (" + format_mib(device.max_alloc) + ")");
+  try {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, bytes, held.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
+  }
+}
+
+// Whether a scene's arrays may become the device's buffers in place (adopt): a CPU device
+// that shares the host's memory, with an alignment the arrays meet
+bool adopts_host_arrays(const DeviceEntry& device) {
+  try {
+    return (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) &&
+           device.device.getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() &&
+           device.device.getInfo<CL_DEVICE_MEM_BASE_ADDR_ALIGN>() / 8 <= kHostArrayAlignment;
+  } catch (const cl::Error&) {
+    return false;
+  }
+}
+
+// Whether v's storage meets the alignment of adopted arrays (UninitVector's allocator does)
+template <typename T, typename A>
+bool host_array_aligned(const std::vector<T, A>& v) {
+  return !v.empty() && reinterpret_cast<uintptr_t>(v.data()) % kHostArrayAlignment == 0;
 }
 
 void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
@@ -138,9 +174,18 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   group_pixels_ = local_size_ * pixels_per_item_;
 
   const AnisotropicAlbedo anisotropic = anisotropic_albedo(scene.features.anisotropy, scene.buffers.materials);
-#define CD_UPLOAD(type, name)                                                     \
-  scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name)); \
-  if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);
+  // On a CPU device, the aligned arrays (the BVH's) that the scene releases become the
+  // buffers in place (kept in host_arrays_); the others are copied, and released one by one
+  const bool adopts = release && adopts_host_arrays(device_);
+#define CD_UPLOAD(type, name)                                                                                      \
+  if (adopts && std::string(#name) != "lights" && host_array_aligned(release->buffers.name)) {                     \
+    auto held = std::make_shared<std::decay_t<decltype(release->buffers.name)>>(std::move(release->buffers.name)); \
+    scene_buffers_.push_back(adopt(context_, device_, *held, #name));                                              \
+    host_arrays_.push_back(held);                                                                                  \
+  } else {                                                                                                         \
+    scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));                                \
+    if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);  \
+  }
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
   if (settings.energy_compensation)
@@ -177,6 +222,14 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
     queue_.finish();
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("allocating the film", e.err()));
+  }
+}
+
+DeviceRenderer::~DeviceRenderer() {
+  if (host_arrays_.empty()) return;
+  try {
+    queue_.finish();
+  } catch (const cl::Error&) {  // a lost device: nothing left to wait for
   }
 }
 

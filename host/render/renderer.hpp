@@ -125,9 +125,14 @@ class DeviceRenderer {
   // the sheen albedo table (host/device/sheen_albedo.hpp). `camera`:
   // the device record for settings.width x settings.height (compile/camera.hpp).
   // `release`: the same scene, whose host arrays are freed one by one once uploaded (for
-  // the last device that uploads them; CompiledScene::release_host_arrays)
+  // the last device that uploads them; CompiledScene::release_host_arrays); a CPU device
+  // takes the BVH's arrays over as its buffers instead of copying them
   DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const dev::Camera& camera,
                  const RenderSettings& settings, CompiledScene* release = nullptr);
+  // Waits for the device's work when buffers use host arrays that are about to be freed
+  ~DeviceRenderer();
+  DeviceRenderer(const DeviceRenderer&) = delete;
+  DeviceRenderer& operator=(const DeviceRenderer&) = delete;
 
   // Adds sample indices [sample_begin, sample_begin + count) to every pixel, in launches
   // of about settings.launch_seconds over ranges of launch indices (8x8 tiles of pixels,
@@ -160,6 +165,8 @@ class DeviceRenderer {
   cl::Context context_;
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
+  // The memory of the buffers made over host arrays (declared first: freed after the buffers)
+  std::vector<std::shared_ptr<void>> host_arrays_;
   std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};
