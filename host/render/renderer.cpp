@@ -32,15 +32,19 @@ std::string format_mib(uint64_t bytes) {
   return buf;
 }
 
+void check_buffer_size(const DeviceEntry& device, size_t bytes, const char* what) {
+  if (bytes > device.max_alloc)
+    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +
+                device.description() + " allows (" + format_mib(device.max_alloc) + ")");
+}
+
 // A read-only buffer holding `data`, or one dummy element when it is empty
 template <typename T, typename A>
 cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::vector<T, A>& data, const char* what) {
   std::vector<T, A> one(1, T{});
   const std::vector<T, A>& src = data.empty() ? one : data;
   size_t bytes = src.size() * sizeof(T);
-  if (bytes > device.max_alloc)
-    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +
-                device.description() + " allows (" + format_mib(device.max_alloc) + ")");
+  check_buffer_size(device, bytes, what);
   try {
     return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(src.data()));
   } catch (const cl::Error& e) {
@@ -50,15 +54,12 @@ cl::Buffer upload(const cl::Context& ctx, const DeviceEntry& device, const std::
 
 // A read-only buffer over the memory of `held` itself (CL_MEM_USE_HOST_PTR), which the
 // caller keeps alive as long as the buffer: for a CPU device, which reads host memory, where
-// a copy would cost the time and the memory of the array once more
+// a copy would cost the time and the memory of the array once more (its size checked
+// already: adoptable)
 template <typename T, typename A>
-cl::Buffer adopt(const cl::Context& ctx, const DeviceEntry& device, std::vector<T, A>& held, const char* what) {
-  size_t bytes = held.size() * sizeof(T);
-  if (bytes > device.max_alloc)
-    throw Error(std::string("the scene's ") + what + " need " + format_mib(bytes) + " in one buffer, more than " +
-                device.description() + " allows (" + format_mib(device.max_alloc) + ")");
+cl::Buffer adopt(const cl::Context& ctx, std::vector<T, A>& held, const char* what) {
   try {
-    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, bytes, held.data());
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, held.size() * sizeof(T), held.data());
   } catch (const cl::Error& e) {
     throw Error(cl_error_message(std::string("uploading ") + what, e.err()));
   }
@@ -76,10 +77,18 @@ bool adopts_host_arrays(const DeviceEntry& device) {
   }
 }
 
-// Whether v's storage meets the alignment of adopted arrays (UninitVector's allocator does)
+// Whether `v` may become a buffer in place (adopt): an UninitVector, whose allocator aligns
+// it as adopts_host_arrays asks, not empty and within the device's largest buffer (else an
+// Error, before anything is moved)
 template <typename T, typename A>
-bool host_array_aligned(const std::vector<T, A>& v) {
-  return !v.empty() && reinterpret_cast<uintptr_t>(v.data()) % kHostArrayAlignment == 0;
+bool adoptable(const DeviceEntry&, const std::vector<T, A>&, const char*) {
+  return false;
+}
+template <typename T>
+bool adoptable(const DeviceEntry& device, const UninitVector<T>& v, const char* what) {
+  if (v.empty() || reinterpret_cast<uintptr_t>(v.data()) % kHostArrayAlignment != 0) return false;
+  check_buffer_size(device, v.size() * sizeof(T), what);
+  return true;
 }
 
 void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
@@ -174,14 +183,15 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   group_pixels_ = local_size_ * pixels_per_item_;
 
   const AnisotropicAlbedo anisotropic = anisotropic_albedo(scene.features.anisotropy, scene.buffers.materials);
-  // On a CPU device, the aligned arrays (the BVH's) that the scene releases become the
+  // On a CPU device, the UninitVector arrays (the BVH's) that the scene releases become the
   // buffers in place (kept in host_arrays_); the others are copied, and released one by one
   const bool adopts = release && adopts_host_arrays(device_);
+  host_arrays_.reserve(dev::kSceneBufferCount);
 #define CD_UPLOAD(type, name)                                                                                      \
-  if (adopts && std::string(#name) != "lights" && host_array_aligned(release->buffers.name)) {                     \
+  if (adopts && std::string(#name) != "lights" && adoptable(device_, release->buffers.name, #name)) {              \
     auto held = std::make_shared<std::decay_t<decltype(release->buffers.name)>>(std::move(release->buffers.name)); \
-    scene_buffers_.push_back(adopt(context_, device_, *held, #name));                                              \
     host_arrays_.push_back(held);                                                                                  \
+    scene_buffers_.push_back(adopt(context_, *held, #name));                                                       \
   } else {                                                                                                         \
     scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));                                \
     if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);  \

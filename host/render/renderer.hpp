@@ -146,6 +146,8 @@ class DeviceRenderer {
   uint32_t suggested_batch(double seconds_left) const;
 
   Film film();  // reads the film back from the device
+  // How many of the scene's buffers are host arrays taken over in place (adopt)
+  size_t adopted_buffers() const { return host_arrays_.size(); }
   double kernel_build_seconds() const { return kernel_build_seconds_; }
   bool kernel_from_cache() const { return kernel_from_cache_; }
   // A KernelPrebuild built this worker's program from source and this worker loaded it
@@ -162,11 +164,12 @@ class DeviceRenderer {
 
   DeviceEntry device_;
   RenderSettings settings_;
+  // The memory of the buffers made over host arrays (declared before the OpenCL objects:
+  // freed after them)
+  std::vector<std::shared_ptr<void>> host_arrays_;
   cl::Context context_;
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
-  // The memory of the buffers made over host arrays (declared first: freed after the buffers)
-  std::vector<std::shared_ptr<void>> host_arrays_;
   std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
   cl::Buffer params_, film_mean_, film_m2_;
   dev::RenderParams params_host_{};

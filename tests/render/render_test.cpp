@@ -227,6 +227,34 @@ TEST(Packets, SameSamplesAsOnePixelPerWorkItem) {
   }
 }
 
+// The CLI's renderer frees the compiled scene's host arrays as it uploads them, and a CPU
+// device takes the BVH's arrays over as its buffers instead of copying them: the same image
+// as a renderer that copies every array (as library users' renderers do)
+TEST(Render, ReleasedHostArraysGiveTheSameImage) {
+  DeviceEntry device = pocl_device();
+  for (const char* name : {"cornell-box/cornell-box.gltf", "materials/materials.gltf"}) {
+    Scene loaded = load_gltf(scene_path(name));
+    RenderSettings settings;
+    settings.width = 40;
+    settings.height = 30;
+    settings.seed = 3;
+    auto kept = std::make_shared<const CompiledScene>(compile_scene(loaded));
+    auto released = std::make_shared<CompiledScene>(compile_scene(loaded));
+    Renderer copying({device}, kept, scene_camera(loaded, settings), settings);
+    Renderer adopting({device}, released, scene_camera(loaded, settings), settings, true);
+    EXPECT_EQ(copying.worker().adopted_buffers(), 0u) << name;
+    EXPECT_EQ(adopting.worker().adopted_buffers(), 2u) << name << ": the BVH's nodes and triangles";
+    EXPECT_TRUE(released->buffers.bvh_nodes.empty() && released->buffers.bvh_tris.empty()) << name;
+    EXPECT_FALSE(kept->buffers.bvh_nodes.empty()) << name;
+    Film a = copying.render(0, 4).film, b = adopting.render(0, 4).film;
+    EXPECT_EQ(a.mean, b.mean) << name;
+    EXPECT_EQ(a.m2, b.m2) << name;
+    double sum = 0.0;
+    for (size_t i = 0; i < b.mean.size(); i += 4) sum += b.mean[i];
+    EXPECT_GT(sum, 0.0) << name << ": a black image";
+  }
+}
+
 TEST(Determinism, SameSeedSameImageWhateverTheLaunchSplit) {
   DeviceEntry device = pocl_device();
   Scene scene = load_gltf(scene_path("cornell-box/cornell-box.gltf"));
