@@ -153,6 +153,18 @@ void KernelPrebuild::wait() {
   threads_.clear();
 }
 
+template <typename V>
+void DeviceRenderer::add_scene_buffer(const V& data, V* released, bool adopts, const char* what) {
+  if (released && adopts && adoptable(device_, *released, what)) {
+    auto held = std::make_shared<V>(std::move(*released));
+    host_arrays_.push_back(held);
+    scene_buffers_.push_back(adopt(context_, *held, what));
+    return;
+  }
+  scene_buffers_.push_back(upload(context_, device_, data, what));
+  if (released) V().swap(*released);
+}
+
 DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& scene, const dev::Camera& camera,
                                const RenderSettings& settings, CompiledScene* release)
     : device_(device), settings_(settings) {
@@ -187,15 +199,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   // buffers in place (kept in host_arrays_); the others are copied, and released one by one
   const bool adopts = release && adopts_host_arrays(device_);
   host_arrays_.reserve(dev::kSceneBufferCount);
-#define CD_UPLOAD(type, name)                                                                                      \
-  if (adopts && std::string(#name) != "lights" && adoptable(device_, release->buffers.name, #name)) {              \
-    auto held = std::make_shared<std::decay_t<decltype(release->buffers.name)>>(std::move(release->buffers.name)); \
-    host_arrays_.push_back(held);                                                                                  \
-    scene_buffers_.push_back(adopt(context_, *held, #name));                                                       \
-  } else {                                                                                                         \
-    scene_buffers_.push_back(upload(context_, device_, scene.buffers.name, #name));                                \
-    if (release && std::string(#name) != "lights") decltype(release->buffers.name)().swap(release->buffers.name);  \
-  }
+#define CD_UPLOAD(type, name)                                                                                          \
+  add_scene_buffer(scene.buffers.name, (release && std::string(#name) != "lights") ? &release->buffers.name : nullptr, \
+                   adopts, #name);
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
   if (settings.energy_compensation)

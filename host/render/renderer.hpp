@@ -161,6 +161,10 @@ class DeviceRenderer {
 
  private:
   void launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end);
+  // Appends the buffer of one scene array (`data`); `released`: the same array when the
+  // scene releases it (freed once copied, or taken over in place when `adopts` and it can be)
+  template <typename V>
+  void add_scene_buffer(const V& data, V* released, bool adopts, const char* what);
 
   DeviceEntry device_;
   RenderSettings settings_;
