@@ -1,6 +1,8 @@
 # The renderer's OpenCL program: every kernel source in program order (each file may use
 # what the files before it define; shared/device_types.h comes first). A new .cl file is
-# added here, in the folder of its subsystem.
+# added here, in the folder of its subsystem. The files up to and including
+# cl/bsdf/energy_dielectric.cl (kLastTablesFile, host/device/kernel_sources.hpp) also make
+# the tables program, which holds every table kernel (energy.cl, sheen.cl, energy_dielectric.cl).
 set(CANDELA_CL_SOURCES
   cl/shared/device_types.h
   cl/shared/color.h

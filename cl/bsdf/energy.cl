@@ -87,6 +87,7 @@ float2 energy_ggx_albedo_quadrature(Ggx g, float mu, uint n) {
 // which y would crowd into its last cell. The delta lobe at r = 0 reflects about the
 // normal: E = 1, E5 = (1 - mu)^5. At y = 0 (grazing) E = 1: every reflection leaves and
 // none is shadowed; E5 at mu = 0 is the quadrature just above grazing. Global size (N, N).
+#if CD_TABLE_KERNELS
 __kernel void energy_ggx_albedo_table(__global float* table, uint n) {
   int i = (int)get_global_id(0), j = (int)get_global_id(1);
   if (i >= GGX_ALBEDO_N || j >= GGX_ALBEDO_N) return;
@@ -99,6 +100,7 @@ __kernel void energy_ggx_albedo_table(__global float* table, uint n) {
   table[j * GGX_ALBEDO_N + i] = fmin(e, 1.0f);
   table[GGX_ALBEDO_HALF + j * GGX_ALBEDO_N + i] = clamp(e5, 0.0f, 1.0f);
 }
+#endif
 
 // The table looked up for one lobe seen from wo: the roughness cell, E(wo), E_avg and the
 // same for E5. No table (compensation off) or a delta lobe: nothing to compensate, E = 1
@@ -237,6 +239,7 @@ GgxEnergy energy_row(__global const float* table, int j) {
 // f_ms gives back 1 - E(mu_o) as looked up (exactly at the nodes of r, closely between
 // them): 8-point Gauss-Legendre in mu between the mu of consecutive nodes; the same for E5.
 // E_avg of the delta row is 1. Runs after energy_ggx_albedo_table; global size (N, 2).
+#if CD_TABLE_KERNELS
 __kernel void energy_ggx_average_table(__global float* table) {
   const float x[4] = ENERGY_GL_X;
   const float w[4] = ENERGY_GL_W;
@@ -257,6 +260,7 @@ __kernel void energy_ggx_average_table(__global float* table) {
   if (j == 0 && part == 0) sum = 1.0f;
   table[part * GGX_ALBEDO_HALF + GGX_ALBEDO_N * GGX_ALBEDO_N + j] = fmin(sum, 1.0f);
 }
+#endif
 
 #if CD_FEATURE_ANISOTROPY
 // The anisotropic cells of a lobe with ax != ay, from its cell `iso` (energy_cell: table and alpha)
@@ -342,6 +346,7 @@ float3 energy_aniso_average_point(int q, int p, int n, float a1, float a0, int p
 // Table entries (i, l, j, k) as energy_ggx_albedo_table's, seen from the azimuth with
 // sin^2 = t_l; global size (N, P, R Q). Without `exact`, the isotropic table's values at
 // alpha = sqrt(ax ay) instead of the quadrature (runs after the isotropic table and its averages).
+#if CD_TABLE_KERNELS
 __kernel void energy_ggx_aniso_table(__global float* table, uint n, uint exact) {
   int i = (int)get_global_id(0), l = (int)get_global_id(1), jk = (int)get_global_id(2);
   if (i >= GGX_ANISO_N || l >= GGX_ANISO_P || jk >= GGX_ANISO_R * GGX_ANISO_Q) return;
@@ -368,6 +373,7 @@ __kernel void energy_ggx_aniso_table(__global float* table, uint n, uint exact) 
   table[GGX_ANISO_OFFSET + at] = fmin(e, 1.0f);
   table[GGX_ANISO_OFFSET + GGX_ANISO_PART + at] = clamp(e5, 0.0f, 1.0f);
 }
+#endif
 
 // The lookup at node (j, k) exactly
 GgxEnergy energy_aniso_row(__global const float* table, int j, int k) {
@@ -384,6 +390,7 @@ GgxEnergy energy_aniso_row(__global const float* table, int j, int k) {
 
 // E_avg(j, k) = (1 / pi) integral of E cos over the hemisphere as energy_lookup interpolates
 // it (energy_aniso_average_point). Global size (R Q, 2).
+#if CD_TABLE_KERNELS
 __kernel void energy_ggx_aniso_average_table(__global float* table) {
   int jk = (int)get_global_id(0), part = (int)get_global_id(1);
   if (jk >= GGX_ANISO_R * GGX_ANISO_Q || part > 1) return;
@@ -397,6 +404,7 @@ __kernel void energy_ggx_aniso_average_table(__global float* table) {
   if (j == 0 && part == 0) total = 1.0f;
   *(__global float*)energy_aniso_average(table, part, j, k) = fmin(total, 1.0f);
 }
+#endif
 #endif
 
 // f_ms without its colour from E(wi) = e_i already looked up (table bound, E_avg < 1, wi above)

@@ -74,6 +74,7 @@ float energy_dielectric_quadrature(Ggx g, float eta, float mu, uint n) {
 
 // Entry (i, j, k + F side): E at y_i, roughness r_j, eta node k on side `side`. The delta
 // row (r = 0) is an ideal interface: E = 1. Global size (N, R, 2 F).
+#if CD_TABLE_KERNELS
 __kernel void energy_dielectric_albedo_table(__global float* table, uint n) {
   int i = (int)get_global_id(0), j = (int)get_global_id(1), ks = (int)get_global_id(2);
   if (i >= DIEL_ALBEDO_N || j >= DIEL_ALBEDO_R || ks >= 2 * DIEL_ALBEDO_F) return;
@@ -86,6 +87,7 @@ __kernel void energy_dielectric_albedo_table(__global float* table, uint n) {
     e = energy_dielectric_quadrature(g, eta, fmax(energy_mu(energy_dielectric_y_node(i), g.ax), 1e-4f), n);
   table[DIEL_ALBEDO_OFFSET + ((side * DIEL_ALBEDO_F + k) * DIEL_ALBEDO_R + j) * DIEL_ALBEDO_N + i] = fmin(e, 1.0f);
 }
+#endif
 
 // The table looked up for one interface (eta seen from wo): the roughness and eta cells,
 // E_s(mu_o), and the averages of both sides
@@ -220,6 +222,7 @@ float energy_dielectric_average(const DielectricEnergy* d, int side) {
 // E_avg of node row (j, k, side) = 2 integral of E mu dmu over the E the lookups
 // interpolate: 8-point Gauss-Legendre between the mu of consecutive y nodes. Runs after
 // energy_dielectric_albedo_table; global size (R, 2 F).
+#if CD_TABLE_KERNELS
 __kernel void energy_dielectric_average_table(__global float* table) {
   const float x[4] = {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f};
   const float w[4] = {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f};
@@ -241,6 +244,7 @@ __kernel void energy_dielectric_average_table(__global float* table) {
   if (j == 0) sum = 1.0f;
   table[DIEL_ALBEDO_OFFSET + DIEL_ALBEDO_ROWS * DIEL_ALBEDO_N + ks * DIEL_ALBEDO_R + j] = fmin(sum, 1.0f);
 }
+#endif
 
 #if CD_FEATURE_ANISOTROPY
 // The anisotropic lobe at node (j, k): major alpha a1 = r_j^2 along x, minor
@@ -266,6 +270,7 @@ void energy_dielectric_aniso_node_of(int index, int* j, int* k, int* f, int* sid
 // major axis, by quadrature (the delta row: 1); without `exact`, the isotropic table's value
 // at alpha = sqrt(ax ay) instead (runs after the isotropic table and its averages). Global
 // size (N, P, DIEL_ANISO_NODES).
+#if CD_TABLE_KERNELS
 __kernel void energy_dielectric_aniso_table(__global float* table, uint n, uint exact) {
   int i = (int)get_global_id(0), l = (int)get_global_id(1), node = (int)get_global_id(2);
   if (i >= DIEL_ANISO_N || l >= DIEL_ANISO_P || node >= DIEL_ANISO_NODES) return;
@@ -288,6 +293,7 @@ __kernel void energy_dielectric_aniso_table(__global float* table, uint n, uint 
   }
   *(__global float*)energy_dielectric_aniso_entry(table, side, f, k, j, l, i) = fmin(e, 1.0f);
 }
+#endif
 
 // The anisotropic interface at node (roughness j, ratio k, eta f) of the table on `side`
 // exactly; the anisotropic cells also for the delta row (ax = ay = 0) and the isotropic
@@ -306,6 +312,7 @@ DielectricEnergy energy_dielectric_aniso_node_cells(__global const float* table,
 
 // E_avg of node (j, k, f, side) over the E the lookups interpolate
 // (energy_aniso_average_point). Global size DIEL_ANISO_NODES.
+#if CD_TABLE_KERNELS
 __kernel void energy_dielectric_aniso_average_table(__global float* table) {
   int node = (int)get_global_id(0);
   if (node >= DIEL_ANISO_NODES) return;
@@ -320,6 +327,7 @@ __kernel void energy_dielectric_aniso_average_table(__global float* table) {
   if (j == 0) total = 1.0f;
   *(__global float*)energy_dielectric_aniso_average_entry(table, side, f, k, j) = fmin(total, 1.0f);
 }
+#endif
 #endif
 
 // 2 integral of F mu dmu from the rarer side (eta >= 1), of the sheet's 2F / (1 + F) if

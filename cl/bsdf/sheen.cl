@@ -74,6 +74,7 @@ float sheen_albedo_quadrature(float alpha, float mu, uint n) {
 // where E varies fastest; mu_0 taken at 1e-3), r_j = j / (N - 1). E exceeds 1 toward grazing
 // angles at low roughness (6 at mu = 1e-3, r = 0): the lobe is not energy conserving there,
 // and bsdf_gltf.cl divides it by E. Global size (N, N).
+#if CD_TABLE_KERNELS
 __kernel void sheen_albedo_table(__global float* table, uint n) {
   int i = (int)get_global_id(0), j = (int)get_global_id(1);
   if (i >= SHEEN_ALBEDO_N || j >= SHEEN_ALBEDO_N) return;
@@ -81,6 +82,7 @@ __kernel void sheen_albedo_table(__global float* table, uint n) {
   float r = (float)j / (float)(SHEEN_ALBEDO_N - 1);
   table[j * SHEEN_ALBEDO_N + i] = sheen_albedo_quadrature(sheen_alpha(r), mu, n);
 }
+#endif
 
 // E(mu) at sheen roughness r, bilinear in (sqrt(mu), r); 0 without a table
 float sheen_albedo(__global const float* table, float mu, float roughness) {

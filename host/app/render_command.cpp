@@ -228,6 +228,7 @@ RenderSettings check_render_args(const RenderArgs& a) {
   if (!a.strategy.empty()) parse_enum(kStrategyNames, "--strategy", a.strategy);  // fails before loading
   settings.filter = parse_enum(kPixelFilterNames, "--filter", a.filter);
   settings.sampler = parse_enum(kSamplerNames, "--sampler", a.sampler);
+  settings.energy_compensation = !a.no_energy_compensation;
   parse_tonemap(a.tonemap);  // a bad name fails before loading
   parse_enum(kDefaultLightNames, "--default-light", a.default_light);
   if (!a.light_units.empty()) parse_enum(kLightUnitNames, "--light-units", a.light_units);
@@ -247,7 +248,6 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
   resolve_image_size(a, scene, &settings->width, &settings->height);
   settings->seed = a.seed;
   settings->max_depth = a.max_depth;
-  settings->energy_compensation = !a.no_energy_compensation;
   // CANDELA_LAUNCH_SECONDS: the target duration of one launch (default 0.2 s)
   if (const char* text = std::getenv("CANDELA_LAUNCH_SECONDS")) {
     char* end = nullptr;
@@ -271,10 +271,9 @@ SceneFeatures kernel_features(const CompiledScene& c, const RenderArgs& a) {
 // (README, Performance: Memory). --generic: every kernel feature on (and the vertex arrays
 // those features read).
 Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& settings,
-                       const std::vector<DeviceEntry>& devices) {
+                       const std::vector<DeviceEntry>& devices, KernelPrebuild& prebuild) {
   // The kernels build while the BVH does: a cold build (seconds) overlaps the scene's
   // compile, and the renderers below find the programs in the kernel cache
-  KernelPrebuild prebuild;
   auto features_known = [&](const CompiledScene& c) {
     for (const DeviceEntry& d : devices) prebuild.start(d, kernel_features(c, a), settings);
   };
@@ -406,19 +405,23 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
 int run_render(RenderArgs a) {
   catch_signals();
   RenderSettings settings = check_render_args(a);
+  std::vector<DeviceEntry> devices = select_render_devices(a.device);
+  // The tables every scene binds are computed (cold cache) while a long load goes on
+  KernelPrebuild prebuild;
+  for (const DeviceEntry& d : devices) prebuild.start_tables(d, settings);
   raise_if_asked("loading");
   Scene scene = load_render_scene(&a);
+  prebuild.loaded();
   complete_settings(a, scene, &settings);
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
   check_sample_offset(a, spp);
   uint32_t first_sample = mpi_shard(&a, &spp);
-  std::vector<DeviceEntry> devices = select_render_devices(a.device);
   if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", joined_descriptions(devices).c_str());
   std::string camera = camera_fingerprint(scene, settings.width, settings.height);
   dev::Camera view = compile_camera(scene, settings.width, settings.height);
   std::string lighting = lighting_fingerprint(scene);
   raise_if_asked("kernel-build");
-  Renderer renderer = make_renderer(a, &scene, settings, devices);
+  Renderer renderer = make_renderer(a, &scene, settings, devices, prebuild);
   if (!a.quiet) print_render_summary(renderer, devices);
   RenderResult r = render_with_progress(renderer, a, settings, first_sample, spp);
   enter_phase(kWriting);

@@ -56,17 +56,34 @@ void check_regular_file(const std::string& path, const std::string& what) {
   if (!S_ISREG(st.st_mode)) throw Error(what + " " + path + " is " + kind_of(st.st_mode) + ", not a regular file");
 }
 
-std::string read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes) {
+namespace {
+
+// The file into `data` (a std::string or a byte vector), resized to fit
+template <typename Bytes>
+void read_into(const std::string& path, const std::string& what, uint64_t max_bytes, Bytes* data) {
   check_regular_file(path, what);
   std::error_code ec;
   uintmax_t size = fs::file_size(path, ec);
   if (ec) throw Error("cannot read " + what + " " + path + ": " + ec.message());
   if (size > max_bytes) throw Error(what + " " + path + " is larger than " + std::to_string(max_bytes >> 20) + " MiB");
-  std::string data(size_t(size), '\0');
+  data->resize(size_t(size));
   std::ifstream in(path, std::ios::binary);
-  if (!in || !in.read(data.data(), std::streamsize(size)) || in.gcount() != std::streamsize(size))
+  if (!in || !in.read(reinterpret_cast<char*>(data->data()), std::streamsize(size)) ||
+      in.gcount() != std::streamsize(size))
     throw Error("cannot read " + what + " " + path);
+}
+
+}  // namespace
+
+std::string read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes) {
+  std::string data;
+  read_into(path, what, max_bytes, &data);
   return data;
+}
+
+void read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes,
+                       std::vector<unsigned char>* out) {
+  read_into(path, what, max_bytes, out);
 }
 
 std::string SceneFolder::resolve(const std::string& reference, const std::string& what) const {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace candela {
 
@@ -14,6 +15,9 @@ void check_regular_file(const std::string& path, const std::string& what);
 
 // The whole of a regular file, at most max_bytes; Error naming `what` and path otherwise
 std::string read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes);
+// The same into *out (a glTF buffer, read in place rather than copied from a string)
+void read_regular_file(const std::string& path, const std::string& what, uint64_t max_bytes,
+                       std::vector<unsigned char>* out);
 
 // Where the files a scene names (buffers, images, environment maps, grids) may come from
 struct SceneFolder {

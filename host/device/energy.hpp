@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/device_types.hpp"
+#include "device/program_cache.hpp"
 
 namespace candela {
 
@@ -37,5 +38,13 @@ AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev:
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                 const std::string& program_cache_file,
                                 AnisotropicAlbedo anisotropic = AnisotropicAlbedo::none);
+
+// The same for the program built on demand (the tables program, host/device/tables_program.hpp):
+// built only when the table is not in the cache
+GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program,
+                                AnisotropicAlbedo anisotropic);
+
+// The cache entry of the table for a program's cache entry (empty: no cache)
+std::string ggx_albedo_cache_file(const std::string& program_cache_file, AnisotropicAlbedo anisotropic);
 
 }  // namespace candela

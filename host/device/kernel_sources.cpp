@@ -101,9 +101,13 @@ std::string feature_defaults() {
   return text;
 }
 
-std::string program_source(bool with_tests) {
+// The program's files in order, with the test kernels or without, with the table kernels
+// (CD_TABLE_KERNELS) or without; `last` (if set): only up to and including that file
+std::string program_source(bool with_tests, bool table_kernels, const char* last = nullptr) {
   std::string src = std::string("#define CD_PNANOVDB_AVAILABLE ") + (pnanovdb_header() ? "1" : "0") + "\n";
+  src += std::string("#define CD_TABLE_KERNELS ") + (table_kernels ? "1" : "0") + "\n";
   src += feature_defaults();
+  bool reached = false;
   for (const auto& f : embedded_kernel_files()) {
     if (is_system_header(f)) continue;
     bool is_test = std::string(f.path).rfind("tests/", 0) == 0;
@@ -111,7 +115,12 @@ std::string program_source(bool with_tests) {
     src += "#line 1 \"" + std::string(f.path) + "\"\n";
     src += resolve_includes(f.path, file_text(f));
     src += "\n";
+    if (last && std::string(f.path) == last) {
+      reached = true;
+      break;
+    }
   }
+  if (last && !reached) throw Error(std::string("the kernel program has no file ") + last);
   return src;
 }
 
@@ -137,8 +146,10 @@ std::string pnanovdb_opencl_text(std::string text) {
 
 void set_kernel_source_root(const std::string& root) { source_root() = root; }
 
-std::string renderer_program_source() { return program_source(false); }
+std::string renderer_program_source() { return program_source(false, false); }
 
-std::string test_program_source() { return program_source(true); }
+std::string test_program_source() { return program_source(true, true); }
+
+std::string tables_program_source() { return program_source(false, true, kLastTablesFile); }
 
 }  // namespace candela

@@ -22,10 +22,19 @@ void set_kernel_source_root(const std::string& root);
 std::string pnanovdb_opencl_text(std::string text);
 
 // The renderer program: the kernel's default of every feature macro (CD_SCENE_FEATURES), then
-// every cl/ file in order, each starting with a #line marker
+// every cl/ file in order, each starting with a #line marker. Its table kernels (those that
+// compute the tables of device/energy.hpp and device/sheen_albedo.hpp) are left out
+// (CD_TABLE_KERNELS 0): the tables program computes them, and a driver that compiles every
+// kernel of a program (PoCL, for the program's binary) compiles the scene's kernel alone.
 std::string renderer_program_source();
 
-// The renderer program followed by the test kernels of tests/cl/
+// The renderer program with its table kernels, followed by the test kernels of tests/cl/
 std::string test_program_source();
+
+// The tables program (host/device/tables_program.hpp): the renderer program with its table
+// kernels, up to and including kLastTablesFile, the last file with a table kernel
+// (cl/program.cmake)
+constexpr const char* kLastTablesFile = "cl/bsdf/energy_dielectric.cl";
+std::string tables_program_source();
 
 }  // namespace candela

@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "base/error.hpp"
@@ -136,8 +137,23 @@ std::string program_cache_file(const DeviceEntry& device, const std::string& sou
   return dir.empty() ? "" : dir + "/" + cache_key(device, source, options) + ".bin";
 }
 
+LazyProgram::LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options)
+    : context_(std::move(context)),
+      device_(std::move(device)),
+      source_(std::move(source)),
+      options_(std::move(options)),
+      cache_file_(program_cache_file(device_, source_, options_)) {}
+
+const cl::Program& LazyProgram::get() {
+  if (!built_) {
+    program_ = build_program(context_, device_, source_, options_, {}, false).program;
+    built_ = true;
+  }
+  return program_;
+}
+
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
-                           const std::string& options, const std::function<void()>& before_compile) {
+                           const std::string& options, const std::function<void()>& before_compile, bool store) {
   auto start = std::chrono::steady_clock::now();
   ProgramBuild result;
   result.cache_file = program_cache_file(device, source, options);
@@ -167,7 +183,7 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
                   "), build log:\n" + log);
     }
     result.program = program;
-    if (!result.cache_file.empty()) {
+    if (store && !result.cache_file.empty()) {
       try {
         auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
         if (binaries.size() == 1 && !binaries[0].empty()) write_entry(result.cache_file, binaries[0]);

@@ -24,11 +24,32 @@ struct ProgramBuild {
 // rejected cache entry falls back to a source build. A failed source build throws
 // Error with the device's build log. `before_compile` (if set) is called just before a
 // build from source (no usable cache entry): what a caller announces before a wait of
-// seconds to minutes.
+// seconds to minutes. `store`: a program built from source is written to the cache (PoCL
+// compiles every kernel of the program to give its binary).
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
-                           const std::string& options, const std::function<void()>& before_compile = {});
+                           const std::string& options, const std::function<void()>& before_compile = {},
+                           bool store = true);
 
 std::string kernel_cache_dir();
+
+// A program built on first use: the path of its cache entry is known before (data cached
+// beside it can be read without building it). A binary in the cache is used, but a program
+// built from source is not stored: it computes data that the cache then keeps, and storing
+// it would compile every one of its kernels.
+class LazyProgram {
+ public:
+  LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options);
+  const std::string& cache_file() const { return cache_file_; }
+  // Built, or loaded from the cache, on the first call
+  const cl::Program& get();
+
+ private:
+  cl::Context context_;
+  DeviceEntry device_;
+  std::string source_, options_, cache_file_;
+  bool built_ = false;
+  cl::Program program_;
+};
 
 // The cache entry build_program uses for `source` built with `options` on the device
 // (empty: no cache)

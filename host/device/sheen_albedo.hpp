@@ -6,6 +6,8 @@
 #include <CL/opencl.hpp>
 #include <string>
 
+#include "device/program_cache.hpp"
+
 namespace candela {
 
 struct SheenAlbedoTable {
@@ -19,5 +21,9 @@ struct SheenAlbedoTable {
 // else computed on the device and stored there
 SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue,
                                     const cl::Program& program, const std::string& program_cache_file);
+
+// The same for the program built on demand (the tables program, host/device/tables_program.hpp):
+// built only when the table is not in the cache
+SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program);
 
 }  // namespace candela

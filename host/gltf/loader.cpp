@@ -80,8 +80,7 @@ bool read_scene_file(std::vector<unsigned char>* out, std::string* err, const st
   const auto* files = static_cast<const SceneFiles*>(user);
   try {
     std::string file = files->folder->resolve(path.substr(files->prefix.size()), "the file");
-    std::string data = read_regular_file(file, "the file", kMaxFileBytes);
-    out->assign(data.begin(), data.end());
+    read_regular_file(file, "the file", kMaxFileBytes, out);
     return true;
   } catch (const Error& e) {
     if (err) *err += e.what();

@@ -17,7 +17,7 @@
 #include "device/energy.hpp"
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
-#include "device/sheen_albedo.hpp"
+#include "device/tables_program.hpp"
 
 namespace candela {
 namespace {
@@ -91,12 +91,23 @@ bool adoptable(const DeviceEntry& device, const UninitVector<T>& v, const char* 
   return true;
 }
 
+void check_device(const DeviceEntry& device) {
+  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 || device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
+    throw Error(device.description() + " supports only " + device.opencl_c_version + "; candela needs OpenCL C 1.2");
+}
+
 void check_settings(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.width <= 0 || settings.height <= 0 || settings.width > 65536 || settings.height > 65536 ||
       uint64_t(settings.width) * settings.height > (uint64_t(1) << 28))
     throw Error("image size must be between 1x1 and 65536x65536 with at most 2^28 pixels");
-  if (device.opencl_c_version.rfind("OpenCL C 1.0", 0) == 0 || device.opencl_c_version.rfind("OpenCL C 1.1", 0) == 0)
-    throw Error(device.description() + " supports only " + device.opencl_c_version + "; candela needs OpenCL C 1.2");
+  check_device(device);
+}
+
+// A kernel cache that the prebuilds can write and the renderers read back
+bool writable_cache() {
+  std::string dir = kernel_cache_dir();
+  std::error_code ec;
+  return !dir.empty() && (std::filesystem::create_directories(dir, ec), ::access(dir.c_str(), W_OK) == 0);
 }
 
 }  // namespace
@@ -122,9 +133,8 @@ void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& featu
   }
   // Only into a cache the renderer can read back (else the program would be built twice),
   // and only what is not there yet
-  std::string dir = kernel_cache_dir();
+  if (!writable_cache()) return;
   std::error_code ec;
-  if (dir.empty() || (std::filesystem::create_directories(dir, ec), ::access(dir.c_str(), W_OK) != 0)) return;
   std::string options = render_kernel_options(features, settings, device);
   std::string entry = program_cache_file(device, renderer_program_source(), options);
   if (std::filesystem::exists(entry, ec) || ec) return;
@@ -146,6 +156,42 @@ void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& featu
     started_.push_back(entry);
   } catch (const std::system_error&) {  // no thread: the renderer builds it
   }
+}
+
+void KernelPrebuild::start_tables(const DeviceEntry& device, const RenderSettings& settings) {
+  if (!settings.energy_compensation) return;
+  try {
+    check_device(device);
+  } catch (const Error&) {
+    return;  // the renderer reports it
+  }
+  if (!writable_cache()) return;
+  std::string entry = common_tables_cache_file(device);
+  std::error_code ec;
+  if (std::filesystem::exists(entry, ec) || ec) return;
+  if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return;
+  try {
+    threads_.emplace_back([this, device] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      auto delay = std::chrono::duration<double>(kTablesAfterLoading);
+      if (loaded_signal_.wait_for(lock, delay, [this] { return loaded_; })) return;
+      lock.unlock();
+      try {
+        compute_common_tables(device);
+      } catch (...) {  // the renderer computes them, and reports what fails
+      }
+    });
+    started_.push_back(entry);
+  } catch (const std::system_error&) {  // no thread: the renderer computes them
+  }
+}
+
+void KernelPrebuild::loaded() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    loaded_ = true;
+  }
+  loaded_signal_.notify_all();
 }
 
 void KernelPrebuild::wait() {
@@ -204,12 +250,10 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
                    adopts, #name);
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
-  if (settings.energy_compensation)
-    scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] =
-        ggx_albedo_table(context_, queue_, build.program, build.cache_file, anisotropic).buffer;
-  if (scene.features.sheen)
-    scene_buffers_[unsigned(dev::SceneBuffer::sheen_albedo)] =
-        sheen_albedo_table(context_, queue_, build.program, build.cache_file).buffer;
+  DeviceTables tables =
+      device_tables(context_, queue_, device_, settings.energy_compensation, anisotropic, scene.features.sheen);
+  if (settings.energy_compensation) scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] = tables.ggx_albedo;
+  if (scene.features.sheen) scene_buffers_[unsigned(dev::SceneBuffer::sheen_albedo)] = tables.sheen_albedo;
 
   params_host_.camera = camera;
   params_host_.width = uint32_t(settings.width);

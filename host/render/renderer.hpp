@@ -5,9 +5,11 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -104,8 +106,21 @@ class KernelPrebuild {
   KernelPrebuild() = default;
   KernelPrebuild(const KernelPrebuild&) = delete;
   KernelPrebuild& operator=(const KernelPrebuild&) = delete;
-  ~KernelPrebuild() { wait(); }
+  ~KernelPrebuild() {
+    loaded();
+    wait();
+  }
   void start(const DeviceEntry& device, const SceneFeatures& features, const RenderSettings& settings);
+  // Computes the tables that every scene with energy compensation binds into the cache
+  // (device/tables_program.hpp: common_tables_cache_file), unless there: work that needs no
+  // scene, so it runs while a long load goes on. It starts once the scene has loaded for
+  // kTablesAfterLoading; a scene loaded before that (loaded()) leaves them to the renderer,
+  // after its kernel: PoCL compiles one program at a time, and the scene's comes first.
+  // Adds no result().
+  void start_tables(const DeviceEntry& device, const RenderSettings& settings);
+  static constexpr double kTablesAfterLoading = 0.25;  // seconds
+  // The scene is loaded: tables not started yet are left to the renderer
+  void loaded();
   void wait();
   // The i-th start's build, once wait() returned
   const Result& result(size_t i) const { return *results_.at(i); }
@@ -114,7 +129,10 @@ class KernelPrebuild {
  private:
   std::vector<std::thread> threads_;
   std::vector<std::unique_ptr<Result>> results_;
-  std::vector<std::string> started_;  // cache entries being built
+  std::vector<std::string> started_;  // cache entries being built or computed
+  std::mutex mutex_;
+  std::condition_variable loaded_signal_;
+  bool loaded_ = false;
 };
 
 // One device's worker: renders ranges of sample indices of a compiled scene into its film

@@ -55,6 +55,10 @@ double mean_emission(const Scene& scene, const MaterialDesc& m, std::vector<doub
 void gather(const Scene& scene, std::vector<TriangleRef>* tris, std::vector<double>* tris_area,
             std::vector<Emitter>* em, double* emissive_area) {
   std::vector<double> texture_mean(scene.textures.size(), -1.0);
+  size_t triangles = 0;
+  for (const MeshDesc& mesh : scene.meshes) triangles += mesh.triangles();
+  tris->reserve(triangles);  // grown by push_back, 10 M triangles would be copied over and over
+  tris_area->reserve(triangles);
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshDesc& mesh = scene.meshes[i];
     const MaterialDesc& m = scene.materials.at(mesh.material);

@@ -17,30 +17,6 @@ namespace fs = std::filesystem;
 namespace candela::test {
 namespace {
 
-class ScopedCacheDir {
- public:
-  ScopedCacheDir() {
-    dir_ = fs::temp_directory_path() / ("candela-cache-test-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    const char* old = std::getenv("CANDELA_CACHE_DIR");
-    if (old) old_ = old;
-    had_old_ = old != nullptr;
-    setenv("CANDELA_CACHE_DIR", dir_.c_str(), 1);
-  }
-  ~ScopedCacheDir() {
-    fs::remove_all(dir_);
-    if (had_old_)
-      setenv("CANDELA_CACHE_DIR", old_.c_str(), 1);
-    else
-      unsetenv("CANDELA_CACHE_DIR");
-  }
-
- private:
-  fs::path dir_;
-  std::string old_;
-  bool had_old_ = false;
-};
-
 bool kernel_runs(const cl::Context& ctx, const DeviceEntry& d, cl::Program& program) {
   KernelRig rig(d, ctx, program);
   auto out = rig.output<cl_uint>(256);  // room for all of CD_LAYOUT

@@ -1,10 +1,32 @@
 #include "support/test_support.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 
 namespace candela::test {
+
+ScopedCacheDir::ScopedCacheDir() {
+  dir_ = (std::filesystem::temp_directory_path() / ("candela-cache-test-" + std::to_string(::getpid()))).string();
+  std::filesystem::remove_all(dir_);
+  const char* old = std::getenv("CANDELA_CACHE_DIR");
+  if (old) old_ = old;
+  had_old_ = old != nullptr;
+  setenv("CANDELA_CACHE_DIR", dir_.c_str(), 1);
+}
+
+ScopedCacheDir::~ScopedCacheDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
+  if (had_old_)
+    setenv("CANDELA_CACHE_DIR", old_.c_str(), 1);
+  else
+    unsetenv("CANDELA_CACHE_DIR");
+}
 
 Estimate region_mean(const Film& f, int c, int x0, int x1, int y0, int y1) {
   double sum = 0.0, var = 0.0;

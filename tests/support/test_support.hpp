@@ -18,6 +18,21 @@
 
 namespace candela::test {
 
+// CANDELA_CACHE_DIR set to an empty folder of the test's own for its lifetime (removed, and
+// the variable restored, after)
+class ScopedCacheDir {
+ public:
+  ScopedCacheDir();
+  ~ScopedCacheDir();
+  ScopedCacheDir(const ScopedCacheDir&) = delete;
+  ScopedCacheDir& operator=(const ScopedCacheDir&) = delete;
+  const std::string& path() const { return dir_; }
+
+ private:
+  std::string dir_, old_;
+  bool had_old_ = false;
+};
+
 // A mean over pixels with its standard error from the per-pixel sample variances
 struct Estimate {
   double mean = 0.0;
