@@ -19,6 +19,7 @@
 #include "app/render_scene.hpp"
 #include "app/report.hpp"
 #include "base/atomic_file.hpp"
+#include "base/file_access.hpp"
 #include "compile/camera.hpp"
 #include "compile/light_tree.hpp"
 #include "compile/scene_compiler.hpp"
@@ -405,6 +406,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
 int run_render(RenderArgs a) {
   catch_signals();
   RenderSettings settings = check_render_args(a);
+  check_regular_file(a.scene, "scene file");  // a missing scene is named before any device
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   // The tables every scene binds are computed (cold cache) while a long load goes on
   KernelPrebuild prebuild;

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstring>
-#include <functional>
 #include <vector>
 
 #include "base/device_types.hpp"
@@ -55,24 +54,6 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   return table;
 }
 
-// The table from the cache entry `path`, else computed by `program` (built only then)
-GgxAlbedoTable table_of(const cl::Context& context, const cl::CommandQueue& queue,
-                        const std::function<const cl::Program&()>& program, const std::string& path,
-                        AnisotropicAlbedo anisotropic) {
-  auto start = std::chrono::steady_clock::now();
-  GgxAlbedoTable t;
-  try {
-    t.buffer = cached_device_table(
-        context, path, GGX_ALBEDO_SIZE, 0.0f, 1.0f, "GGX albedos",
-        [&](cl::Buffer* buffer) { return compute_table(context, queue, program(), anisotropic, buffer); },
-        &t.from_cache);
-  } catch (const cl::Error& e) {
-    throw Error(cl_error_message("computing the GGX albedo table", e.err()));
-  }
-  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return t;
-}
-
 }  // namespace
 
 AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials) {
@@ -90,23 +71,39 @@ AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev:
 
 std::string ggx_albedo_cache_file(const std::string& program_cache_file, AnisotropicAlbedo anisotropic) {
   if (program_cache_file.empty()) return "";
-  return program_cache_file + (anisotropic == AnisotropicAlbedo::exact_glass ? ".ggx_albedo_aniso_glass"
-                               : anisotropic == AnisotropicAlbedo::exact     ? ".ggx_albedo_aniso"
-                                                                             : ".ggx_albedo");
+  switch (anisotropic) {
+    case AnisotropicAlbedo::none:
+      return program_cache_file + ".ggx_albedo";
+    case AnisotropicAlbedo::approximate:
+      return program_cache_file + ".ggx_albedo_aniso_approx";
+    case AnisotropicAlbedo::exact:
+      return program_cache_file + ".ggx_albedo_aniso";
+    case AnisotropicAlbedo::exact_glass:
+      return program_cache_file + ".ggx_albedo_aniso_glass";
+  }
+  return "";
 }
 
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program,
                                 AnisotropicAlbedo anisotropic) {
-  return table_of(
-      context, queue, [&]() -> const cl::Program& { return program.get(); },
-      ggx_albedo_cache_file(program.cache_file(), anisotropic), anisotropic);
+  auto start = std::chrono::steady_clock::now();
+  GgxAlbedoTable t;
+  try {
+    t.buffer = cached_device_table(
+        context, ggx_albedo_cache_file(program.cache_file(), anisotropic), GGX_ALBEDO_SIZE, 0.0f, 1.0f, "GGX albedos",
+        [&](cl::Buffer* buffer) { return compute_table(context, queue, program.get(), anisotropic, buffer); },
+        &t.from_cache);
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("computing the GGX albedo table", e.err()));
+  }
+  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return t;
 }
 
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                 const std::string& program_cache_file, AnisotropicAlbedo anisotropic) {
-  return table_of(
-      context, queue, [&]() -> const cl::Program& { return program; },
-      ggx_albedo_cache_file(program_cache_file, anisotropic), anisotropic);
+  LazyProgram built(program, program_cache_file);
+  return ggx_albedo_table(context, queue, built, anisotropic);
 }
 
 }  // namespace candela

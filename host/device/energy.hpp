@@ -1,6 +1,7 @@
 // The GGX albedo table of multiple-scattering energy compensation (cl/bsdf/energy.cl), the
-// ggx_albedo scene buffer: computed on the device by the program's own kernels, so it
-// describes the lobes exactly as the kernels evaluate them, and cached beside the program.
+// ggx_albedo scene buffer: computed on the device by the kernels' own lobes (the tables
+// program's table kernels, device/tables_program.hpp), so it describes the lobes exactly as
+// the kernels evaluate them, and cached beside that program's cache entry.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -18,8 +19,8 @@ struct GgxAlbedoTable {
   bool from_cache = false;
 };
 
-// What the table's anisotropic part (lobes with ax != ay) holds. Only a program built with
-// CD_FEATURE_ANISOTROPY has the kernels that fill it and reads it: `none` for any other.
+// What the table's anisotropic part (lobes with ax != ay) holds. Only a kernel built with
+// CD_FEATURE_ANISOTROPY reads it: `none` (zeros) for any other.
 // `exact` integrates it by quadrature (several minutes on rusticl, so only for scenes with an
 // anisotropic material); `approximate` fills it with the isotropic table's values at
 // alpha = sqrt(ax ay) at next to no cost (the generic kernel of a scene without anisotropy).
@@ -32,19 +33,20 @@ enum class AnisotropicAlbedo { none, approximate, exact, exact_glass };
 // thin-walled), `exact` when some material has anisotropy strength > 0, else `approximate`
 AnisotropicAlbedo anisotropic_albedo(bool kernel_feature, const std::vector<dev::Material>& materials);
 
-// The table for `program`, whose cache entry is `program_cache_file`
-// (ProgramBuild::cache_file; empty: no cache): loaded from beside it, else computed on the
-// device and stored there. The exact and approximate anisotropic parts are cached apart.
+// The table computed by `program` (which must hold the table kernels: the tables program of
+// device/tables_program.hpp, or the tests' program), loaded from the cache entry beside the
+// program's (ggx_albedo_cache_file), else computed on the device (the program built only
+// then) and stored there. Each anisotropic mode is cached apart.
+GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program,
+                                AnisotropicAlbedo anisotropic);
+
+// The same for a program built already, whose cache entry is `program_cache_file`
+// (ProgramBuild::cache_file; empty: no cache)
 GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, const cl::Program& program,
                                 const std::string& program_cache_file,
                                 AnisotropicAlbedo anisotropic = AnisotropicAlbedo::none);
 
-// The same for the program built on demand (the tables program, host/device/tables_program.hpp):
-// built only when the table is not in the cache
-GgxAlbedoTable ggx_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program,
-                                AnisotropicAlbedo anisotropic);
-
-// The cache entry of the table for a program's cache entry (empty: no cache)
+// The cache entry of the table in `anisotropic` mode beside a program's entry (empty: no cache)
 std::string ggx_albedo_cache_file(const std::string& program_cache_file, AnisotropicAlbedo anisotropic);
 
 }  // namespace candela

@@ -144,6 +144,9 @@ LazyProgram::LazyProgram(cl::Context context, DeviceEntry device, std::string so
       options_(std::move(options)),
       cache_file_(program_cache_file(device_, source_, options_)) {}
 
+LazyProgram::LazyProgram(cl::Program built, std::string cache_file)
+    : cache_file_(std::move(cache_file)), built_(true), program_(std::move(built)) {}
+
 const cl::Program& LazyProgram::get() {
   if (!built_) {
     program_ = build_program(context_, device_, source_, options_, {}, false).program;

@@ -39,6 +39,8 @@ std::string kernel_cache_dir();
 class LazyProgram {
  public:
   LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options);
+  // A program built already, whose cache entry is `cache_file` (empty: no cache)
+  LazyProgram(cl::Program built, std::string cache_file);
   const std::string& cache_file() const { return cache_file_; }
   // Built, or loaded from the cache, on the first call
   const cl::Program& get();

@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <vector>
 
 #include "base/device_types.hpp"
@@ -27,17 +26,16 @@ std::vector<float> compute_table(const cl::Context& context, const cl::CommandQu
   return table;
 }
 
-// The table from the cache entry beside `program_cache_file`, else computed by `program`
-// (built only then)
-SheenAlbedoTable table_of(const cl::Context& context, const cl::CommandQueue& queue,
-                          const std::function<const cl::Program&()>& program, const std::string& program_cache_file) {
+}  // namespace
+
+SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program) {
   auto start = std::chrono::steady_clock::now();
   SheenAlbedoTable t;
-  std::string path = program_cache_file.empty() ? "" : program_cache_file + ".sheen_albedo";
+  std::string path = program.cache_file().empty() ? "" : program.cache_file() + ".sheen_albedo";
   try {
     t.buffer = cached_device_table(
         context, path, SHEEN_ALBEDO_SIZE, 0.0f, 100.0f, "sheen albedos",
-        [&](cl::Buffer* buffer) { return compute_table(context, queue, program(), buffer); }, &t.from_cache);
+        [&](cl::Buffer* buffer) { return compute_table(context, queue, program.get(), buffer); }, &t.from_cache);
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("computing the sheen albedo table", e.err()));
   }
@@ -45,17 +43,10 @@ SheenAlbedoTable table_of(const cl::Context& context, const cl::CommandQueue& qu
   return t;
 }
 
-}  // namespace
-
 SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue,
                                     const cl::Program& program, const std::string& program_cache_file) {
-  return table_of(
-      context, queue, [&]() -> const cl::Program& { return program; }, program_cache_file);
-}
-
-SheenAlbedoTable sheen_albedo_table(const cl::Context& context, const cl::CommandQueue& queue, LazyProgram& program) {
-  return table_of(
-      context, queue, [&]() -> const cl::Program& { return program.get(); }, program.cache_file());
+  LazyProgram built(program, program_cache_file);
+  return sheen_albedo_table(context, queue, built);
 }
 
 }  // namespace candela

@@ -134,11 +134,9 @@ void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& featu
   // Only into a cache the renderer can read back (else the program would be built twice),
   // and only what is not there yet
   if (!writable_cache()) return;
-  std::error_code ec;
   std::string options = render_kernel_options(features, settings, device);
   std::string entry = program_cache_file(device, renderer_program_source(), options);
-  if (std::filesystem::exists(entry, ec) || ec) return;
-  if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return;
+  if (!claim(entry)) return;
   std::function<void(const std::string&)> note = settings.before_kernel_compile;
   Result* result = results_.back().get();
   try {
@@ -153,7 +151,6 @@ void KernelPrebuild::start(const DeviceEntry& device, const SceneFeatures& featu
       } catch (...) {  // the renderer's own build reports it
       }
     });
-    started_.push_back(entry);
   } catch (const std::system_error&) {  // no thread: the renderer builds it
   }
 }
@@ -166,10 +163,13 @@ void KernelPrebuild::start_tables(const DeviceEntry& device, const RenderSetting
     return;  // the renderer reports it
   }
   if (!writable_cache()) return;
-  std::string entry = common_tables_cache_file(device);
-  std::error_code ec;
-  if (std::filesystem::exists(entry, ec) || ec) return;
-  if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return;
+  std::string entry;
+  try {
+    entry = common_tables_cache_file(device);  // the sources read (--kernel-dir) may fail
+  } catch (const Error&) {
+    return;  // the renderer reports it
+  }
+  if (!claim(entry)) return;
   try {
     threads_.emplace_back([this, device] {
       std::unique_lock<std::mutex> lock(mutex_);
@@ -181,9 +181,16 @@ void KernelPrebuild::start_tables(const DeviceEntry& device, const RenderSetting
       } catch (...) {  // the renderer computes them, and reports what fails
       }
     });
-    started_.push_back(entry);
   } catch (const std::system_error&) {  // no thread: the renderer computes them
   }
+}
+
+bool KernelPrebuild::claim(const std::string& entry) {
+  std::error_code ec;
+  if (std::filesystem::exists(entry, ec) || ec) return false;
+  if (std::find(started_.begin(), started_.end(), entry) != started_.end()) return false;
+  started_.push_back(entry);
+  return true;
 }
 
 void KernelPrebuild::loaded() {

@@ -113,10 +113,10 @@ class KernelPrebuild {
   void start(const DeviceEntry& device, const SceneFeatures& features, const RenderSettings& settings);
   // Computes the tables that every scene with energy compensation binds into the cache
   // (device/tables_program.hpp: common_tables_cache_file), unless there: work that needs no
-  // scene, so it runs while a long load goes on. It starts once the scene has loaded for
+  // scene, so it runs while a long load goes on. It starts once the load has lasted
   // kTablesAfterLoading; a scene loaded before that (loaded()) leaves them to the renderer,
   // after its kernel: PoCL compiles one program at a time, and the scene's comes first.
-  // Adds no result().
+  // Once started it runs to its end (seconds), even when the load then fails. Adds no result().
   void start_tables(const DeviceEntry& device, const RenderSettings& settings);
   static constexpr double kTablesAfterLoading = 0.25;  // seconds
   // The scene is loaded: tables not started yet are left to the renderer
@@ -129,6 +129,8 @@ class KernelPrebuild {
  private:
   std::vector<std::thread> threads_;
   std::vector<std::unique_ptr<Result>> results_;
+  // Whether to start filling cache entry `entry`: not there yet, nor started; then started
+  bool claim(const std::string& entry);
   std::vector<std::string> started_;  // cache entries being built or computed
   std::mutex mutex_;
   std::condition_variable loaded_signal_;

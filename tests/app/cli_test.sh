@@ -42,6 +42,7 @@ expect_error "unknown device" "no OpenCL device matches --device 'quantum'" -- "
 expect_error "device index out of range" "there are only" -- "$bin" render "$scene" -o "$tmp/x.png" --device 7
 mkdir -p "$tmp/no-vendors"
 expect_error "no OpenCL platform" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$scene" -o "$tmp/x.png"
+expect_error "missing scene, no OpenCL platform" "scene file not found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" render "$tmp/nope.gltf" -o "$tmp/x.png"
 expect_error "no OpenCL platform (devices)" "no OpenCL platform found" -- env OCL_ICD_VENDORS="$tmp/no-vendors" OCL_ICD_FILENAMES= "$bin" devices
 expect_error "bad output extension" "must end in .exr, .png or .jpg" -- "$bin" render "$scene" -o "$tmp/x.tiff" --device pocl
 expect_error "bad strategy" "strategy must be nee, bsdf or auto" -- "$bin" render "$scene" -o "$tmp/x.png" --strategy mis --device pocl
