@@ -219,13 +219,20 @@ void check_stats_path(const RenderArgs& a) {
 // What can be checked before the scene loads: option names and output paths
 RenderSettings check_render_args(const RenderArgs& a) {
   RenderSettings settings;
-  if (!a.quiet)
+  if (!a.quiet) {
     settings.before_kernel_compile = [](const std::string& device) {
       std::fprintf(stderr,
                    "compiling the render kernel for %s (not in the kernel cache yet: seconds on PoCL, up to minutes "
                    "on rusticl)\n",
                    device.c_str());
     };
+    settings.before_tables_compute = [](const std::string& device) {
+      std::fprintf(stderr,
+                   "computing the albedo tables for %s (once per device, then cached: seconds on PoCL, minutes on "
+                   "rusticl)\n",
+                   device.c_str());
+    };
+  }
   if (!a.strategy.empty()) parse_enum(kStrategyNames, "--strategy", a.strategy);  // fails before loading
   settings.filter = parse_enum(kPixelFilterNames, "--filter", a.filter);
   settings.sampler = parse_enum(kSamplerNames, "--sampler", a.sampler);

@@ -137,19 +137,21 @@ std::string program_cache_file(const DeviceEntry& device, const std::string& sou
   return dir.empty() ? "" : dir + "/" + cache_key(device, source, options) + ".bin";
 }
 
-LazyProgram::LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options)
+LazyProgram::LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options,
+                         std::function<void()> before_compile)
     : context_(std::move(context)),
       device_(std::move(device)),
       source_(std::move(source)),
       options_(std::move(options)),
-      cache_file_(program_cache_file(device_, source_, options_)) {}
+      cache_file_(program_cache_file(device_, source_, options_)),
+      before_compile_(std::move(before_compile)) {}
 
 LazyProgram::LazyProgram(cl::Program built, std::string cache_file)
     : cache_file_(std::move(cache_file)), built_(true), program_(std::move(built)) {}
 
 const cl::Program& LazyProgram::get() {
   if (!built_) {
-    program_ = build_program(context_, device_, source_, options_, {}, false).program;
+    program_ = build_program(context_, device_, source_, options_, before_compile_, false).program;
     built_ = true;
   }
   return program_;

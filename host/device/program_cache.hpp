@@ -38,7 +38,9 @@ std::string kernel_cache_dir();
 // it would compile every one of its kernels.
 class LazyProgram {
  public:
-  LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options);
+  // `before_compile`: as build_program's
+  LazyProgram(cl::Context context, DeviceEntry device, std::string source, std::string options,
+              std::function<void()> before_compile = {});
   // A program built already, whose cache entry is `cache_file` (empty: no cache)
   LazyProgram(cl::Program built, std::string cache_file);
   const std::string& cache_file() const { return cache_file_; }
@@ -49,6 +51,7 @@ class LazyProgram {
   cl::Context context_;
   DeviceEntry device_;
   std::string source_, options_, cache_file_;
+  std::function<void()> before_compile_;
   bool built_ = false;
   cl::Program program_;
 };

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <functional>
 #include <string>
 
 #include "device/device.hpp"
@@ -19,16 +20,20 @@ namespace candela {
 // Every table kernel compiled in (the anisotropic ones with CD_FEATURE_ANISOTROPY)
 std::string tables_program_options();
 
-// The tables program on `device`, built through the kernel cache when first needed
-LazyProgram tables_program(const cl::Context& context, const DeviceEntry& device);
+// The tables program on `device`, built when first needed (`before_compile` called then:
+// a table is about to be computed)
+LazyProgram tables_program(const cl::Context& context, const DeviceEntry& device,
+                           std::function<void()> before_compile = {});
 
 // The tables a renderer binds, from the kernel cache or computed by the tables program
 struct DeviceTables {
   cl::Buffer ggx_albedo;    // with energy compensation
   cl::Buffer sheen_albedo;  // with the sheen feature
 };
+// `before_compute`: called once before the first table that is not in the cache is computed
 DeviceTables device_tables(const cl::Context& context, const cl::CommandQueue& queue, const DeviceEntry& device,
-                           bool energy_compensation, AnisotropicAlbedo anisotropic, bool sheen);
+                           bool energy_compensation, AnisotropicAlbedo anisotropic, bool sheen,
+                           const std::function<void()>& before_compute = {});
 
 // The cache entry of the table every scene with energy compensation binds on `device` (GGX
 // and dielectric albedos, no anisotropic part); empty without a cache

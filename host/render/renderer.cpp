@@ -258,7 +258,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   CD_SCENE_BUFFERS(CD_UPLOAD)
 #undef CD_UPLOAD
   DeviceTables tables =
-      device_tables(context_, queue_, device_, settings.energy_compensation, anisotropic, scene.features.sheen);
+      device_tables(context_, queue_, device_, settings.energy_compensation, anisotropic, scene.features.sheen, [&] {
+        if (settings.before_tables_compute) settings.before_tables_compute(device_.description());
+      });
   if (settings.energy_compensation) scene_buffers_[unsigned(dev::SceneBuffer::ggx_albedo)] = tables.ggx_albedo;
   if (scene.features.sheen) scene_buffers_[unsigned(dev::SceneBuffer::sheen_albedo)] = tables.sheen_albedo;
 

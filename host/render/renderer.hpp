@@ -61,6 +61,9 @@ struct RenderSettings {
   // Called with the device's description before its kernel is built from source (not in
   // the kernel cache): seconds on PoCL, minutes on rusticl
   std::function<void(const std::string&)> before_kernel_compile;
+  // Called with the device's description before albedo tables not in the kernel cache are
+  // computed on it (once per device: seconds on PoCL, minutes on rusticl)
+  std::function<void(const std::string&)> before_tables_compute;
 };
 
 struct RenderProgress {
