@@ -141,13 +141,13 @@ float path_lobe_pdf_squared(float omega) { return omega >= PI_F ? 2.0f / (3.0f *
 // takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
 // path, at the light sample and where the sampled ray finds the light, on the same inputs:
 // no contraction, so both give the same answer. `pmf`: the light's selection probability
-// at ctx when the caller has it (the light sample's: lights_select_pmf's value exactly),
-// else negative (lights_select_pmf computes it).
-bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index, float pmf) {
+// at ctx.
+bool path_nee_takes_by_moments(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index,
+                               float pmf) {
 #pragma OPENCL FP_CONTRACT OFF
   LightExtent e = lights_extent(sc, index, ctx->p);
   if (!(e.omega > 0.0f)) return true;  // a delta light
-  e.pmf = pmf >= 0.0f ? pmf : lights_select_pmf(sc, ctx, index);
+  e.pmf = pmf;
   float l_bright = e.everywhere ? e.integral / e.omega : 1.0f;
   float m_bsdf = 0.0f, j[BSDF_MAX_LOBES];
   for (uint k = 0u; k < lobes->count; ++k) {
@@ -178,6 +178,36 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
   }
   float scale = e.everywhere ? e.integral / e.pmf : e.omega / e.pmf;
   return AUTO_SHADOW_COST * scale * m_nee <= m_bsdf;
+}
+
+// A test that settles most of the choices without the light's extent. For a light that is
+// not `everywhere`, J_c <= k_c q_c P_c (k_c: AUTO_COSINE_SOBOL for a cosine lobe, else 1)
+// and r_ab <= 1 give M_nee <= W_L / pmf (sum_c w_c sqrt(k_c q_c P_c))^2, at most
+// W_L / pmf (sum_c w_c k_c q_c) (sum_c w_c P_c) = W_L / pmf (sum_c w_c k_c q_c) M_bsdf by
+// Cauchy-Schwarz. q_c is at most the lobe's peak density (1 / pi for a cosine lobe, 1 / W_c
+// for the GGX-shaped one) and W_L at most `omega_bound` (lights_omega_bound; negative:
+// none), so light sampling takes the light when
+// AUTO_SHADOW_COST omega_bound sum_c w_c k_c peak_c <= pmf. W_L is taken at 1e-6 sr at
+// least, over the rounding of a far, tiny triangle's solid angle, with 1 % to spare.
+bool path_nee_surely_takes(const BsdfLobes* lobes, float omega_bound, float pmf) {
+#pragma OPENCL FP_CONTRACT OFF
+  if (!(omega_bound >= 0.0f)) return false;
+  float sum = 0.0f;
+  for (uint k = 0u; k < lobes->count; ++k) {
+    float omega = lobes->omega[k];
+    sum += lobes->weight[k] * (omega >= PI_F ? AUTO_COSINE_SOBOL * INV_PI_F : 1.0f / omega);
+  }
+  return AUTO_SHADOW_COST * fmax(omega_bound, 1e-6f) * sum <= 0.99f * pmf;
+}
+
+// STRATEGY_AUTO's choice: path_nee_takes_by_moments, most often settled by
+// path_nee_surely_takes first (the same answer, for a fraction of the work). `pmf`: the
+// light's selection probability at ctx when the caller has it (the light sample's:
+// lights_select_pmf's value exactly), else negative (lights_select_pmf computes it).
+bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index, float pmf) {
+  if (pmf < 0.0f) pmf = lights_select_pmf(sc, ctx, index);
+  return path_nee_surely_takes(lobes, lights_omega_bound(sc, index, ctx->p), pmf) ||
+         path_nee_takes_by_moments(sc, lobes, ctx, index, pmf);
 }
 
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with

@@ -114,6 +114,9 @@ void lights_environment_extent(const SceneData* sc, __global const Light* light,
   e->integral = light->params[7] * (map ? light->params[1] : luminance(load3(light->radiance)));
 }
 
+// An environment surrounds every point: no bound smaller than its extent
+float lights_environment_omega_bound(const SceneData* sc, __global const Light* light, float3 p) { return -1.0f; }
+
 // Triangle lights are sampled uniformly in the solid angle they subtend at ctx.p (Arvo
 // 1995, Stratified Sampling of Spherical Triangles) where that solid angle is at least
 // LIGHTS_SPHERICAL_MIN_SOLID_ANGLE (0.1 sr), else uniformly in area. Solid-angle sampling
@@ -285,6 +288,24 @@ void lights_triangle_extent(const SceneData* sc, __global const Light* light, fl
   e->radius = acos_fast(cos_min);
 }
 
+// An upper bound on the solid angle the triangle subtends at p, for far less work than its
+// extent: the smaller of the cone of its bounding sphere (centre c the centroid, radius R),
+// 2 pi (1 - sqrt(1 - R^2 / d^2)) <= 2 pi R^2 / d^2 at distance d, and area / (d - R)^2 (no
+// point of it is nearer than d - R, and dw = cos dA / r^2), at most 2 pi; 1 % over them
+// for rounding
+float lights_triangle_omega_bound(const SceneData* sc, __global const Light* light, float3 p) {
+#pragma OPENCL FP_CONTRACT OFF
+  float3 v0, v1, v2;
+  scene_prim_positions(sc, light->index, &v0, &v1, &v2);
+  float3 c = (v0 + v1 + v2) * (1.0f / 3.0f);
+  float3 a = v0 - c, b = v1 - c, e = v2 - c, pc = c - p;
+  float r2 = fmax(fmax(dot(a, a), dot(b, b)), dot(e, e)), d2 = dot(pc, pc);
+  float near = sqrt(d2) - sqrt(r2);
+  float area = near > 0.0f ? light->params[0] / (near * near) : INFINITY;
+  float bound = fmin(fmin(2.0f * PI_F * r2 / d2, area), 2.0f * PI_F);
+  return bound >= 0.0f ? 1.01f * bound : 2.0f * PI_F;  // NaN (p or the triangle): no help
+}
+
 // Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries
 // the irradiance arriving normal to wi as `radiance` with pdf 1 (times the selection
 // pmf), so path_direct_light's f * radiance * cos / pdf is the reflected radiance, and no
@@ -350,6 +371,9 @@ bool lights_directional_sample(const SceneData* sc, __global const Light* light,
 void lights_point_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
 void lights_spot_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
 void lights_directional_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {}
+float lights_point_omega_bound(const SceneData* sc, __global const Light* light, float3 p) { return 0.0f; }
+float lights_spot_omega_bound(const SceneData* sc, __global const Light* light, float3 p) { return 0.0f; }
+float lights_directional_omega_bound(const SceneData* sc, __global const Light* light, float3 p) { return 0.0f; }
 uint lights_point_prim(__global const Light* light) { return UINT_MAX; }
 uint lights_spot_prim(__global const Light* light) { return UINT_MAX; }
 uint lights_directional_prim(__global const Light* light) { return UINT_MAX; }
@@ -618,6 +642,17 @@ int lights_of_prim(const SceneData* sc, uint prim) {
       hi = mid;
   }
   return lo < sc->params->num_lights && lights_prim(&sc->lights[lo]) == prim ? (int)lo : NO_LIGHT;
+}
+
+// An upper bound on the solid angle light `index` subtends at p, cheaper than its extent
+// (0 for a delta light), or a negative value where it has none
+float lights_omega_bound(const SceneData* sc, uint index, float3 p) {
+  __global const Light* light = &sc->lights[index];
+#define LIGHTS_OMEGA_BOUND(id, name, feature) \
+  if (feature && light->type == id) return lights_##name##_omega_bound(sc, light, p);
+  CD_LIGHTS(LIGHTS_OMEGA_BOUND)
+#undef LIGHTS_OMEGA_BOUND
+  return -1.0f;
 }
 
 // Light `index` as STRATEGY_AUTO's choice sees it from p, its selection probability aside

@@ -94,6 +94,8 @@
 //                           float2 u, LightSample*)
 //   float lights_NAME_pdf(const SceneData*, __global const Light*, const LightSampleContext*, float3 wi)
 //   void lights_NAME_extent(const SceneData*, __global const Light*, float3 p, LightExtent*)
+//   float lights_NAME_omega_bound(const SceneData*, __global const Light*, float3 p): an upper
+//                           bound on its solid angle at p, cheaper than the extent (0: delta; < 0: none)
 //   uint lights_NAME_prim(__global const Light*): the emissive primitive it is, or UINT_MAX
 // in cl/lights/ and light_power_NAME on the host (host/compile/scene_compiler.cpp). `feature`
 // is the CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 #include <memory>
+#include <random>
 
 #include "compile/scene_compiler.hpp"
 #include "support/reference.hpp"
@@ -411,6 +412,72 @@ TEST_P(LightsTest, MixtureIrradianceEstimate) {
     double want = kPi * 1.0 + 800.0 * polygon_irradiance(c.p, c.n, kSmallTriangle);
     EXPECT_NEAR(mean, want, 4.0 * se) << "transmits " << c.transmits;
   }
+}
+
+// The auto strategy's shortcut (path_nee_surely_takes, cl/integrator/integrator_path.cl)
+// from points around the quad's triangles, 10^-2 to 10^3 of the quad's size away, with
+// lobes as sharp as 10^-4 sr: every lights_omega_bound holds the extent's solid angle, and
+// every choice the shortcut settles is the one the second moments make. With lobes of at
+// least 0.3 sr (diffuse and rough surfaces, where light sampling wins) it settles most of
+// the choices for light sampling (71 %), and nearly all of them (99 %) 20 sizes away or more (else it would
+// only cost). The environment has no bound and is never settled by it.
+TEST_P(LightsTest, AutoShortcutAgreesWithTheSecondMoments) {
+  constexpr size_t kPoints = 1 << 16;
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  glm::dvec3 centre(0.0);
+  for (const auto& v : quad_light()) centre += glm::dvec3(v) / 4.0;
+  std::vector<cl_float4> points;
+  std::vector<double> distance;
+  for (size_t i = 0; i < kPoints; ++i) {
+    double z = 2.0 * uni(gen) - 1.0, phi = 2.0 * M_PI * uni(gen), r = std::sqrt(1.0 - z * z);
+    double d = std::pow(10.0, -2.0 + 5.0 * uni(gen));  // the quad is about 1.5 x 1.0
+    points.push_back(f4(centre + d * glm::dvec3(r * std::cos(phi), r * std::sin(phi), z)));
+    distance.push_back(d);
+  }
+  auto run = [&](cl_uint light, cl_uint seed, float sharpest) {
+    auto out = rig().output<cl_float4>(kPoints);
+    rig().run("test_lights_nee_shortcut", kPoints, *scene_, light, seed, sharpest, rig().input(points), out);
+    return out.read();
+  };
+  use_scene(quad_scene());
+  for (cl_uint light : {0u, 1u})
+    for (float sharpest : {4.0f, 0.5f}) {
+      SCOPED_TRACE("triangle light " + std::to_string(light) + ", lobes down to 10^-" + std::to_string(sharpest) +
+                   " sr");
+      size_t takes = 0, settled = 0, wrong = 0, far_takes = 0, far_settled = 0;
+      std::vector<cl_float4> out = run(light, 31 + light, sharpest);
+      for (size_t i = 0; i < kPoints; ++i) {
+        ASSERT_GE(out[i].s[0], out[i].s[1]) << "lights_omega_bound below the extent's solid angle, point " << i;
+        bool surely = out[i].s[2] != 0.0f, by_moments = out[i].s[3] != 0.0f;
+        takes += by_moments;
+        settled += surely;
+        wrong += surely && !by_moments;
+        if (distance[i] > 20.0) {
+          far_takes += by_moments;
+          far_settled += surely;
+        }
+      }
+      EXPECT_EQ(wrong, 0u) << "the shortcut took a light the second moments leave to BSDF sampling";
+      EXPECT_GT(takes, kPoints / 10) << "too few choices for light sampling to test the shortcut";
+      EXPECT_LT(takes, kPoints - kPoints / 20) << "too few choices for BSDF sampling to test the shortcut";
+      if (sharpest < 1.0f) {
+        EXPECT_GT(settled, takes * 2 / 3) << "the shortcut settles few of the choices";  // 71 %
+        EXPECT_GT(far_settled, far_takes * 95 / 100)
+            << "far from the light it should settle nearly every choice";  // 99 %
+      }
+    }
+  use_scene(mixture_scene());
+  size_t environments = 0;
+  for (cl_uint light = 0; light < compiled_.buffers.lights.size(); ++light) {
+    if (compiled_.buffers.lights[light].type != LIGHT_ENVIRONMENT) continue;
+    ++environments;
+    for (const cl_float4& o : run(light, 41, 4.0f)) {
+      ASSERT_LT(o.s[0], 0.0f) << "an environment has no bound";
+      ASSERT_EQ(o.s[2], 0.0f) << "the shortcut settled an environment";
+    }
+  }
+  EXPECT_EQ(environments, 1u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, LightsTest, kernel_devices(), DeviceParamName());

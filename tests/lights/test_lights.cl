@@ -124,3 +124,30 @@ __kernel void test_lights_select(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const
   bool ok = lights_select(&sc, &ctx, x_select, u_select, &light, &pmf);
   out[i] = (float4)((float)light, pmf, ok ? lights_select_pmf(&sc, &ctx, light) : 0.0f, ok ? 1.0f : 0.0f);
 }
+
+// STRATEGY_AUTO's shortcut (integrator_path.cl) for light `index` seen from points[i], with
+// one to three lobes (cosine, or GGX-shaped of 10^-sharpest to 1 sr, random centres and
+// weights) and a selection probability in [1e-3, 1] drawn from rng_init(i, 0, seed): out[i] =
+// (lights_omega_bound, lights_extent's omega, path_nee_surely_takes,
+// path_nee_takes_by_moments), the last two as 0 or 1
+__kernel void test_lights_nee_shortcut(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, uint index,
+                                       uint seed, float sharpest, __global const float4* points, __global float4* out) {
+  uint i = get_global_id(0);
+  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
+  LightSampleContext ctx = test_lights_context(points[i], (float4)(0.0f, 0.0f, 1.0f, 0.0f), 0u);
+  Rng rng = rng_init(i, 0u, seed);
+  BsdfLobes lobes;
+  lobes.count = 0u;
+  uint n = 1u + min((uint)(rng_next(&rng) * 3.0f), 2u);
+  for (uint k = 0u; k < n; ++k) {
+    float2 u = rng_next_2d(&rng);
+    float kind = rng_next(&rng), size = rng_next(&rng), weight = 0.05f + rng_next(&rng);
+    bsdf_lobes_add(&lobes, sample_uniform_sphere(u.x, u.y), kind < 0.4f ? PI_F : pow(10.0f, -sharpest * size), weight);
+  }
+  float pmf = pow(10.0f, -3.0f * rng_next(&rng));
+  float bound = lights_omega_bound(&sc, index, ctx.p);
+  LightExtent e = lights_extent(&sc, index, ctx.p);
+  bool surely = path_nee_surely_takes(&lobes, bound, pmf);
+  bool takes = path_nee_takes_by_moments(&sc, &lobes, &ctx, index, pmf);
+  out[i] = (float4)(bound, e.omega, surely ? 1.0f : 0.0f, takes ? 1.0f : 0.0f);
+}
