@@ -289,21 +289,18 @@ void lights_triangle_extent(const SceneData* sc, __global const Light* light, fl
 }
 
 // An upper bound on the solid angle the triangle subtends at p, for far less work than its
-// extent: the smaller of the cone of its bounding sphere (centre c the centroid, radius R),
+// extent: the smaller of the cone of its bounding sphere (centre c, radius R: params[1..4]),
 // 2 pi (1 - sqrt(1 - R^2 / d^2)) <= 2 pi R^2 / d^2 at distance d, and area / (d - R)^2 (no
 // point of it is nearer than d - R, and dw = cos dA / r^2), at most 2 pi; 1 % over them
 // for rounding
 float lights_triangle_omega_bound(const SceneData* sc, __global const Light* light, float3 p) {
 #pragma OPENCL FP_CONTRACT OFF
-  float3 v0, v1, v2;
-  scene_prim_positions(sc, light->index, &v0, &v1, &v2);
-  float3 c = (v0 + v1 + v2) * (1.0f / 3.0f);
-  float3 a = v0 - c, b = v1 - c, e = v2 - c, pc = c - p;
-  float r2 = fmax(fmax(dot(a, a), dot(b, b)), dot(e, e)), d2 = dot(pc, pc);
-  float near = sqrt(d2) - sqrt(r2);
+  float3 pc = (float3)(light->params[1], light->params[2], light->params[3]) - p;
+  float r = light->params[4], d2 = dot(pc, pc);
+  float near = sqrt(d2) - r;
   float area = near > 0.0f ? light->params[0] / (near * near) : INFINITY;
-  float bound = fmin(fmin(2.0f * PI_F * r2 / d2, area), 2.0f * PI_F);
-  return bound >= 0.0f ? 1.01f * bound : 2.0f * PI_F;  // NaN (p or the triangle): no help
+  float bound = fmin(fmin(2.0f * PI_F * (r * r) / d2, area), 2.0f * PI_F);
+  return bound >= 0.0f ? 1.01f * bound : 2.0f * PI_F;  // NaN (p): no help
 }
 
 // Punctual lights (KHR_lights_punctual). Each is a delta in direction: the sample carries

@@ -323,8 +323,9 @@ typedef struct {
 // Lights are selected through the alias table (light_alias, one bin per light, O(1));
 // `pmf` is exactly the probability it realizes, counted over all 2^32 integers, so the
 // estimator divides by what the kernel does.
-//   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area;
-//                      radiance comes from the primitive's material.
+//   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area, params[1..3] =
+//                      centroid, params[4] = radius of the sphere about it that holds the
+//                      corners; radiance comes from the primitive's material.
 //   LIGHT_ENVIRONMENT: without a map (params[0] = NO_TEXTURE): radiance = constant radiance.
 //                      With an equirectangular map (cl/lights/environment.cl): params[0] = its
 //                      TextureInfo index (an integer stored as float), params[1] = strength

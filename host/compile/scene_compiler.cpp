@@ -396,6 +396,18 @@ dev::Light compile_environment_map(const EnvironmentDesc& env, dev::SceneBuffers
   return l;
 }
 
+// A triangle light's bounding sphere for lights_triangle_omega_bound: params[1..3] = its
+// centroid in float, params[4] = the largest distance from that point to a corner, rounded
+// up, so that the sphere holds the float corners the kernel sees
+void set_triangle_bounding_sphere(const dev::SceneBuffers& b, const dev::Prim& p, dev::Light* l) {
+  glm::dvec3 v[3] = {vertex(b, p.v[0]), vertex(b, p.v[1]), vertex(b, p.v[2])};
+  glm::vec3 c = glm::vec3((v[0] + v[1] + v[2]) / 3.0);
+  double r = 0.0;
+  for (const glm::dvec3& x : v) r = std::max(r, glm::length(x - glm::dvec3(c)));
+  for (int a = 0; a < 3; ++a) l->params[1 + a] = c[a];
+  l->params[4] = std::nextafter(float(r * (1.0 + 1e-6)), INFINITY);
+}
+
 // Every emissive triangle, punctual light and the environment, with the selection table
 // and the light tree over the finite ones (light_tree.hpp).
 // Triangle lights come first, in increasing primitive order: the kernel finds the light of
@@ -419,6 +431,7 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     l.type = LIGHT_TRIANGLE;
     l.index = uint32_t(i);
     l.params[0] = float(area);
+    set_triangle_bounding_sphere(*b, p, &l);
     double w = light_power(l, *b, scale, radius);
     if (!(w > 0.0)) continue;  // includes emissive textures that are black throughout
     b->lights.push_back(l);
