@@ -3,7 +3,9 @@
 //    over (cos theta, phi) cells: 1M samples, cells with expected count < 5 pooled,
 //    alpha = 0.01 with the Sidak correction over the chi-square tests of this file;
 //  - ls.pdf = lights_pdf(chosen light, wi) wherever a traced ray confirms the light;
-//  - irradiance estimates E[L cos / pdf] against closed forms, within 4 standard errors.
+//  - irradiance estimates E[L cos / pdf] against closed forms, within 4 standard errors;
+//  - the auto strategy's shortcut: lights_omega_bound holds the extent's solid angle, and
+//    every choice path_nee_surely_takes settles is path_nee_takes_by_moments' choice.
 #include <gtest/gtest.h>
 
 #include <algorithm>
