@@ -52,8 +52,6 @@ typedef struct {
   bool decide;              // STRATEGY_AUTO: emission counts for lights the vertex it left
   LightSampleContext prev;  // (seen from `prev`, with lobes `lobes`) did not take by light
   BsdfLobes lobes;          // sampling
-  int chosen_light;         // the light `prev`'s light sample picked (NO_LIGHT: none), and whether
-  bool chosen_takes;        // light sampling took it: path_prev_takes needs no second evaluation
   float eta_scale;          // product of eta^2 over transmissions, so roulette sees radiance scale
   int medium;               // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
   MediumStack media;        // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
@@ -70,8 +68,6 @@ PathState path_start(const SceneData* sc, Ray ray) {
   ps.depth = 0u;
   ps.specular_bounce = true;  // the camera sees emitters directly
   ps.decide = false;
-  ps.chosen_light = NO_LIGHT;
-  ps.chosen_takes = false;
   ps.eta_scale = 1.0f;
   ps.medium = NO_MEDIUM;
 #if CD_FEATURE_DISPERSION
@@ -214,23 +210,13 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
          path_nee_takes_by_moments(sc, lobes, ctx, index, pmf);
 }
 
-// STRATEGY_AUTO's choice for light `index` at the vertex a BSDF-sampled ray left (ps->prev,
-// ps->lobes), where the ray finds it: the one that vertex's light sample made when it
-// picked the same light (the same inputs, the same answer), else path_nee_takes
-bool path_prev_takes(const SceneData* sc, const PathState* ps, uint index) {
-  if (ps->chosen_light == (int)index) return ps->chosen_takes;
-  return path_nee_takes(sc, &ps->lobes, &ps->prev, index, -1.0f);
-}
-
 // Next-event estimate of light arriving at ctx and scattered by bsdf toward wo; with
 // `lobes` (STRATEGY_AUTO), only of a light the vertex takes by light sampling (the others
-// count when a sampled ray finds them: a sample of one contributes nothing here), the
-// light it picked and the choice in *chosen_light and *chosen_takes (set by the caller to
-// NO_LIGHT beforehand). `media`: the media on wo's side; a shadow ray through the surface
-// enters (or leaves) `interior`, the medium inside the surface.
+// count when a sampled ray finds them: a sample of one contributes nothing here).
+// `media`: the media on wo's side; a shadow ray through the surface enters (or leaves)
+// `interior`, the medium inside the surface.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
-                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng, int* chosen_light,
-                         bool* chosen_takes) {
+                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
   uint x_select;
   float u_select;
   lights_select_numbers(sc, rng, &x_select, &u_select);
@@ -240,11 +226,7 @@ float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, con
   if (!lights_select(sc, ctx, x_select, u_select, &light, &pmf)) return (float3)(0.0f);
   // The choice depends on the light and the vertex, not on the direction: a light left to
   // BSDF sampling costs no direction sample (a delta light is always taken)
-  if (lobes) {
-    *chosen_light = (int)light;
-    *chosen_takes = path_nee_takes(sc, lobes, ctx, light, pmf);
-    if (!*chosen_takes) return (float3)(0.0f);
-  }
+  if (lobes && !path_nee_takes(sc, lobes, ctx, light, pmf)) return (float3)(0.0f);
   LightSample ls;
   if (!lights_sample_selected(sc, ctx, light, pmf, u, &ls)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
@@ -347,7 +329,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
       if (counts_emission || ps.decide) {
         float3 le = lights_environment_radiance(sc, ps.ray.dir);
         if (!counts_emission && max_component(le) > 0.0f)
-          counts_emission = !path_prev_takes(sc, &ps, (uint)params->environment_light);
+          counts_emission = !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)params->environment_light, -1.0f);
         if (counts_emission) ps.radiance += ps.beta * le;
       }
       break;
@@ -373,7 +355,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
       float3 le = surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
       if (!counts_emission && max_component(le) > 0.0f) {
         int light = lights_of_prim(sc, (uint)hit.prim);
-        counts_emission = light == NO_LIGHT || !path_prev_takes(sc, &ps, (uint)light);
+        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)light, -1.0f);
       }
       if (counts_emission) ps.radiance += ps.beta * le;
     }
@@ -400,11 +382,9 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     BsdfLobes lobes;
     if (chooses) lobes = bsdf_lobes(&bsdf, wo);
     LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
-    int chosen_light = NO_LIGHT;
-    bool chosen_takes = false;
     if (samples_lights) {
       ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
-                                                 sc->materials[s.material].medium, rng, &chosen_light, &chosen_takes);
+                                                 sc->materials[s.material].medium, rng);
     }
 
     // Continue the path by sampling the BSDF
@@ -419,8 +399,6 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     if (ps.decide) {
       ps.prev = ctx;  // the light selection the light sample saw here
       ps.lobes = lobes;
-      ps.chosen_light = chosen_light;
-      ps.chosen_takes = chosen_takes;
     }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
