@@ -5,7 +5,8 @@
 //  - ls.pdf = lights_pdf(chosen light, wi) wherever a traced ray confirms the light;
 //  - irradiance estimates E[L cos / pdf] against closed forms, within 4 standard errors;
 //  - the auto strategy's shortcut: lights_omega_bound holds the extent's solid angle, and
-//    every choice path_nee_surely_takes settles is path_nee_takes_by_moments' choice.
+//    every choice path_nee_surely_takes settles is path_nee_takes_by_moments' choice, and
+//    settling first by the lobes' own terms changes none of the latter's choices.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -437,10 +438,22 @@ TEST_P(LightsTest, AutoShortcutAgreesWithTheSecondMoments) {
     points.push_back(f4(centre + d * glm::dvec3(r * std::cos(phi), r * std::sin(phi), z)));
     distance.push_back(d);
   }
+  // The choices with and without settling first by the lobes' own terms must be the same
+  // (path_nee_takes_by_moments' own_terms_first); returns test_lights_nee_shortcut's out
   auto run = [&](cl_uint light, cl_uint seed, float sharpest) {
     auto out = rig().output<cl_float4>(kPoints);
-    rig().run("test_lights_nee_shortcut", kPoints, *scene_, light, seed, sharpest, rig().input(points), out);
-    return out.read();
+    auto full = rig().output<cl_float>(kPoints);
+    rig().run("test_lights_nee_shortcut", kPoints, *scene_, light, seed, sharpest, rig().input(points), out, full);
+    std::vector<cl_float4> o = out.read();
+    std::vector<cl_float> f = full.read();
+    size_t differ = 0, leaves = 0;
+    for (size_t i = 0; i < kPoints; ++i) {
+      differ += o[i].s[3] != f[i];
+      leaves += f[i] == 0.0f;
+    }
+    EXPECT_EQ(differ, 0u) << "settling by the lobes' own terms changed a choice";
+    EXPECT_GT(leaves, kPoints / 20) << "too few choices for BSDF sampling to test settling by the own terms";
+    return o;
   };
   use_scene(quad_scene());
   for (cl_uint light : {0u, 1u})

@@ -129,9 +129,11 @@ __kernel void test_lights_select(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const
 // one to three lobes (cosine, or GGX-shaped of 10^-sharpest to 1 sr, random centres and
 // weights) and a selection probability in [1e-3, 1] drawn from rng_init(i, 0, seed): out[i] =
 // (lights_omega_bound, lights_extent's omega, path_nee_surely_takes,
-// path_nee_takes_by_moments), the last two as 0 or 1
+// path_nee_takes_by_moments), the last two as 0 or 1; full[i]: path_nee_takes_by_moments
+// without settling first by the lobes' own terms, 0 or 1
 __kernel void test_lights_nee_shortcut(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params, uint index,
-                                       uint seed, float sharpest, __global const float4* points, __global float4* out) {
+                                       uint seed, float sharpest, __global const float4* points, __global float4* out,
+                                       __global float* full) {
   uint i = get_global_id(0);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   LightSampleContext ctx = test_lights_context(points[i], (float4)(0.0f, 0.0f, 1.0f, 0.0f), 0u);
@@ -148,6 +150,7 @@ __kernel void test_lights_nee_shortcut(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global
   float bound = lights_omega_bound(&sc, index, ctx.p);
   LightExtent e = lights_extent(&sc, index, ctx.p);
   bool surely = path_nee_surely_takes(&lobes, bound, pmf);
-  bool takes = path_nee_takes_by_moments(&sc, &lobes, &ctx, index, pmf);
+  bool takes = path_nee_takes_by_moments(&sc, &lobes, &ctx, index, pmf, true);
   out[i] = (float4)(bound, e.omega, surely ? 1.0f : 0.0f, takes ? 1.0f : 0.0f);
+  full[i] = path_nee_takes_by_moments(&sc, &lobes, &ctx, index, pmf, false) ? 1.0f : 0.0f;
 }
