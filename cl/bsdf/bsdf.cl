@@ -134,19 +134,24 @@ float bsdf_pdf(const Bsdf* b, float3 wo, float3 wi) {
   return pdf;
 }
 
-// The lobe's sample in the local frame
-bool bsdf_sample_local(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+// The lobe's sample in the local frame (and with l its lobes at wo)
+bool bsdf_sample_local(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* l) {
 #define BSDF_SAMPLE(id, name, feature) \
-  if (feature && b->type == id) return bsdf_##name##_sample(b, wo, uc, u, bs);
+  if (feature && b->type == id) return bsdf_##name##_sample(b, wo, uc, u, bs, l);
   CD_MATERIALS(BSDF_SAMPLE)
 #undef BSDF_SAMPLE
-  return bsdf_diffuse_sample(b, wo, uc, u, bs);
+  return bsdf_diffuse_sample(b, wo, uc, u, bs, l);
 }
 
-// Samples bs->wi (world space) from uc (lobe choice) and u; false when the path ends here
-bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+// Samples bs->wi (world space) from uc (lobe choice) and u; false when the path ends here.
+// With `lobes` (STRATEGY_AUTO), also bsdf_lobes(b, wo) into it, whatever the sample: a type
+// computes what both need at wo once.
+bool bsdf_sample_lobes(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* lobes) {
   float3 wo_l = frame_to_local(&b->frame, wo);
-  bool ok = bsdf_sample_local(b, wo_l, uc, u, bs);
+  if (lobes) lobes->count = 0u;
+  bool ok = bsdf_sample_local(b, wo_l, uc, u, bs, lobes);
+  if (lobes)
+    for (uint k = 0u; k < lobes->count; ++k) lobes->dir[k] = frame_from_local(&b->frame, lobes->dir[k]);
   if (!ok) return false;
   bool local_reflection = bs->wi.z > 0.0f;
   bs->wi = frame_from_local(&b->frame, bs->wi);
@@ -154,4 +159,8 @@ bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (bsdf_is_reflection(b, bs->wi) != ((bs->flags & BSDF_REFLECTION) != 0u)) return false;
   if (local_reflection != ((bs->flags & BSDF_REFLECTION) != 0u)) return false;
   return bs->pdf > 0.0f && max_component(bs->f) > 0.0f;
+}
+
+bool bsdf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  return bsdf_sample_lobes(b, wo, uc, u, bs, 0);
 }

@@ -39,7 +39,18 @@ float3 bsdf_conductor_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   return single + f_ms * energy_ms(&e, energy_at(wi));
 }
 
-bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+// The GGX reflection about the mirror direction, and the multiple-scattering cosine lobe
+void bsdf_conductor_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
+  const ConductorBsdf* p = &b->lobe.conductor;
+  if (ggx_is_delta(p->ggx) || wo.z <= 0.0f) return;
+  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, energy_at(wo));
+  float q = e.table ? bsdf_conductor_ms_share(p, &e, energy_ms_fresnel(&e, p->f_avg)) : 0.0f;
+  bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(p->ggx), 1.0f - q);
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), q);
+}
+
+bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* l) {
+  if (l) bsdf_conductor_lobes(b, wo, l);
   const ConductorBsdf* p = &b->lobe.conductor;
   bs->eta = 1.0f;
   if (ggx_is_delta(p->ggx)) {
@@ -60,14 +71,4 @@ bool bsdf_conductor_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSam
   bs->f = bsdf_conductor_eval(b, wo, bs->wi, &bs->pdf);
   bs->flags = BSDF_REFLECTION | BSDF_GLOSSY;
   return bs->pdf > 0.0f;
-}
-
-// The GGX reflection about the mirror direction, and the multiple-scattering cosine lobe
-void bsdf_conductor_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
-  const ConductorBsdf* p = &b->lobe.conductor;
-  if (ggx_is_delta(p->ggx) || wo.z <= 0.0f) return;
-  GgxEnergy e = energy_ggx(b->ggx_albedo, p->ggx, energy_at(wo));
-  float q = e.table ? bsdf_conductor_ms_share(p, &e, energy_ms_fresnel(&e, p->f_avg)) : 0.0f;
-  bsdf_lobes_add(l, (float3)(-wo.x, -wo.y, wo.z), bsdf_lobe_omega_ggx(p->ggx), 1.0f - q);
-  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), q);
 }

@@ -10,7 +10,13 @@ float3 bsdf_diffuse_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
   return wi.z > 0.0f ? b->base_color * INV_PI_F : (float3)(0.0f);
 }
 
-bool bsdf_diffuse_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+// One cosine lobe about the normal
+void bsdf_diffuse_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
+  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), 1.0f);
+}
+
+bool bsdf_diffuse_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* l) {
+  if (l) bsdf_diffuse_lobes(b, wo, l);
   bs->wi = sample_cosine_hemisphere(u.x, u.y);
   bs->f = bsdf_diffuse_eval(b, wo, bs->wi, &bs->pdf);
   bs->flags = BSDF_REFLECTION | BSDF_DIFFUSE;
@@ -51,9 +57,4 @@ float3 diffuse_eon_eval_pi(float3 rho, float r, float e_o, float3 wo, float3 wi)
   float3 rho_ms = rho * rho * e_avg / ((float3)(1.0f) - rho * (1.0f - e_avg));
   float ms = (1.0f - e_o) * (1.0f - diffuse_eon_albedo(mu_i, r)) / (1.0f - e_avg);
   return rho * (a * (1.0f + r * s_over_t)) + rho_ms * ms;
-}
-
-// One cosine lobe about the normal
-void bsdf_diffuse_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
-  bsdf_lobes_add(l, (float3)(0.0f, 0.0f, 1.0f), bsdf_lobe_omega_cosine(), 1.0f);
 }

@@ -657,59 +657,6 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   return bs->pdf > 0.0f ? GLTF_SAMPLE_DONE : GLTF_SAMPLE_FAILED;
 }
 
-// A component by uc (its CDF over GLTF_COMPONENTS), sampled with uc rescaled to [0, 1)
-// within the component; a chosen direction is weighed by the whole mixture
-bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
-  if (wo.z <= 0.0f) return false;
-  GltfAtWo at_wo = gltf_at_wo(b, wo);
-  const uint last = GLTF_COMPONENT_COUNT - 1u;
-  float cdf[GLTF_COMPONENT_COUNT - 1];
-  cdf[0] = at_wo.w[0];
-  for (uint k = 1u; k < last; ++k) cdf[k] = cdf[k - 1u] + at_wo.w[k];
-  uint c = 0u;
-  while (c < last && uc >= cdf[c]) ++c;
-  float lo = c == 0u ? 0.0f : cdf[c - 1u], width = (c == last ? 1.0f : cdf[c]) - lo;
-  float uc2 = width > 0.0f ? clamp((uc - lo) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
-  int done = GLTF_SAMPLE_FAILED;
-  uint kind = 0u;
-#define GLTF_SAMPLE(id, name, flag)                         \
-  if (c == id) {                                            \
-    done = gltf_##name##_sample(b, &at_wo, wo, uc2, u, bs); \
-    kind = flag;                                            \
-  }
-  GLTF_COMPONENTS(GLTF_SAMPLE)
-#undef GLTF_SAMPLE
-  if (done != GLTF_SAMPLE_DIRECTION) return done == GLTF_SAMPLE_DONE;
-  bool transmits = bs->wi.z < 0.0f;
-  bs->f = gltf_eval_at(b, &at_wo, wo, bs->wi, &bs->pdf);
-  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | kind;
-  // A diffuse component's transmission does not refract (the direction, evaluated as the
-  // whole mixture, counts as the component that sampled it)
-  bs->eta = transmits && !b->lobe.gltf.thin && !(kind & BSDF_DIFFUSE) ? b->lobe.gltf.eta : 1.0f;
-  return bs->pdf > 0.0f;
-}
-
-// The kinds of lobe present
-uint bsdf_gltf_flags(const Bsdf* b) {
-  const GltfBsdf* lobe = &b->lobe.gltf;
-  uint flags = BSDF_REFLECTION;
-  bool plastic = lobe->metallic < 1.0f && lobe->transmission < 1.0f;
-  if (plastic && max_component(b->base_color) > 0.0f) flags |= BSDF_DIFFUSE;
-  bool spec_delta = ggx_is_delta(lobe->ggx), coat_delta = lobe->coat > 0.0f && ggx_is_delta(lobe->coat_ggx);
-  if (lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->transmission > 0.0f)
-    flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
-  if (lobe->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
-  if (lobe->transmission > 0.0f && lobe->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
-#if CD_FEATURE_SHEEN
-  if (max_component(lobe->sheen) > 0.0f) flags |= BSDF_GLOSSY;
-#endif
-#if CD_FEATURE_DIFFUSE_TRANSMISSION
-  if (plastic && lobe->diffuse_transmission > 0.0f && max_component(lobe->diffuse_transmission_color) > 0.0f)
-    flags |= BSDF_DIFFUSE | BSDF_TRANSMISSION;
-#endif
-  return flags;
-}
-
 // Each component's lobes (a GGX reflection about the mirror direction, cosine lobes about
 // the normal; the glass splits its weight by the Fresnel reflectance at wo between its
 // reflection and its transmission, about the refracted direction, or straight through a
@@ -769,10 +716,70 @@ void gltf_glass_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, Bsdf
   bsdf_lobes_add(l, t, omega, w * (1.0f - r));
 }
 
+// The mixture's lobes at wo, from its weights there
+void gltf_lobes_at(const Bsdf* b, const GltfAtWo* g, float3 wo, BsdfLobes* l) {
+#define GLTF_LOBES(id, name, kind) gltf_##name##_lobes(b, g, wo, g->w[id], l);
+  GLTF_COMPONENTS(GLTF_LOBES)
+#undef GLTF_LOBES
+}
+
 void bsdf_gltf_lobes(const Bsdf* b, float3 wo, BsdfLobes* l) {
   if (wo.z <= 0.0f) return;
   GltfAtWo g = gltf_at_wo(b, wo);
-#define GLTF_LOBES(id, name, kind) gltf_##name##_lobes(b, &g, wo, g.w[id], l);
-  GLTF_COMPONENTS(GLTF_LOBES)
-#undef GLTF_LOBES
+  gltf_lobes_at(b, &g, wo, l);
+}
+
+// A component by uc (its CDF over GLTF_COMPONENTS), sampled with uc rescaled to [0, 1)
+// within the component; a chosen direction is weighed by the whole mixture
+// (with l, its lobes too, from the same mixture at wo)
+bool bsdf_gltf_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* l) {
+  if (wo.z <= 0.0f) return false;
+  GltfAtWo at_wo = gltf_at_wo(b, wo);
+  if (l) gltf_lobes_at(b, &at_wo, wo, l);
+  const uint last = GLTF_COMPONENT_COUNT - 1u;
+  float cdf[GLTF_COMPONENT_COUNT - 1];
+  cdf[0] = at_wo.w[0];
+  for (uint k = 1u; k < last; ++k) cdf[k] = cdf[k - 1u] + at_wo.w[k];
+  uint c = 0u;
+  while (c < last && uc >= cdf[c]) ++c;
+  float lo = c == 0u ? 0.0f : cdf[c - 1u], width = (c == last ? 1.0f : cdf[c]) - lo;
+  float uc2 = width > 0.0f ? clamp((uc - lo) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
+  int done = GLTF_SAMPLE_FAILED;
+  uint kind = 0u;
+#define GLTF_SAMPLE(id, name, flag)                         \
+  if (c == id) {                                            \
+    done = gltf_##name##_sample(b, &at_wo, wo, uc2, u, bs); \
+    kind = flag;                                            \
+  }
+  GLTF_COMPONENTS(GLTF_SAMPLE)
+#undef GLTF_SAMPLE
+  if (done != GLTF_SAMPLE_DIRECTION) return done == GLTF_SAMPLE_DONE;
+  bool transmits = bs->wi.z < 0.0f;
+  bs->f = gltf_eval_at(b, &at_wo, wo, bs->wi, &bs->pdf);
+  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | kind;
+  // A diffuse component's transmission does not refract (the direction, evaluated as the
+  // whole mixture, counts as the component that sampled it)
+  bs->eta = transmits && !b->lobe.gltf.thin && !(kind & BSDF_DIFFUSE) ? b->lobe.gltf.eta : 1.0f;
+  return bs->pdf > 0.0f;
+}
+
+// The kinds of lobe present
+uint bsdf_gltf_flags(const Bsdf* b) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+  uint flags = BSDF_REFLECTION;
+  bool plastic = lobe->metallic < 1.0f && lobe->transmission < 1.0f;
+  if (plastic && max_component(b->base_color) > 0.0f) flags |= BSDF_DIFFUSE;
+  bool spec_delta = ggx_is_delta(lobe->ggx), coat_delta = lobe->coat > 0.0f && ggx_is_delta(lobe->coat_ggx);
+  if (lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->transmission > 0.0f)
+    flags |= spec_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (lobe->coat > 0.0f) flags |= coat_delta ? BSDF_DELTA : BSDF_GLOSSY;
+  if (lobe->transmission > 0.0f && lobe->metallic < 1.0f) flags |= BSDF_TRANSMISSION;
+#if CD_FEATURE_SHEEN
+  if (max_component(lobe->sheen) > 0.0f) flags |= BSDF_GLOSSY;
+#endif
+#if CD_FEATURE_DIFFUSE_TRANSMISSION
+  if (plastic && lobe->diffuse_transmission > 0.0f && max_component(lobe->diffuse_transmission_color) > 0.0f)
+    flags |= BSDF_DIFFUSE | BSDF_TRANSMISSION;
+#endif
+  return flags;
 }

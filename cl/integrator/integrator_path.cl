@@ -223,13 +223,11 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
 // `lobes` (STRATEGY_AUTO), only of a light the vertex takes by light sampling (the others
 // count when a sampled ray finds them: a sample of one contributes nothing here).
 // `media`: the media on wo's side; a shadow ray through the surface enters (or leaves)
-// `interior`, the medium inside the surface.
+// `interior`, the medium inside the surface. x_select, u_select (lights_select_numbers) and
+// u (rng_next_2d): its random numbers, which the caller draws.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
-                         const BsdfLobes* lobes, const MediumStack* media, int interior, Rng* rng) {
-  uint x_select;
-  float u_select;
-  lights_select_numbers(sc, rng, &x_select, &u_select);
-  float2 u = rng_next_2d(rng);
+                         const BsdfLobes* lobes, const MediumStack* media, int interior, uint x_select, float u_select,
+                         float2 u, Rng* rng) {
   uint light;
   float pmf;
   if (!lights_select(sc, ctx, x_select, u_select, &light, &pmf)) return (float3)(0.0f);
@@ -388,19 +386,30 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     // under auto, of the lights the vertex takes by light sampling (path_nee_takes)
     bool samples_lights = strategy != STRATEGY_BSDF && (flags & (BSDF_DIFFUSE | BSDF_GLOSSY)) != 0u;
     bool chooses = samples_lights && strategy == STRATEGY_AUTO;
-    BsdfLobes lobes;
-    if (chooses) lobes = bsdf_lobes(&bsdf, wo);
     LightSampleContext ctx = light_context_at_surface(&s, &bsdf);
+    // The random numbers of the light sample, then of the BSDF sample that continues the
+    // path. The BSDF is sampled first, with its lobes when the vertex chooses (a type
+    // computes what both need at wo once: for the glTF mixture, most of the vertex's BSDF
+    // work), then the light.
+    uint x_select = 0u;
+    float u_select = 0.0f;
+    float2 u_light = (float2)(0.0f);
     if (samples_lights) {
-      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
-                                                 sc->materials[s.material].medium, rng);
+      lights_select_numbers(sc, rng, &x_select, &u_select);
+      u_light = rng_next_2d(rng);
     }
-
-    // Continue the path by sampling the BSDF
     float uc = rng_next(rng);
     float2 u = rng_next_2d(rng);
     BsdfSample bs;
-    if (!bsdf_sample(&bsdf, wo, uc, u, &bs)) break;
+    BsdfLobes lobes;
+    bool sampled = bsdf_sample_lobes(&bsdf, wo, uc, u, &bs, chooses ? &lobes : 0);
+    if (samples_lights) {
+      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
+                                                 sc->materials[s.material].medium, x_select, u_select, u_light, rng);
+    }
+    if (!sampled) break;
+
+    // Continue the path along the sampled direction
     ps.beta *= bs.f * (fabs(dot(bs.wi, bsdf.frame.n)) / bs.pdf);  // the mapped shading normal
     bool delta = (bs.flags & BSDF_DELTA) != 0u;
     ps.specular_bounce = delta || !samples_lights;

@@ -44,7 +44,8 @@
 //   void bsdf_NAME_params(const SceneData*, __global const Material*, const SurfaceHit*, Bsdf*)
 //   uint bsdf_NAME_flags(const Bsdf*)
 //   float3 bsdf_NAME_eval(const Bsdf*, float3 wo, float3 wi, float* pdf)
-//   bool bsdf_NAME_sample(const Bsdf*, float3 wo, float uc, float2 u, BsdfSample*)
+//   bool bsdf_NAME_sample(const Bsdf*, float3 wo, float uc, float2 u, BsdfSample*, BsdfLobes* l):
+//     with l (not 0), also its lobes at wo into l, as bsdf_NAME_lobes gives them
 //   void bsdf_NAME_lobes(const Bsdf*, float3 wo, BsdfLobes*): its lobes at wo (bsdf_common.cl)
 // and on the host compile_material_NAME (host/compile/scene_compiler.cpp). `feature` is the
 // CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.

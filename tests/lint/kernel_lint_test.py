@@ -160,7 +160,7 @@ LOBE = {
     'params': ('void', ['const SceneData*', '__global const Material*', 'const SurfaceHit*', 'Bsdf*']),
     'flags': ('uint', ['const Bsdf*']),
     'eval': ('float3', ['const Bsdf*', 'float3', 'float3', 'float*']),
-    'sample': ('bool', ['const Bsdf*', 'float3', 'float', 'float2', 'BsdfSample*']),
+    'sample': ('bool', ['const Bsdf*', 'float3', 'float', 'float2', 'BsdfSample*', 'BsdfLobes*']),
     'lobes': ('void', ['const Bsdf*', 'float3', 'BsdfLobes*']),
 }
 COMPONENT = {
