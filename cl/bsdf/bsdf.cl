@@ -68,6 +68,7 @@ void bsdf_lobes_local(const Bsdf* b, float3 wo, BsdfLobes* l) {
   bsdf_diffuse_lobes(b, wo, l);
 }
 
+// (The integrator takes the lobes from bsdf_sample_lobes; the tests check the two agree.)
 BsdfLobes bsdf_lobes(const Bsdf* b, float3 wo) {
   BsdfLobes l;
   l.count = 0u;
@@ -144,8 +145,8 @@ bool bsdf_sample_local(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample*
 }
 
 // Samples bs->wi (world space) from uc (lobe choice) and u; false when the path ends here.
-// With `lobes` (STRATEGY_AUTO), also bsdf_lobes(b, wo) into it, whatever the sample: a type
-// computes what both need at wo once.
+// With `lobes` (STRATEGY_AUTO), also bsdf_lobes(b, wo) into it, whatever the sample, so that
+// a type can compute what both need at wo once (the glTF mixture does).
 bool bsdf_sample_lobes(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs, BsdfLobes* lobes) {
   float3 wo_l = frame_to_local(&b->frame, wo);
   if (lobes) lobes->count = 0u;

@@ -7,9 +7,9 @@
 //                  arrives through shadow rays to sampled lights (skipped at delta lobes)
 //   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
 //                  punctual lights, which no ray can hit, contribute nothing)
-//   STRATEGY_AUTO: per vertex and per light, decided before sampling from the BSDF's lobes
-//                  at wo (bsdf_lobes) and the light's extent seen from the vertex
-//                  (lights_extent): path_nee_takes. A light sample counts only for a light
+//   STRATEGY_AUTO: per vertex and per light, decided before the light sample from the
+//                  BSDF's lobes at wo (bsdf_sample_lobes) and the light's extent seen from
+//                  the vertex (lights_extent): path_nee_takes. A light sample counts only for a light
 //                  the vertex takes by light sampling; a BSDF-sampled ray that finds an
 //                  emitter or the environment counts it only for a light the vertex it left
 //                  did not take (the path state keeps that vertex's light-sampling context and lobes).

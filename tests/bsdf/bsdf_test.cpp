@@ -4,7 +4,8 @@
 // (chi-square, 1M samples, cells with expected count < 5 pooled, alpha = 0.01 with the Sidak
 // correction over the harness's chi-square tests), the pdf integrates to at most 1, sample
 // weights agree with eval and pdf, no energy is created, eval is reciprocal (generalized for
-// refraction) and matches a host-side reference lobe. Delta lobes are checked against their
+// refraction) and matches a host-side reference lobe; the sample and lobes the integrator
+// takes in one call are those of bsdf_sample and bsdf_lobes. Delta lobes are checked against their
 // Fresnel weights and frequencies (BsdfDelta, in each family's file), albedos on a grid of
 // incidence angles and roughnesses (BsdfEnergy). Known kernel bugs are listed per material
 // (MaterialCase::bugs): their rows are skipped with a note, the rest runs. This file: the
@@ -58,6 +59,36 @@ TEST_P(BsdfEval, MatchesReference) {
       check_reference(BsdfRun(rig(), mat.material, g), mat, bugs);
     }
   BSDF_SKIP_KNOWN_BUGS(bugs);
+}
+
+// The integrator takes a vertex's lobes from its BSDF sample (bsdf_sample_lobes): they must
+// be bsdf_lobes' bit for bit, and the sample bsdf_sample's, for every material at every
+// geometry (test_bsdf_lobes). On PoCL only: the same kernel source decides it on any device,
+// and llvmpipe (rusticl) takes many minutes to compile a kernel with two whole samples of
+// every material type in it.
+TEST(BsdfLobes, SampleGivesTheLobesOfBsdfLobes) {
+  constexpr size_t kDraws = 4096;
+  const KernelRig& rig = kernel_rig("pocl");
+  size_t cases_with_lobes = 0, samples = 0;
+  for (const MaterialCase& mat : all_materials())
+    for (const Geometry& g : geometries()) {
+      SCOPED_TRACE(mat.name + " " + g.name);
+      BsdfRun run(rig, mat.material, g);
+      auto out = rig.output<cl_uint4>(kDraws);
+      rig.run("test_bsdf_lobes", kDraws, run.materials, f4(g.ng), f4(g.ns), f4(g.tangent), f4(g.wo), cl_uint(5), out);
+      size_t lobes_differ = 0, samples_differ = 0;
+      std::vector<cl_uint4> result = out.read();
+      for (const cl_uint4& o : result) {
+        lobes_differ += o.s[0] == 0;
+        samples_differ += o.s[3] == 0;
+        samples += o.s[2];
+      }
+      EXPECT_EQ(lobes_differ, 0u) << "bsdf_sample_lobes' lobes are not bsdf_lobes'";
+      EXPECT_EQ(samples_differ, 0u) << "bsdf_sample_lobes' sample is not bsdf_sample's";
+      cases_with_lobes += result[0].s[1] > 0;
+    }
+  EXPECT_GT(cases_with_lobes, 10u) << "too few materials and geometries with lobes to test";
+  EXPECT_GT(samples, 10u * kDraws) << "too few samples returned to test";
 }
 
 INSTANTIATE_TEST_SUITE_P(Lobes, BsdfEval, kernel_devices(), DeviceParamName());

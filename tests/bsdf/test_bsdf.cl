@@ -127,6 +127,41 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
   test_bsdf_sample_at(&sc, ng, ns, tangent, wo, seed, out, info);
 }
 
+// Sample i of material 0 seen from wo, (uc, u) drawn from rng_init(i, 0, seed), through
+// bsdf_sample_lobes (the integrator's call: the sample and the lobes at wo together) against
+// bsdf_sample and bsdf_lobes called apart: out[i] = (1 when the lobes are the same bit for
+// bit, their count, 1 when bsdf_sample_lobes returned a sample, 1 when both calls returned
+// the same answer and, if a sample, the same one bit for bit)
+__kernel void test_bsdf_lobes(__global const Material* materials, float4 ng, float4 ns, float4 tangent, float4 wo,
+                              uint seed, __global uint4* out) {
+  uint i = get_global_id(0);
+  SceneData sc = test_bsdf_scene(materials);
+  SurfaceHit s = test_bsdf_hit(ng.xyz, ns.xyz, tangent.xyz, wo.xyz, 0u);
+  Bsdf b = bsdf_at(&sc, &s);
+  Rng rng = rng_init(i, 0u, seed);
+  float uc = rng_next(&rng);
+  float2 u = rng_next_2d(&rng);
+  BsdfSample with, apart;
+  BsdfLobes lobes;
+  bool ok = bsdf_sample_lobes(&b, wo.xyz, uc, u, &with, &lobes);
+  bool ok_apart = bsdf_sample(&b, wo.xyz, uc, u, &apart);
+  BsdfLobes alone = bsdf_lobes(&b, wo.xyz);
+  bool same_lobes = lobes.count == alone.count;
+  for (uint k = 0u; same_lobes && k < alone.count; ++k)
+    same_lobes =
+        as_uint(lobes.dir[k].x) == as_uint(alone.dir[k].x) && as_uint(lobes.dir[k].y) == as_uint(alone.dir[k].y) &&
+        as_uint(lobes.dir[k].z) == as_uint(alone.dir[k].z) && as_uint(lobes.omega[k]) == as_uint(alone.omega[k]) &&
+        as_uint(lobes.weight[k]) == as_uint(alone.weight[k]);
+  bool same_sample = ok == ok_apart;
+  if (same_sample && ok)
+    same_sample = as_uint(with.wi.x) == as_uint(apart.wi.x) && as_uint(with.wi.y) == as_uint(apart.wi.y) &&
+                  as_uint(with.wi.z) == as_uint(apart.wi.z) && as_uint(with.f.x) == as_uint(apart.f.x) &&
+                  as_uint(with.f.y) == as_uint(apart.f.y) && as_uint(with.f.z) == as_uint(apart.f.z) &&
+                  as_uint(with.pdf) == as_uint(apart.pdf) && as_uint(with.eta) == as_uint(apart.eta) &&
+                  with.flags == apart.flags;
+  out[i] = (uint4)(same_lobes ? 1u : 0u, alone.count, ok ? 1u : 0u, same_sample ? 1u : 0u);
+}
+
 // test_bsdf_eval_at in a scene of the material table alone
 __kernel void test_bsdf_eval(__global const Material* materials, float4 ng, float4 ns, float4 tangent,
                              __global const float4* pairs, __global float4* out) {
