@@ -196,6 +196,81 @@ uint2 rng_sobol_next_2d(RngSobol* r) {
   return p;
 }
 
+// ---- Eight pixels' first pair at once (CPU packets) -------------------------------------
+// rng_pcg4d, rng_lk_hash, rng_reverse_bits and rng_sobol_dim1_reversed lane for lane on
+// uint8: the same integer operations, so the same bits, in SIMD lanes. A work-item that
+// traces eight camera rays as a packet draws their film positions (pair 0) this way.
+
+void rng_pcg4d8(uint8* x, uint8* y, uint8* z, uint8* w) {
+  uint8 a = *x * 1664525u + 1013904223u, b = *y * 1664525u + 1013904223u;
+  uint8 c = *z * 1664525u + 1013904223u, d = *w * 1664525u + 1013904223u;
+  a += b * d;
+  b += c * a;
+  c += a * b;
+  d += b * c;
+  a ^= a >> 16u;
+  b ^= b >> 16u;
+  c ^= c >> 16u;
+  d ^= d >> 16u;
+  a += b * d;
+  b += c * a;
+  c += a * b;
+  d += b * c;
+  *x = a;
+  *y = b;
+  *z = c;
+  *w = d;
+}
+
+uint8 rng_lk_hash8(uint8 x, uint8 seed) {
+  x ^= x * 0x3d20adeau;
+  x += seed;
+  x *= (seed >> 16) | 1u;
+  x ^= x * 0x05526c56u;
+  x ^= x * 0x53a22864u;
+  return x;
+}
+
+uint8 rng_reverse_bits8(uint8 x) {
+  x = (x << 16) | (x >> 16);
+  x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+  return x;
+}
+
+uint8 rng_sobol_dim1_reversed8(uint8 i) {
+  i ^= (i >> 1) & 0x55555555u;
+  i ^= (i >> 2) & 0x33333333u;
+  i ^= (i >> 4) & 0x0f0f0f0fu;
+  i ^= (i >> 8) & 0x00ff00ffu;
+  i ^= (i >> 16) & 0x0000ffffu;
+  return i;
+}
+
+// rng_sobol_pair of eight pixels (lane l: pixel.sl) for one sample and pair
+void rng_sobol_pair8(uint8 pixel, uint sample_reversed, uint hashed_seed, uint pair, uint8* x, uint8* y) {
+  uint8 hx = pixel, hy = (uint8)(pair), hz = (uint8)(hashed_seed), hw = (uint8)(0x736f626cu);
+  rng_pcg4d8(&hx, &hy, &hz, &hw);
+  uint8 index = rng_reverse_bits8(rng_lk_hash8((uint8)(sample_reversed), hx));
+  *x = rng_reverse_bits8(rng_lk_hash8(index, hy));
+  *y = rng_reverse_bits8(rng_lk_hash8(rng_sobol_dim1_reversed8(index), hz));
+}
+
+// The state rng_sobol_init(pixel, sample, seed) is in after its first two 1D draws (pair 0,
+// whose second coordinate is y), from the sample's reversed index and the hashed seed
+RngSobol rng_sobol_after_pair0(uint pixel, uint sample_reversed, uint hashed_seed, uint y) {
+  RngSobol r;
+  r.pixel = pixel;
+  r.sample_reversed = sample_reversed;
+  r.seed = hashed_seed;
+  r.dimension_1d = 2u;
+  r.pending = y;
+  r.draws_2d = 0u;
+  return r;
+}
+
 // ---- The interface ------------------------------------------------------------------
 
 #if CD_SAMPLER_SOBOL

@@ -489,6 +489,67 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 // (Loops over the eight lanes have a fixed trip count, and structs reach the arrays from
 // locals: llvmpipe mistranslated a lane loop with a data-dependent bound and a struct
 // returned straight into an array element.)
+
+// The camera rays and random number states of eight pixels' sample `sample`: lane for
+// lane pixel_camera_ray's after rng_init, bit for bit. With the Sobol sampler the film
+// positions (pair 0) are drawn in SIMD lanes, and so are the rays of a pinhole camera.
+void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, Rng rng[8],
+                        Ray rays[8]) {
+#if CD_SAMPLER_SOBOL
+  uint sample_reversed = rng_reverse_bits(sample), hashed_seed = rng_hash_seed(params->seed);
+  uint8 pixels = vload8(0, pixel), ux, uy;
+  rng_sobol_pair8(pixels, sample_reversed, hashed_seed, 0u, &ux, &uy);
+  uint y_bits[8];
+  vstore8(uy, 0, y_bits);
+  // Where each sample lands on the film: the box filter's is the uniform jitter itself
+  float8 jx = convert_float8(ux >> 8) * 0x1.0p-24f, jy = convert_float8(uy >> 8) * 0x1.0p-24f;  // rng_uint_to_float
+  float8 fx = convert_float8(pixels % params->width), fy = convert_float8(pixels / params->width);
+  if (params->filter == FILTER_BOX) {
+    fx += jx;
+    fy += jy;
+  } else {
+    float ax[8], ay[8], bx[8], by[8];
+    vstore8(jx, 0, ax);
+    vstore8(jy, 0, ay);
+    vstore8(fx, 0, bx);
+    vstore8(fy, 0, by);
+    for (int l = 0; l < 8; ++l) {
+      float2 film = filter_sample(params->filter, ax[l], ay[l]);
+      bx[l] += film.x;
+      by[l] += film.y;
+    }
+    fx = vload8(0, bx);
+    fy = vload8(0, by);
+  }
+  for (int l = 0; l < 8; ++l) {
+    Rng r = rng_sobol_after_pair0(pixel[l], sample_reversed, hashed_seed, y_bits[l]);
+    rng[l] = r;
+  }
+  if (params->camera.type == CAMERA_PERSPECTIVE && !(params->camera.lens_radius > 0.0f)) {
+    camera_rays8(params, fx, fy, rays);
+    return;
+  }
+  float px[8], py[8];
+  vstore8(fx, 0, px);
+  vstore8(fy, 0, py);
+  for (int l = 0; l < 8; ++l) {
+    Rng r = rng[l];
+    float2 lens = (float2)(0.0f);
+    if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(&r), rng_next(&r));
+    Ray ray = camera_ray(params, px[l], py[l], lens);
+    rng[l] = r;
+    rays[l] = ray;
+  }
+#else
+  for (int l = 0; l < 8; ++l) {
+    Rng r = rng_init(pixel[l], sample, params->seed);
+    Ray ray = pixel_camera_ray(params, pixel[l] % params->width, pixel[l] / params->width, &r);
+    rng[l] = r;
+    rays[l] = ray;
+  }
+#endif
+}
+
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
                            __global float4* film_mean, __global float4* film_m2) {
   uint first = params->pixel_begin + 8u * (uint)get_global_id(0);
@@ -507,14 +568,9 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
     Rng rng[8];
     Ray rays[8];
     float tmax[8];
-    for (uint l = 0u; l < 8u; ++l) {
-      Rng r = rng_init(pixel[l], params->sample_begin + k, params->seed);
-      Ray ray = pixel_camera_ray(params, pixel[l] % params->width, pixel[l] / params->width, &r);
-      rng[l] = r;
-      rays[l].org = ray.org;
-      rays[l].dir = ray.dir;
+    packet_camera_rays(params, pixel, params->sample_begin + k, rng, rays);
+    for (uint l = 0u; l < 8u; ++l)
       tmax[l] = first + l < params->pixel_end ? INFINITY : 0.0f;  // past the end: finds nothing
-    }
     Hit hits[8];
     scene_intersect8(&sc, rays, tmax, hits);
     for (uint l = 0u; l < 8u; ++l) {

@@ -199,15 +199,35 @@ TEST(Render, BufferLargerThanTheDeviceAllowsIsAClearError) {
 // one-pixel-per-work-item kernel's, but for a pixel whose camera ray meets two triangles
 // within rounding of one distance (the packet may test them in another order). An odd size
 // leaves partial packets; the materials scene has textures and alpha-tested cut-outs, the
-// cloud a medium.
+// cloud a medium. The packets draw the film positions and a pinhole camera's rays in SIMD
+// lanes, and the other filters, cameras and the independent sampler lane by lane: the
+// Cornell box is rendered with each of those too.
 TEST(Packets, SameSamplesAsOnePixelPerWorkItem) {
   DeviceEntry device = pocl_device();
-  for (const char* name : {"cornell-box/cornell-box.gltf", "materials/materials.gltf", "volumes/cloud.gltf"}) {
+  enum Variant { kDefault, kTent, kGaussian, kThinLens, kOrthographic, kIndependent };
+  struct Case {
+    const char* name;
+    Variant variant;
+  };
+  for (Case c :
+       {Case{"cornell-box/cornell-box.gltf", kDefault}, Case{"materials/materials.gltf", kDefault},
+        Case{"volumes/cloud.gltf", kDefault}, Case{"cornell-box/cornell-box.gltf", kTent},
+        Case{"cornell-box/cornell-box.gltf", kGaussian}, Case{"cornell-box/cornell-box.gltf", kThinLens},
+        Case{"cornell-box/cornell-box.gltf", kOrthographic}, Case{"cornell-box/cornell-box.gltf", kIndependent}}) {
+    const char* name = c.name;
     Scene scene = load_gltf(scene_path(name));
     RenderSettings settings;
     settings.width = 37;
     settings.height = 23;
     settings.seed = 7;
+    if (c.variant == kTent) settings.filter = PixelFilter::Tent;
+    if (c.variant == kGaussian) settings.filter = PixelFilter::Gaussian;
+    if (c.variant == kIndependent) settings.sampler = Sampler::Independent;
+    if (c.variant == kThinLens || c.variant == kOrthographic) {
+      ASSERT_TRUE(scene.camera.has_value()) << name;
+      if (c.variant == kThinLens) scene.camera->aperture_radius = 0.05f;
+      if (c.variant == kOrthographic) scene.camera->projection = Projection::Orthographic;
+    }
     settings.launch_seconds = 1e-3;  // several launches; the 851 pixels end in a partial packet
     Film packets = scene_renderer(device, scene, settings).render(0, 3).film;
     settings.packets = false;
@@ -219,7 +239,7 @@ TEST(Packets, SameSamplesAsOnePixelPerWorkItem) {
       for (int c = 0; c < 4; ++c) same = same && packets.mean[4 * i + c] == single.mean[4 * i + c];
       differ += !same;
     }
-    std::printf("%s: %zu of %zu pixels differ with packets\n", name, differ, pixels);
+    std::printf("%s (variant %d): %zu of %zu pixels differ with packets\n", name, int(c.variant), differ, pixels);
     EXPECT_LE(differ, pixels / 200) << name << ": pixels whose samples differ";
     double sum = 0.0;
     for (size_t i = 0; i < pixels; ++i) sum += packets.mean[4 * i];
