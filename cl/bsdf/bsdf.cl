@@ -68,12 +68,17 @@ void bsdf_lobes_local(const Bsdf* b, float3 wo, BsdfLobes* l) {
   bsdf_diffuse_lobes(b, wo, l);
 }
 
+// The lobes' directions from the shading frame to world space
+void bsdf_lobes_to_world(const Bsdf* b, BsdfLobes* l) {
+  for (uint k = 0u; k < l->count; ++k) l->dir[k] = frame_from_local(&b->frame, l->dir[k]);
+}
+
 // (The integrator takes the lobes from bsdf_sample_lobes; the tests check the two agree.)
 BsdfLobes bsdf_lobes(const Bsdf* b, float3 wo) {
   BsdfLobes l;
   l.count = 0u;
   bsdf_lobes_local(b, frame_to_local(&b->frame, wo), &l);
-  for (uint k = 0u; k < l.count; ++k) l.dir[k] = frame_from_local(&b->frame, l.dir[k]);
+  bsdf_lobes_to_world(b, &l);
   return l;
 }
 
@@ -151,8 +156,7 @@ bool bsdf_sample_lobes(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample*
   float3 wo_l = frame_to_local(&b->frame, wo);
   if (lobes) lobes->count = 0u;
   bool ok = bsdf_sample_local(b, wo_l, uc, u, bs, lobes);
-  if (lobes)
-    for (uint k = 0u; k < lobes->count; ++k) lobes->dir[k] = frame_from_local(&b->frame, lobes->dir[k]);
+  if (lobes) bsdf_lobes_to_world(b, lobes);
   if (!ok) return false;
   bool local_reflection = bs->wi.z > 0.0f;
   bs->wi = frame_from_local(&b->frame, bs->wi);

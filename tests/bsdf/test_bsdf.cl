@@ -127,6 +127,12 @@ __kernel void test_bsdf_sample(__global const Material* materials, float4 ng, fl
   test_bsdf_sample_at(&sc, ng, ns, tangent, wo, seed, out, info);
 }
 
+// Bit-for-bit equality (a NaN equals itself, 0 and -0 differ)
+bool test_same_bits(float a, float b) { return as_uint(a) == as_uint(b); }
+bool test_same_bits3(float3 a, float3 b) {
+  return test_same_bits(a.x, b.x) && test_same_bits(a.y, b.y) && test_same_bits(a.z, b.z);
+}
+
 // Sample i of material 0 seen from wo, (uc, u) drawn from rng_init(i, 0, seed), through
 // bsdf_sample_lobes (the integrator's call: the sample and the lobes at wo together) against
 // bsdf_sample and bsdf_lobes called apart: out[i] = (1 when the lobes are the same bit for
@@ -148,16 +154,12 @@ __kernel void test_bsdf_lobes(__global const Material* materials, float4 ng, flo
   BsdfLobes alone = bsdf_lobes(&b, wo.xyz);
   bool same_lobes = lobes.count == alone.count;
   for (uint k = 0u; same_lobes && k < alone.count; ++k)
-    same_lobes =
-        as_uint(lobes.dir[k].x) == as_uint(alone.dir[k].x) && as_uint(lobes.dir[k].y) == as_uint(alone.dir[k].y) &&
-        as_uint(lobes.dir[k].z) == as_uint(alone.dir[k].z) && as_uint(lobes.omega[k]) == as_uint(alone.omega[k]) &&
-        as_uint(lobes.weight[k]) == as_uint(alone.weight[k]);
+    same_lobes = test_same_bits3(lobes.dir[k], alone.dir[k]) && test_same_bits(lobes.omega[k], alone.omega[k]) &&
+                 test_same_bits(lobes.weight[k], alone.weight[k]);
   bool same_sample = ok == ok_apart;
   if (same_sample && ok)
-    same_sample = as_uint(with.wi.x) == as_uint(apart.wi.x) && as_uint(with.wi.y) == as_uint(apart.wi.y) &&
-                  as_uint(with.wi.z) == as_uint(apart.wi.z) && as_uint(with.f.x) == as_uint(apart.f.x) &&
-                  as_uint(with.f.y) == as_uint(apart.f.y) && as_uint(with.f.z) == as_uint(apart.f.z) &&
-                  as_uint(with.pdf) == as_uint(apart.pdf) && as_uint(with.eta) == as_uint(apart.eta) &&
+    same_sample = test_same_bits3(with.wi, apart.wi) && test_same_bits3(with.f, apart.f) &&
+                  test_same_bits(with.pdf, apart.pdf) && test_same_bits(with.eta, apart.eta) &&
                   with.flags == apart.flags;
   out[i] = (uint4)(same_lobes ? 1u : 0u, alone.count, ok ? 1u : 0u, same_sample ? 1u : 0u);
 }
