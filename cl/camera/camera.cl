@@ -17,9 +17,7 @@ Ray camera_ray(const __global RenderParams* params, float px, float py, float2 l
   }
   float3 d = load3(c->forward) + x * right + y * up;  // reaches depth 1 along forward
   r.org = load3(c->origin);
-  // d / |d| written out (|d| >= 1: normalize's rescaling is not needed), as camera_rays8
-  // computes it lane for lane
-  r.dir = d * (1.0f / sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
+  r.dir = normalize(d);
   if (c->lens_radius > 0.0f) {
     // Start on the lens disk and aim at where the pinhole ray meets the focus plane
     float2 l = c->lens_radius * sample_concentric_disk(lens.x, lens.y);
@@ -31,8 +29,10 @@ Ray camera_ray(const __global RenderParams* params, float px, float py, float2 l
 }
 
 // Eight rays of a pinhole perspective camera (type CAMERA_PERSPECTIVE, lens_radius 0) at
-// once, lane l at (px.sl, py.sl): camera_ray's rays bit for bit (the same operations in the
-// same order, in SIMD lanes). The CPU packets' camera rays (render_paths, CD_PACKETS).
+// once, lane l at (px.sl, py.sl): camera_ray's rays bit for bit. The directions are made
+// in SIMD lanes with camera_ray's operations in the same order, then normalized lane by
+// lane (the library's normalize, whose arithmetic a float8 version need not repeat). The
+// CPU packets' camera rays (render_paths, CD_PACKETS).
 void camera_rays8(const __global RenderParams* params, float8 px, float8 py, Ray rays[8]) {
   __global const Camera* c = &params->camera;
   float8 x = 2.0f * px / (float)params->width - 1.0f;
@@ -41,13 +41,12 @@ void camera_rays8(const __global RenderParams* params, float8 px, float8 py, Ray
   float8 dx = f.x + x * right.x + y * up.x;
   float8 dy = f.y + x * right.y + y * up.y;
   float8 dz = f.z + x * right.z + y * up.z;
-  float8 inv = 1.0f / sqrt(dx * dx + dy * dy + dz * dz);
   float rx[8], ry[8], rz[8];
-  vstore8(dx * inv, 0, rx);
-  vstore8(dy * inv, 0, ry);
-  vstore8(dz * inv, 0, rz);
+  vstore8(dx, 0, rx);
+  vstore8(dy, 0, ry);
+  vstore8(dz, 0, rz);
   for (int l = 0; l < 8; ++l) {
     rays[l].org = org;
-    rays[l].dir = (float3)(rx[l], ry[l], rz[l]);
+    rays[l].dir = normalize((float3)(rx[l], ry[l], rz[l]));
   }
 }

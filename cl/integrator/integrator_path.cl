@@ -492,7 +492,8 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 
 // The camera rays and random number states of eight pixels' sample `sample`: lane for
 // lane pixel_camera_ray's after rng_init, bit for bit. With the Sobol sampler the film
-// positions (pair 0) are drawn in SIMD lanes, and so are the rays of a pinhole camera.
+// positions (pair 0) are drawn in SIMD lanes, and so are a pinhole camera's ray directions
+// (normalized lane by lane: camera_rays8).
 void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, Rng rng[8],
                         Ray rays[8]) {
 #if CD_SAMPLER_SOBOL
