@@ -102,12 +102,17 @@ uint rng_independent_next_uint(RngIndependent* r) {
 
 // ---- Owen-scrambled Sobol sampler ---------------------------------------------------
 
+// The bit operations below are written once, as macros over a variable x of type uint or
+// uint8, so that the eight-lane versions (CPU packets) are the scalar ones lane for lane
+#define RNG_REVERSE_BITS(x)                                \
+  x = (x << 16) | (x >> 16);                               \
+  x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu); \
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu); \
+  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u); \
+  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u)
+
 uint rng_reverse_bits(uint x) {
-  x = (x << 16) | (x >> 16);
-  x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
-  x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
-  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
-  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+  RNG_REVERSE_BITS(x);
   return x;
 }
 
@@ -116,12 +121,15 @@ uint rng_reverse_bits(uint x) {
 // bits read from the least significant one up. So reverse(rng_lk_hash(reverse(x), seed))
 // Owen-scrambles the 32-bit binary fraction x: its most significant bit is flipped by the
 // seed alone, every lower bit by the seed and the bits above it.
+#define RNG_LK_HASH(x, seed) \
+  x ^= x * 0x3d20adeau;      \
+  x += seed;                 \
+  x *= (seed >> 16) | 1u;    \
+  x ^= x * 0x05526c56u;      \
+  x ^= x * 0x53a22864u
+
 uint rng_lk_hash(uint x, uint seed) {
-  x ^= x * 0x3d20adeau;
-  x += seed;
-  x *= (seed >> 16) | 1u;
-  x ^= x * 0x05526c56u;
-  x ^= x * 0x53a22864u;
+  RNG_LK_HASH(x, seed);
   return x;
 }
 
@@ -132,12 +140,15 @@ uint rng_lk_hash(uint x, uint seed) {
 // supersets b of r: a superset-XOR transform over the 5-bit bit positions, one step per
 // position bit (equal to XOR-ing the columns v_0 = 1/2, v_{b+1} = v_b ^ (v_b >> 1) of the
 // index's set bits)
+#define RNG_SOBOL_DIM1_REVERSED(i) \
+  i ^= (i >> 1) & 0x55555555u;     \
+  i ^= (i >> 2) & 0x33333333u;     \
+  i ^= (i >> 4) & 0x0f0f0f0fu;     \
+  i ^= (i >> 8) & 0x00ff00ffu;     \
+  i ^= (i >> 16) & 0x0000ffffu
+
 uint rng_sobol_dim1_reversed(uint i) {
-  i ^= (i >> 1) & 0x55555555u;
-  i ^= (i >> 2) & 0x33333333u;
-  i ^= (i >> 4) & 0x0f0f0f0fu;
-  i ^= (i >> 8) & 0x00ff00ffu;
-  i ^= (i >> 16) & 0x0000ffffu;
+  RNG_SOBOL_DIM1_REVERSED(i);
   return i;
 }
 
@@ -198,8 +209,9 @@ uint2 rng_sobol_next_2d(RngSobol* r) {
 
 // ---- Eight pixels' first pair at once (CPU packets) -------------------------------------
 // rng_pcg4d, rng_lk_hash, rng_reverse_bits and rng_sobol_dim1_reversed lane for lane on
-// uint8: the same integer operations, so the same bits, in SIMD lanes. A work-item that
-// traces eight camera rays as a packet draws their film positions (pair 0) this way.
+// uint8 (the last three from the same macros): the same integer operations, so the same
+// bits, in SIMD lanes. A work-item that traces eight camera rays as a packet draws their
+// film positions (pair 0) this way.
 
 void rng_pcg4d8(uint8* x, uint8* y, uint8* z, uint8* w) {
   uint8 a = *x * 1664525u + 1013904223u, b = *y * 1664525u + 1013904223u;
@@ -223,29 +235,17 @@ void rng_pcg4d8(uint8* x, uint8* y, uint8* z, uint8* w) {
 }
 
 uint8 rng_lk_hash8(uint8 x, uint8 seed) {
-  x ^= x * 0x3d20adeau;
-  x += seed;
-  x *= (seed >> 16) | 1u;
-  x ^= x * 0x05526c56u;
-  x ^= x * 0x53a22864u;
+  RNG_LK_HASH(x, seed);
   return x;
 }
 
 uint8 rng_reverse_bits8(uint8 x) {
-  x = (x << 16) | (x >> 16);
-  x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
-  x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
-  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
-  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+  RNG_REVERSE_BITS(x);
   return x;
 }
 
 uint8 rng_sobol_dim1_reversed8(uint8 i) {
-  i ^= (i >> 1) & 0x55555555u;
-  i ^= (i >> 2) & 0x33333333u;
-  i ^= (i >> 4) & 0x0f0f0f0fu;
-  i ^= (i >> 8) & 0x00ff00ffu;
-  i ^= (i >> 16) & 0x0000ffffu;
+  RNG_SOBOL_DIM1_REVERSED(i);
   return i;
 }
 

@@ -467,13 +467,22 @@ void film_add(float4* mean, float4* m2, float3 l) {
   *mean = (float4)(new_mean, n);
 }
 
+// The camera ray through film position (fx, fy), with the lens sample's two numbers drawn
+// next when the camera has a lens
+Ray film_camera_ray(__global const RenderParams* params, float fx, float fy, Rng* rng) {
+  float2 lens = (float2)(0.0f);
+  if (params->camera.lens_radius > 0.0f) {
+    lens.x = rng_next(rng);
+    lens.y = rng_next(rng);
+  }
+  return camera_ray(params, fx, fy, lens);
+}
+
 // The camera ray of a pixel's sample, from its first random numbers
 Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng* rng) {
   float jx = rng_next(rng), jy = rng_next(rng);
   float2 film = filter_sample(params->filter, jx, jy);
-  float2 lens = (float2)(0.0f);
-  if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(rng), rng_next(rng));
-  return camera_ray(params, (float)px + film.x, (float)py + film.y, lens);
+  return film_camera_ray(params, (float)px + film.x, (float)py + film.y, rng);
 }
 
 // CD_PACKETS=1 (CPU devices, set by the host): a work-item takes eight consecutive launch
@@ -492,8 +501,10 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 
 // The camera rays and random number states of eight pixels' sample `sample`: lane for
 // lane pixel_camera_ray's after rng_init, bit for bit. With the Sobol sampler the film
-// positions (pair 0) are drawn in SIMD lanes, and so are a pinhole camera's ray directions
-// (normalized lane by lane: camera_rays8).
+// positions' numbers (pair 0) are drawn in SIMD lanes (the tent and Gaussian filters then
+// map them lane by lane), and so are a pinhole camera's ray directions (normalized lane by
+// lane: camera_rays8); a lens or an orthographic camera goes lane by lane, and so does the
+// independent sampler.
 void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, Rng rng[8],
                         Ray rays[8]) {
 #if CD_SAMPLER_SOBOL
@@ -535,9 +546,7 @@ void packet_camera_rays(__global const RenderParams* params, const uint pixel[8]
   vstore8(fy, 0, py);
   for (int l = 0; l < 8; ++l) {
     Rng r = rng[l];
-    float2 lens = (float2)(0.0f);
-    if (params->camera.lens_radius > 0.0f) lens = (float2)(rng_next(&r), rng_next(&r));
-    Ray ray = camera_ray(params, px[l], py[l], lens);
+    Ray ray = film_camera_ray(params, px[l], py[l], &r);
     rng[l] = r;
     rays[l] = ray;
   }

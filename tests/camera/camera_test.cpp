@@ -14,6 +14,7 @@
 #include <functional>
 
 #include "base/error.hpp"
+#include "compile/camera.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/renderer.hpp"
 #include "support/reference.hpp"
@@ -294,6 +295,39 @@ TEST_P(CameraRenderTest, OrthographicCameraCoversTheExpectedPixelsAtAnyDistance)
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, CameraRenderTest, kernel_devices(), DeviceParamName());
+
+// The CPU packets' eight pinhole rays at once (camera_rays8) are camera_ray's, lane for
+// lane and bit for bit: random film positions (some past the image's edges, where the tent
+// and Gaussian filters reach) of a tilted camera, square and wide images
+class CameraRays8Test : public DeviceTest {};
+
+TEST_P(CameraRays8Test, EightLaneRaysAreTheScalarRays) {
+  CameraDesc cam;
+  cam.position = glm::vec3(0.3f, -1.2f, 4.5f);
+  cam.forward = glm::vec3(-0.2f, 0.35f, -1.0f);
+  cam.up = glm::vec3(0.1f, 1.0f, 0.0f);
+  cam.yfov = 0.9f;
+  uint64_t state = 12345;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return float(state >> 40) * 0x1.0p-24f;
+  };
+  for (auto [w, h] : {std::pair{37, 23}, std::pair{512, 512}, std::pair{1920, 817}}) {
+    dev::RenderParams params{};
+    params.camera = make_device_camera(cam, w, h);
+    params.width = cl_uint(w);
+    params.height = cl_uint(h);
+    const size_t groups = 4096;
+    std::vector<cl_float2> film(8 * groups);
+    for (cl_float2& f : film) f = {{(uniform() * 1.1f - 0.05f) * float(w), (uniform() * 1.1f - 0.05f) * float(h)}};
+    auto out = rig().output<cl_uint>(groups);
+    rig().run("test_camera_rays8", groups, rig().input(std::vector<dev::RenderParams>{params}), rig().input(film), out);
+    std::vector<cl_uint> same = out.read();
+    EXPECT_EQ(std::count(same.begin(), same.end(), 1u), long(groups)) << w << "x" << h;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, CameraRays8Test, kernel_devices(), DeviceParamName());
 
 // A thin lens of radius 0 is the pinhole camera, bit for bit; any aperture changes the image
 TEST(ThinLens, ZeroApertureIsThePinholeImage) {

@@ -4,6 +4,7 @@
 // layout, and a render whose error at 256 spp the Sobol sampler must clearly beat.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -207,6 +208,31 @@ TEST_P(SamplerTest, SameNumbersAsPocl) {
   for (int which : {kSobol, kIndependent})
     EXPECT_EQ(draw(rig(), which, 7, 64, 100, 64, 5, 40), draw(kernel_rig("pocl"), which, 7, 64, 100, 64, 5, 40))
         << which;
+}
+
+// The CPU packets' eight-lane draw of a pair (rng_sobol_pair8) is rng_sobol_pair's, lane
+// for lane and bit for bit: random pixels (consecutive ones too), samples, pairs and seeds
+TEST_P(SamplerTest, EightLanePairsAreTheScalarPairs) {
+  const size_t groups = 4096;
+  std::vector<cl_uint> pixels(8 * groups), samples(groups);
+  uint64_t state = 0x9e3779b97f4a7c15ull;
+  auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return cl_uint(state >> 32);
+  };
+  for (size_t g = 0; g < groups; ++g) {
+    cl_uint first = next() % (1u << 22);
+    for (size_t l = 0; l < 8; ++l) pixels[8 * g + l] = g % 2 == 0 ? first + cl_uint(l) : next();
+    samples[g] = g % 4 < 2 ? cl_uint(g % 64) : next();
+  }
+  cl::Buffer pixel_buf = rig().input(pixels), sample_buf = rig().input(samples);
+  for (cl_uint seed : {0u, 7u, 0xfffffffeu})
+    for (cl_uint pair : {0u, 1u, 2u, 77u}) {
+      auto out = rig().output<cl_uint>(groups);
+      rig().run("test_sampler_pair8", groups, pixel_buf, sample_buf, seed, pair, out);
+      std::vector<cl_uint> same = out.read();
+      EXPECT_EQ(std::count(same.begin(), same.end(), 1u), long(groups)) << "seed " << seed << " pair " << pair;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, SamplerTest, kernel_devices(), DeviceParamName());

@@ -40,3 +40,25 @@ __kernel void test_sampler_interface(uint pixel_begin, uint sample_begin, uint s
     }
   }
 }
+
+// rng_sobol_pair8 against rng_sobol_pair: work-item i draws pair `pair` of sample
+// samples[i] for the eight pixels pixels[8i .. 8i + 8) both ways; out[i] = 1 when all eight
+// lanes agree bit for bit with the scalar pairs
+__kernel void test_sampler_pair8(__global const uint* pixels, __global const uint* samples, uint seed, uint pair,
+                                 __global uint* out) {
+  uint i = get_global_id(0);
+  uint lanes[8];
+  for (int l = 0; l < 8; ++l) lanes[l] = pixels[8u * i + (uint)l];
+  uint sample_reversed = rng_reverse_bits(samples[i]), hashed_seed = rng_hash_seed(seed);
+  uint8 x, y;
+  rng_sobol_pair8(vload8(0, lanes), sample_reversed, hashed_seed, pair, &x, &y);
+  uint xs[8], ys[8];
+  vstore8(x, 0, xs);
+  vstore8(y, 0, ys);
+  uint same = 1u;
+  for (int l = 0; l < 8; ++l) {
+    uint2 p = rng_sobol_pair(lanes[l], sample_reversed, hashed_seed, pair);
+    same &= (uint)(p.x == xs[l] && p.y == ys[l]);
+  }
+  out[i] = same;
+}

@@ -199,9 +199,10 @@ TEST(Render, BufferLargerThanTheDeviceAllowsIsAClearError) {
 // one-pixel-per-work-item kernel's, but for a pixel whose camera ray meets two triangles
 // within rounding of one distance (the packet may test them in another order). An odd size
 // leaves partial packets; the materials scene has textures and alpha-tested cut-outs, the
-// cloud a medium. The packets draw the film positions and a pinhole camera's rays in SIMD
-// lanes, and the other filters, cameras and the independent sampler lane by lane: the
-// Cornell box is rendered with each of those too.
+// cloud a medium. The packets draw the film positions' numbers and a pinhole camera's ray
+// directions in SIMD lanes; the tent and Gaussian filters map the numbers lane by lane, a
+// lens or an orthographic camera makes its rays lane by lane, the independent sampler
+// draws lane by lane: the Cornell box is rendered with each of those too.
 TEST(Packets, SameSamplesAsOnePixelPerWorkItem) {
   DeviceEntry device = pocl_device();
   enum Variant { kDefault, kTent, kGaussian, kThinLens, kOrthographic, kIndependent };
@@ -236,14 +237,14 @@ TEST(Packets, SameSamplesAsOnePixelPerWorkItem) {
     size_t differ = 0, pixels = packets.mean.size() / 4;
     for (size_t i = 0; i < pixels; ++i) {
       bool same = true;
-      for (int c = 0; c < 4; ++c) same = same && packets.mean[4 * i + c] == single.mean[4 * i + c];
+      for (int ch = 0; ch < 4; ++ch) same = same && packets.mean[4 * i + ch] == single.mean[4 * i + ch];
       differ += !same;
     }
     std::printf("%s (variant %d): %zu of %zu pixels differ with packets\n", name, int(c.variant), differ, pixels);
-    EXPECT_LE(differ, pixels / 200) << name << ": pixels whose samples differ";
+    EXPECT_LE(differ, pixels / 200) << name << " (variant " << int(c.variant) << "): pixels whose samples differ";
     double sum = 0.0;
     for (size_t i = 0; i < pixels; ++i) sum += packets.mean[4 * i];
-    EXPECT_GT(sum, 0.0) << name << ": a black image";
+    EXPECT_GT(sum, 0.0) << name << " (variant " << int(c.variant) << "): a black image";
   }
 }
 
