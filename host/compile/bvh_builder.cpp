@@ -13,6 +13,12 @@
 namespace candela {
 namespace {
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define CD_BUILD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CD_BUILD_CLONES
+#endif
+
 constexpr int kBins = 16;
 constexpr int kMaxLeafSize = 8;
 constexpr float kTraversalCost = 1.0f;                // relative to one triangle test
@@ -442,7 +448,7 @@ class Builder {
     }
   }
 
-  void bin(const Binner& b, uint32_t begin, uint32_t end, int nbins, Bins* bins) const {
+  CD_BUILD_CLONES void bin(const Binner& b, uint32_t begin, uint32_t end, int nbins, Bins* bins) const {
     auto add = [&](const Ref& ref, Bins* to) {
       v4f lo = ref.box_lo(), hi = ref.hi;
       v4i k = b.index(lo + hi);
@@ -527,7 +533,7 @@ class Builder {
 
   // Binned SAH split of r into *left and *right (bounds included); false: r is a leaf.
   // `parallel`: bin large ranges on every thread (the top phase, where the workers wait)
-  bool split(const Range& r, Range* left, Range* right, bool parallel) {
+  CD_BUILD_CLONES bool split(const Range& r, Range* left, Range* right, bool parallel) {
     uint32_t count = r.end - r.begin;
     if (count <= 1 || r.depth >= kMaxBvhDepth) return false;
     // One pass bins the centroids along all three axes; small ranges get fewer bins (the
