@@ -86,9 +86,9 @@ typedef struct {
 // The lobes of a BSDF at wo, for the strategy choice (bsdf_sample_lobes in bsdf.cl; the
 // integrator's STRATEGY_AUTO): each non-delta lobe's centre direction, its solid angle
 // (1 / its peak pdf: pi for a cosine lobe, 4 pi ax ay for a GGX reflection) and its
-// selection weight at wo. Each material type declares its lobes in bsdf_NAME_lobes (in the local frame); lobes
-// of the same centre and solid angle merge, and past BSDF_MAX_LOBES a lobe joins the one
-// nearest in solid angle.
+// selection weight at wo. Each material type declares its lobes in bsdf_NAME_lobes (in the
+// local frame); lobes of the same centre and solid angle merge, and past BSDF_MAX_LOBES a
+// lobe joins the one nearest in solid angle.
 #define BSDF_MAX_LOBES 4
 typedef struct {
   float3 dir[BSDF_MAX_LOBES];    // centre (local while the type fills it, then world)

@@ -53,18 +53,30 @@
 #define CD_SAMPLER_SOBOL 1
 #endif
 
+// Written once, as a macro over four variables of type uint or uint8, so that the
+// eight-lane version (CPU packets) is the scalar one lane for lane
+#define RNG_PCG4D(a, b, c, d)     \
+  a = a * 1664525u + 1013904223u; \
+  b = b * 1664525u + 1013904223u; \
+  c = c * 1664525u + 1013904223u; \
+  d = d * 1664525u + 1013904223u; \
+  a += b * d;                     \
+  b += c * a;                     \
+  c += a * b;                     \
+  d += b * c;                     \
+  a ^= a >> 16u;                  \
+  b ^= b >> 16u;                  \
+  c ^= c >> 16u;                  \
+  d ^= d >> 16u;                  \
+  a += b * d;                     \
+  b += c * a;                     \
+  c += a * b;                     \
+  d += b * c
+
 uint4 rng_pcg4d(uint4 v) {
-  v = v * 1664525u + 1013904223u;
-  v.x += v.y * v.w;
-  v.y += v.z * v.x;
-  v.z += v.x * v.y;
-  v.w += v.y * v.z;
-  v ^= v >> 16u;
-  v.x += v.y * v.w;
-  v.y += v.z * v.x;
-  v.z += v.x * v.y;
-  v.w += v.y * v.z;
-  return v;
+  uint a = v.x, b = v.y, c = v.z, d = v.w;
+  RNG_PCG4D(a, b, c, d);
+  return (uint4)(a, b, c, d);
 }
 
 // The user's seed, hashed once so that neighbouring seeds give unrelated images
@@ -209,25 +221,13 @@ uint2 rng_sobol_next_2d(RngSobol* r) {
 
 // ---- Eight pixels' first pair at once (CPU packets) -------------------------------------
 // rng_pcg4d, rng_lk_hash, rng_reverse_bits and rng_sobol_dim1_reversed lane for lane on
-// uint8 (the last three from the same macros): the same integer operations, so the same
+// uint8 (from the same macros): the same integer operations, so the same
 // bits, in SIMD lanes. A work-item that traces eight camera rays as a packet draws their
 // film positions (pair 0) this way.
 
 void rng_pcg4d8(uint8* x, uint8* y, uint8* z, uint8* w) {
-  uint8 a = *x * 1664525u + 1013904223u, b = *y * 1664525u + 1013904223u;
-  uint8 c = *z * 1664525u + 1013904223u, d = *w * 1664525u + 1013904223u;
-  a += b * d;
-  b += c * a;
-  c += a * b;
-  d += b * c;
-  a ^= a >> 16u;
-  b ^= b >> 16u;
-  c ^= c >> 16u;
-  d ^= d >> 16u;
-  a += b * d;
-  b += c * a;
-  c += a * b;
-  d += b * c;
+  uint8 a = *x, b = *y, c = *z, d = *w;
+  RNG_PCG4D(a, b, c, d);
   *x = a;
   *y = b;
   *z = c;

@@ -8,11 +8,12 @@
 //   STRATEGY_BSDF: no shadow rays; emission counted whenever a sampled ray finds it (so
 //                  punctual lights, which no ray can hit, contribute nothing)
 //   STRATEGY_AUTO: per vertex and per light, decided before the light sample from the
-//                  BSDF's lobes at wo (bsdf_sample_lobes) and the light's extent seen from
-//                  the vertex (lights_extent): path_nee_takes. A light sample counts only for a light
-//                  the vertex takes by light sampling; a BSDF-sampled ray that finds an
-//                  emitter or the environment counts it only for a light the vertex it left
-//                  did not take (the path state keeps that vertex's light-sampling context and lobes).
+//                  BSDF's lobes at wo (bsdf_sample_lobes) and the light's extent seen
+//                  from the vertex (lights_extent): path_nee_takes. A light sample counts
+//                  only for a light the vertex takes by light sampling; a BSDF-sampled ray
+//                  that finds an emitter or the environment counts it only for a light the
+//                  vertex it left did not take (the path state keeps that vertex's
+//                  light-sampling context and lobes).
 //                  Delta lights, which no sampled ray can find, are light-sampled at every
 //                  vertex under nee and auto.
 // Emission found by a delta lobe's ray always counts (no light sample can find it there).
@@ -435,8 +436,8 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
 // Geodetic Data Base and a New Technique in File Sequencing: x in the even bits of the
 // index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
 // Neighbouring work-items (a work-group of 64 launch indices is about one tile) trace
-// neighbouring primary rays. A bijection of [0, width * height) onto the pixels; the sample of a pixel depends on
-// the pixel only, so the order changes no image.
+// neighbouring primary rays. A bijection of [0, width * height) onto the pixels; the
+// sample of a pixel depends on the pixel only, so the order changes no image.
 uint pixel_of_launch_index(uint i, uint width, uint height) {
   uint band = i / (8u * width), in_band = i - band * 8u * width;
   uint th = min(8u, height - 8u * band);  // the band's height
@@ -500,15 +501,16 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 // returned straight into an array element.)
 
 // The camera rays and random number states of eight pixels' sample `sample`: lane for
-// lane pixel_camera_ray's after rng_init, bit for bit. With the Sobol sampler the film
+// lane pixel_camera_ray's after rng_init, bit for bit (hashed_seed: rng_hash_seed of the
+// render's seed; the Sobol sampler's). With the Sobol sampler the film
 // positions' numbers (pair 0) are drawn in SIMD lanes (the tent and Gaussian filters then
 // map them lane by lane), and so are a pinhole camera's ray directions (normalized lane by
 // lane: camera_rays8); a lens or an orthographic camera goes lane by lane, and so does the
 // independent sampler.
-void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, Rng rng[8],
-                        Ray rays[8]) {
+void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, uint hashed_seed,
+                        Rng rng[8], Ray rays[8]) {
 #if CD_SAMPLER_SOBOL
-  uint sample_reversed = rng_reverse_bits(sample), hashed_seed = rng_hash_seed(params->seed);
+  uint sample_reversed = rng_reverse_bits(sample);
   uint8 pixels = vload8(0, pixel), ux, uy;
   rng_sobol_pair8(pixels, sample_reversed, hashed_seed, 0u, &ux, &uy);
   uint y_bits[8];
@@ -568,19 +570,21 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
   if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint pixel[8];
   float4 mean[8], m2[8];
+  float tmax[8];
   for (uint l = 0u; l < 8u; ++l) {
-    // A lane past the launch's end repeats the first lane's pixel, and is never written
-    pixel[l] = pixel_of_launch_index(first + l < params->pixel_end ? first + l : first, params->width, params->height);
+    // A lane past the launch's end repeats the first lane's pixel, finds nothing (tmax 0)
+    // and is never written
+    bool inside = first + l < params->pixel_end;
+    pixel[l] = pixel_of_launch_index(inside ? first + l : first, params->width, params->height);
+    tmax[l] = inside ? INFINITY : 0.0f;
     mean[l] = film_mean[pixel[l]];
     m2[l] = film_m2[pixel[l]];
   }
+  uint hashed_seed = rng_hash_seed(params->seed);
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng[8];
     Ray rays[8];
-    float tmax[8];
-    packet_camera_rays(params, pixel, params->sample_begin + k, rng, rays);
-    for (uint l = 0u; l < 8u; ++l)
-      tmax[l] = first + l < params->pixel_end ? INFINITY : 0.0f;  // past the end: finds nothing
+    packet_camera_rays(params, pixel, params->sample_begin + k, hashed_seed, rng, rays);
     Hit hits[8];
     scene_intersect8(&sc, rays, tmax, hits);
     for (uint l = 0u; l < 8u; ++l) {
