@@ -151,17 +151,17 @@ LazyProgram::LazyProgram(cl::Program built, std::string cache_file)
 
 const cl::Program& LazyProgram::get() {
   if (!built_) {
-    program_ = build_program(context_, device_, source_, options_, before_compile_, false).program;
+    program_ = build_program(context_, device_, source_, options_, before_compile_, /*use_cache=*/false).program;
     built_ = true;
   }
   return program_;
 }
 
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
-                           const std::string& options, const std::function<void()>& before_compile, bool store) {
+                           const std::string& options, const std::function<void()>& before_compile, bool use_cache) {
   auto start = std::chrono::steady_clock::now();
   ProgramBuild result;
-  result.cache_file = program_cache_file(device, source, options);
+  if (use_cache) result.cache_file = program_cache_file(device, source, options);
 
   if (!result.cache_file.empty()) {
     std::vector<unsigned char> binary = read_entry(result.cache_file);
@@ -188,7 +188,7 @@ ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device
                   "), build log:\n" + log);
     }
     result.program = program;
-    if (store && !result.cache_file.empty()) {
+    if (!result.cache_file.empty()) {
       try {
         auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
         if (binaries.size() == 1 && !binaries[0].empty()) write_entry(result.cache_file, binaries[0]);

@@ -17,25 +17,26 @@ struct ProgramBuild {
   cl::Program program;
   double seconds = 0.0;
   bool from_cache = false;
-  std::string cache_file;  // empty when the cache is disabled
+  std::string cache_file;  // empty when the cache is disabled or not used
 };
 
 // Builds `source` with `options` for the device, through the cache. A corrupt or
 // rejected cache entry falls back to a source build. A failed source build throws
 // Error with the device's build log. `before_compile` (if set) is called just before a
 // build from source (no usable cache entry): what a caller announces before a wait of
-// seconds to minutes. `store`: a program built from source is written to the cache (PoCL
-// compiles every kernel of the program to give its binary).
+// seconds to minutes. `use_cache` false: the cache is neither read nor written (a program
+// built from source is otherwise written to it, for which PoCL compiles every kernel of
+// the program to give its binary).
 ProgramBuild build_program(const cl::Context& context, const DeviceEntry& device, const std::string& source,
                            const std::string& options, const std::function<void()>& before_compile = {},
-                           bool store = true);
+                           bool use_cache = true);
 
 std::string kernel_cache_dir();
 
 // A program built on first use: the path of its cache entry is known before (data cached
-// beside it can be read without building it). A binary in the cache is used, but a program
-// built from source is not stored: it computes data that the cache then keeps, and storing
-// it would compile every one of its kernels.
+// beside it can be read without building it). It is built from source, and its binary is
+// not cached: it computes data that the cache then keeps, and storing the binary would
+// compile every one of its kernels.
 class LazyProgram {
  public:
   // `before_compile`: as build_program's
