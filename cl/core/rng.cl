@@ -221,9 +221,9 @@ uint2 rng_sobol_next_2d(RngSobol* r) {
 
 // ---- Eight pixels' first pair at once (CPU packets) -------------------------------------
 // rng_pcg4d, rng_lk_hash, rng_reverse_bits and rng_sobol_dim1_reversed lane for lane on
-// uint8 (from the same macros): the same integer operations, so the same
-// bits, in SIMD lanes. A work-item that traces eight camera rays as a packet draws their
-// film positions (pair 0) this way.
+// uint8, from the same macros: the same integer operations, so the same bits, in SIMD
+// lanes. A work-item that traces eight camera rays as a packet draws their film
+// positions (pair 0) this way.
 
 void rng_pcg4d8(uint8* x, uint8* y, uint8* z, uint8* w) {
   uint8 a = *x, b = *y, c = *z, d = *w;

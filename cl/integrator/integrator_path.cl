@@ -502,7 +502,7 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 
 // The camera rays and random number states of eight pixels' sample `sample`: lane for
 // lane pixel_camera_ray's after rng_init, bit for bit (hashed_seed: rng_hash_seed of the
-// render's seed; the Sobol sampler's). With the Sobol sampler the film
+// render's seed, for the Sobol sampler). With the Sobol sampler the film
 // positions' numbers (pair 0) are drawn in SIMD lanes (the tent and Gaussian filters then
 // map them lane by lane), and so are a pinhole camera's ray directions (normalized lane by
 // lane: camera_rays8); a lens or an orthographic camera goes lane by lane, and so does the

@@ -13,6 +13,9 @@
 namespace candela {
 namespace {
 
+// The builder's hot functions compiled twice, for AVX2 and for the baseline ISA candela
+// is built for (SSE2 on x86-64); the loader picks one for the CPU. No FMA: each operation
+// rounds as in the baseline code, so both give the same tree.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define CD_BUILD_CLONES __attribute__((target_clones("avx2", "default")))
 #else
