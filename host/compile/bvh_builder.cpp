@@ -30,6 +30,13 @@ constexpr float kEmptyLo = 1e30f, kEmptyHi = -1e30f;  // an unused child slot's 
 constexpr uint32_t kParallelBinning = 32768;
 // Ranges of at least this many refs are binned into two sets of bins (Builder::bin)
 constexpr uint32_t kTwoBinSets = 256;
+// Ranges of at least kSampledBinning refs choose their split plane from the bins of every
+// kSampleStride-th ref (8192 refs or more): half the binning work at the top levels, where
+// it streams the array from memory, for trees of the same SAH cost within 0.1 % (every
+// fourth ref gave 1.4 % more on a 10 M mesh). The sides' boxes then come from the
+// partition, which reads every ref.
+constexpr uint32_t kSampledBinning = 16384;
+constexpr uint32_t kSampleStride = 2;
 // The top phase hands subtrees of at most max(kMinJobRefs, refs / kJobsPerTree) refs to
 // the workers: independent of the thread count, so that the tree (node order included) is
 constexpr uint32_t kMinJobRefs = 4096;
@@ -456,7 +463,9 @@ class Builder {
     }
   }
 
-  CD_BUILD_CLONES void bin(const Binner& b, uint32_t begin, uint32_t end, int nbins, Bins* bins) const {
+  // Bins refs begin, begin + stride, ... before end
+  CD_BUILD_CLONES void bin(const Binner& b, uint32_t begin, uint32_t end, uint32_t stride, int nbins,
+                           Bins* bins) const {
     auto add = [&](const Ref& ref, Bins* to) {
       v4f lo = ref.box_lo(), hi = ref.hi;
       v4i k = b.index(lo + hi);
@@ -467,8 +476,8 @@ class Builder {
         to->count[a][j]++;
       }
     };
-    if (end - begin < kTwoBinSets) {
-      for (uint32_t i = begin; i < end; ++i) add(refs_[i], bins);
+    if (end - begin < kTwoBinSets * stride) {
+      for (uint32_t i = begin; i < end; i += stride) add(refs_[i], bins);
       return;
     }
     // Neighbouring refs mostly share their bins (the partitions keep them in space order):
@@ -477,9 +486,9 @@ class Builder {
     Bins odd;
     odd.clear(nbins);
     uint32_t i = begin;
-    for (; i + 1 < end; i += 2) {
+    for (; i + stride < end; i += 2 * stride) {
       add(refs_[i], bins);
-      add(refs_[i + 1], &odd);
+      add(refs_[i + stride], &odd);
     }
     if (i < end) add(refs_[i], bins);
     bins->merge(odd, nbins);
@@ -539,6 +548,48 @@ class Builder {
     return true;
   }
 
+  // The two sides of a partition: their centroid bounds (twice the centroids) and boxes
+  struct Sides {
+    v4f cmin[2], cmax[2], bmin[2], bmax[2];
+    Sides() {
+      for (int s = 0; s < 2; ++s) {
+        cmin[s] = bmin[s] = vec(Bounds().lo);
+        cmax[s] = bmax[s] = vec(Bounds().hi);
+      }
+    }
+  };
+
+  // Partitions range r in place: refs whose bin on axis a is at most `plane` first. Returns
+  // where the second side begins; the sides' centroid bounds in *sides, and with kBoxes
+  // their boxes too. Inlined into split, so that it is compiled for split's ISA.
+  template <bool kBoxes>
+  [[gnu::always_inline]] uint32_t partition(const Range& r, const Binner& binner, int a, int plane, Sides* sides) {
+    uint32_t i = r.begin, j = r.end;
+    auto grow = [&](int s, const Ref& ref, v4f c) {
+      sides->cmin[s] = vmin(sides->cmin[s], c);
+      sides->cmax[s] = vmax(sides->cmax[s], c);
+      if (kBoxes) {
+        sides->bmin[s] = vmin(sides->bmin[s], ref.box_lo());
+        sides->bmax[s] = vmax(sides->bmax[s], ref.hi);
+      }
+    };
+    while (true) {
+      for (; i < j; ++i) {
+        v4f c = refs_[i].centroid2();
+        if (binner.index(c)[a] > plane) break;
+        grow(0, refs_[i], c);
+      }
+      for (; i < j; --j) {
+        v4f c = refs_[j - 1].centroid2();
+        if (binner.index(c)[a] <= plane) break;
+        grow(1, refs_[j - 1], c);
+      }
+      if (i >= j) break;
+      std::swap(refs_[i], refs_[j - 1]);
+    }
+    return i;
+  }
+
   // Binned SAH split of r into *left and *right (bounds included); false: r is a leaf.
   // `parallel`: bin large ranges on every thread (the top phase, where the workers wait)
   CD_BUILD_CLONES bool split(const Range& r, Range* left, Range* right, bool parallel) {
@@ -552,15 +603,18 @@ class Builder {
     if (count == 2) return split_pair(r, binner, usable, left, right);
     Bins bins;
     bins.clear(nbins);
+    const bool sampled = count >= kSampledBinning;
+    const uint32_t stride = sampled ? kSampleStride : 1;
     if (parallel && count >= kParallelBinning && threads_ > 1 && busy_.load() < threads_) {
       std::vector<Bins> part(static_cast<size_t>(threads_));
       for (Bins& p : part) p.clear(nbins);
       parallel_for_indexed(count, [&](int t, size_t b, size_t e) {
-        bin(binner, r.begin + uint32_t(b), r.begin + uint32_t(e), nbins, &part[size_t(t)]);
+        size_t first = (b + stride - 1) / stride * stride;  // the chunk's first sampled ref
+        if (first < e) bin(binner, r.begin + uint32_t(first), r.begin + uint32_t(e), stride, nbins, &part[size_t(t)]);
       });
       for (const Bins& p : part) bins.merge(p, nbins);
     } else {
-      bin(binner, r.begin, r.end, nbins, &bins);
+      bin(binner, r.begin, r.end, stride, nbins, &bins);
     }
     int best_axis = -1, best_plane = 0;
     float best_cost = 1e30f;
@@ -607,37 +661,23 @@ class Builder {
     right->end = r.end;
     if (best_axis >= 0 && (split_cost < leaf_cost || count > kMaxLeafSize)) {
       // Partition by the same bin index as above, so that the bins' bounds are exact; the
-      // sides' centroid bounds on the way
+      // sides' centroid bounds (and, for sampled bins, boxes) on the way
       int a = best_axis;
-      v4f lcmin = vec(Bounds().lo), lcmax = vec(Bounds().hi), rcmin = lcmin, rcmax = lcmax;
-      uint32_t i = r.begin, j = r.end;
-      while (true) {
-        for (; i < j; ++i) {
-          v4f c = refs_[i].centroid2();
-          if (binner.index(c)[a] > best_plane) break;
-          lcmin = vmin(lcmin, c);
-          lcmax = vmax(lcmax, c);
+      Sides sides;
+      uint32_t mid = sampled ? partition<true>(r, binner, a, best_plane, &sides)
+                             : partition<false>(r, binner, a, best_plane, &sides);
+      left->end = right->begin = mid;
+      left->cbox = Bounds{glm3(sides.cmin[0]), glm3(sides.cmax[0])};
+      right->cbox = Bounds{glm3(sides.cmin[1]), glm3(sides.cmax[1])};
+      if (!sampled) {
+        for (int k = 0; k < nbins; ++k) {
+          int s = k <= best_plane ? 0 : 1;
+          sides.bmin[s] = vmin(sides.bmin[s], bins.lo[a][k]);
+          sides.bmax[s] = vmax(sides.bmax[s], bins.hi[a][k]);
         }
-        for (; i < j; --j) {
-          v4f c = refs_[j - 1].centroid2();
-          if (binner.index(c)[a] <= best_plane) break;
-          rcmin = vmin(rcmin, c);
-          rcmax = vmax(rcmax, c);
-        }
-        if (i >= j) break;
-        std::swap(refs_[i], refs_[j - 1]);
       }
-      left->end = right->begin = i;
-      left->cbox = Bounds{glm3(lcmin), glm3(lcmax)};
-      right->cbox = Bounds{glm3(rcmin), glm3(rcmax)};
-      v4f blo[2] = {vec(Bounds().lo), vec(Bounds().lo)}, bhi[2] = {vec(Bounds().hi), vec(Bounds().hi)};
-      for (int k = 0; k < nbins; ++k) {
-        int s = k <= best_plane ? 0 : 1;
-        blo[s] = vmin(blo[s], bins.lo[a][k]);
-        bhi[s] = vmax(bhi[s], bins.hi[a][k]);
-      }
-      left->box = Bounds{glm3(blo[0]), glm3(bhi[0])};
-      right->box = Bounds{glm3(blo[1]), glm3(bhi[1])};
+      left->box = Bounds{glm3(sides.bmin[0]), glm3(sides.bmax[0])};
+      right->box = Bounds{glm3(sides.bmin[1]), glm3(sides.bmax[1])};
       return true;
     }
     if (count <= kMaxLeafSize) return false;

@@ -220,7 +220,9 @@ TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
 // The parallel builder gives the same tree, byte for byte, on any number of threads: the
 // top of the tree is built with parallel binning and subtrees on threads of their own,
 // the rest as jobs on a pool, joined in a fixed order. 150k triangles are enough for
-// both (parallel binning from 32768 refs, jobs of at most max(4096, refs / 128)).
+// both (parallel binning from 32768 refs, jobs of at most max(4096, refs / 128)), and for
+// the sampled binning of ranges of 16384 refs or more, whose sides' boxes come from the
+// partition (check_bvh: every triangle inside its boxes).
 TEST(BvhBuilder, SameTreeOnAnyThreadCount) {
   std::vector<Tri> tris = icosphere(6, glm::vec3(0.0f), 1.0f);              // 81920 triangles
   std::vector<Tri> more = icosphere(5, glm::vec3(3.0f, 0.5f, 0.0f), 0.5f);  // 20480, apart
