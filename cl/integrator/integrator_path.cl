@@ -23,6 +23,12 @@
 // function as its BSDF; null boundaries are passed without a bounce; shadow rays carry the
 // transmittance of the media they cross.
 
+// CPU devices (set by the host): camera rays in packets (render_paths), and the auto
+// strategy's choice kept in the path state (PathState.choice; on GPUs it costs registers)
+#ifndef CD_PACKETS
+#define CD_PACKETS 0
+#endif
+
 // STRATEGY_AUTO's cost of a shadow ray, as a factor on light sampling's second moment
 // (docs/integrator.md, "The choice")
 #ifndef AUTO_SHADOW_COST
@@ -42,6 +48,12 @@
 #endif
 #endif
 
+// STRATEGY_AUTO's choice (path_nee_takes) for one light at one vertex: light -1, none made
+typedef struct {
+  int light;
+  bool takes;
+} AutoChoice;
+
 // Everything a path carries from one vertex to the next (pbrt-v4's PathIntegrator state)
 typedef struct {
   Ray ray;
@@ -56,6 +68,9 @@ typedef struct {
   float eta_scale;          // product of eta^2 over transmissions, so roulette sees radiance scale
   int medium;               // medium the ray travels in (media.cl); NO_MEDIUM without CD_FEATURE_MEDIA
   MediumStack media;        // interiors entered, innermost = medium (read only with CD_FEATURE_MEDIA)
+#if CD_PACKETS
+  AutoChoice choice;  // STRATEGY_AUTO: the light sample's choice at `prev`, reused by a ray finding that light
+#endif
 #if CD_FEATURE_DISPERSION
   int channel;  // the one RGB channel it carries since its first dispersive surface (dispersion.cl); -1: all
 #endif
@@ -140,8 +155,9 @@ float path_lobe_pdf_squared(float omega) { return omega >= PI_F ? 2.0f / (3.0f *
 // a lobe whose centre lies outside that cone sees the radiance L_c there over its whole
 // extent: J_c += L_c S_c and M_bsdf += w_c L_c^2. Light sampling
 // takes the light when AUTO_SHADOW_COST * M_nee <= M_bsdf. Evaluated twice per light
-// path, at the light sample and where the sampled ray finds the light, on the same inputs:
-// no contraction, so both give the same answer. `pmf`: the light's selection probability
+// path on GPUs, at the light sample and where the sampled ray finds the light, on the same
+// inputs: no contraction, so both give the same answer (CPU devices keep the first,
+// path_prev_takes). `pmf`: the light's selection probability
 // at ctx. `own_terms_first`: settle first what the lobes' own terms settle (the same
 // answer; false only in the test that checks so).
 bool path_nee_takes_by_moments(const SceneData* sc, const BsdfLobes* lobes, const LightSampleContext* ctx, uint index,
@@ -225,16 +241,24 @@ bool path_nee_takes(const SceneData* sc, const BsdfLobes* lobes, const LightSamp
 // count when a sampled ray finds them: a sample of one contributes nothing here).
 // `media`: the media on wo's side; a shadow ray through the surface enters (or leaves)
 // `interior`, the medium inside the surface. x_select, u_select (lights_select_numbers) and
-// u (rng_next_2d): its random numbers, which the caller draws.
+// u (rng_next_2d): its random numbers, which the caller draws. `choice`: with CD_PACKETS and
+// `lobes`, set to the light selected and path_nee_takes' answer for it.
 float3 path_direct_light(const SceneData* sc, const LightSampleContext* ctx, const Bsdf* bsdf, float3 wo,
                          const BsdfLobes* lobes, const MediumStack* media, int interior, uint x_select, float u_select,
-                         float2 u, Rng* rng) {
+                         float2 u, Rng* rng, AutoChoice* choice) {
   uint light;
   float pmf;
   if (!lights_select(sc, ctx, x_select, u_select, &light, &pmf)) return (float3)(0.0f);
   // The choice depends on the light and the vertex, not on the direction: a light left to
   // BSDF sampling costs no direction sample (a delta light is always taken)
-  if (lobes && !path_nee_takes(sc, lobes, ctx, light, pmf)) return (float3)(0.0f);
+  if (lobes) {
+    bool takes = path_nee_takes(sc, lobes, ctx, light, pmf);
+#if CD_PACKETS
+    choice->light = (int)light;
+    choice->takes = takes;
+#endif
+    if (!takes) return (float3)(0.0f);
+  }
   LightSample ls;
   if (!lights_sample_selected(sc, ctx, light, pmf, u, &ls)) return (float3)(0.0f);
   float3 f = bsdf_eval(bsdf, wo, ls.wi);
@@ -311,6 +335,16 @@ void path_cross_boundary(const SceneData* sc, PathState* ps, const SurfaceHit* s
 }
 #endif
 
+// Did the vertex the path left (ps->prev, ps->lobes) take light `index` by light sampling?
+// With CD_PACKETS the light sample's answer when it chose for the same light: the same
+// inputs (lights_select's pmf is lights_select_pmf's value exactly), so the same answer
+bool path_prev_takes(const SceneData* sc, const PathState* ps, uint index) {
+#if CD_PACKETS
+  if (ps->choice.light == (int)index) return ps->choice.takes;
+#endif
+  return path_nee_takes(sc, &ps->lobes, &ps->prev, index, -1.0f);
+}
+
 // Radiance along one camera ray; `first`: the camera ray's closest hit when it is known
 // already (traced in a packet), else 0
 float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng) {
@@ -337,7 +371,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
       if (counts_emission || ps.decide) {
         float3 le = lights_environment_radiance(sc, ps.ray.dir);
         if (!counts_emission && max_component(le) > 0.0f)
-          counts_emission = !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)params->environment_light, -1.0f);
+          counts_emission = !path_prev_takes(sc, &ps, (uint)params->environment_light);
         if (counts_emission) ps.radiance += ps.beta * le;
       }
       break;
@@ -363,7 +397,7 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
       float3 le = surface_emission(sc, &sc->materials[s.material], s.front, s.uvs);
       if (!counts_emission && max_component(le) > 0.0f) {
         int light = lights_of_prim(sc, (uint)hit.prim);
-        counts_emission = light == NO_LIGHT || !path_nee_takes(sc, &ps.lobes, &ps.prev, (uint)light, -1.0f);
+        counts_emission = light == NO_LIGHT || !path_prev_takes(sc, &ps, (uint)light);
       }
       if (counts_emission) ps.radiance += ps.beta * le;
     }
@@ -404,9 +438,13 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     BsdfSample bs;
     BsdfLobes lobes;
     bool sampled = bsdf_sample_lobes(&bsdf, wo, uc, u, &bs, chooses ? &lobes : 0);
+    AutoChoice choice;
+    choice.light = -1;
+    choice.takes = false;
     if (samples_lights) {
-      ps.radiance += ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
-                                                 sc->materials[s.material].medium, x_select, u_select, u_light, rng);
+      ps.radiance +=
+          ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
+                                      sc->materials[s.material].medium, x_select, u_select, u_light, rng, &choice);
     }
     if (!sampled) break;
 
@@ -418,6 +456,9 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     if (ps.decide) {
       ps.prev = ctx;  // the light selection the light sample saw here
       ps.lobes = lobes;
+#if CD_PACKETS
+      ps.choice = choice;
+#endif
     }
     if (bs.flags & BSDF_TRANSMISSION) ps.eta_scale *= bs.eta * bs.eta;
     if (!path_survives_roulette(&ps, params->rr_depth, rng)) break;
@@ -491,10 +532,6 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
 // (bvh_intersect8), then each path on its own. The same samples, bit for bit, as one
 // work-item per index, but where a camera ray meets two triangles within rounding of one
 // distance (the packet may test them in another order and keep the other).
-#ifndef CD_PACKETS
-#define CD_PACKETS 0
-#endif
-
 #if CD_PACKETS
 // (Loops over the eight lanes have a fixed trip count, and structs reach the arrays from
 // locals: llvmpipe mistranslated a lane loop with a data-dependent bound and a struct
