@@ -55,7 +55,7 @@ def problems(files, read):
 
 def main():
     root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), '..', '..')
-    files = [os.path.join(root, 'README.md')] + sorted(glob.glob(os.path.join(root, 'docs', '*.md')))
+    files = [os.path.join(root, 'README.md')] + sorted(glob.glob(os.path.join(root, 'docs', '**', '*.md'), recursive=True))
     if len(files) < 5:
         print(f'docs_test: only {len(files)} documents under {root}: wrong root?')
         return 1
