@@ -1,14 +1,38 @@
 #!/usr/bin/env python3
-"""Checks of README.md and docs/*.md: every relative link resolves (files and #anchors, as
-GitHub renders headings), and the docs speak of the product (no issue numbers or session
-talk). Usage: docs_test.py REPO_ROOT
+"""Checks of README.md and docs/**/*.md: every relative link resolves (files and #anchors, as
+GitHub renders headings); the docs speak of the product, not of its history: no issue
+numbers, session talk, commit hashes or dated diary lines in prose (code blocks, inline code
+and the generated tables between `<!-- results:begin -->` and `<!-- results:end -->` may name
+a date and a commit; generated pages under docs/figures/ are checked for links only); and the
+performance targets' table is what docs/results.py generates from docs/figures/results.json.
+Usage: docs_test.py REPO_ROOT
 """
 import glob
 import os
 import re
+import subprocess
 import sys
 
 NARRATIVE = re.compile(r'\b(issue|issues) #?\d+\b|\bthis session\b|\bsession\'s\b', re.I)
+# History in prose: a commit hash (7-40 hex digits with a digit and a letter), a date, a
+# "tried on ..." or "(stop N)" note, a session, or a load average given with a measurement
+HISTORY = [
+    (re.compile(r'(?<![\w./#-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![\w-])'), 'commit hash'),
+    (re.compile(r'\b20\d\d-[01]\d-[0-3]\d\b'), 'date'),
+    (re.compile(r'\btried on\b', re.I), 'diary note'),
+    (re.compile(r'\(stop \d+\)', re.I), 'diary note'),
+    (re.compile(r'\bsessions?\b', re.I), 'session talk'),
+    (re.compile(r'\bload average \d', re.I), 'dated measurement'),
+]
+GENERATED = re.compile(r'<!-- results:begin.*?-->.*?<!-- results:end -->', re.S)
+
+
+def prose(raw):
+    """raw with fenced code, inline code and generated tables blanked (line numbers kept)."""
+    blank = lambda m: re.sub(r'[^\n]', ' ', m.group(0))
+    text = re.sub(r'^```.*?^```', blank, raw, flags=re.S | re.M)
+    text = GENERATED.sub(blank, text)
+    return re.sub(r'`[^`\n]*`', blank, text)
 
 
 def slug(heading):
@@ -31,13 +55,19 @@ def anchors(text):
     return found
 
 
-def problems(files, read):
+def problems(files, read, generated=()):
     out = []
     for f in files:
         raw = read(f)
         for i, line in enumerate(raw.splitlines(), 1):
             if NARRATIVE.search(line):
                 out.append(f'{f}:{i}: development narrative in the docs: "{NARRATIVE.search(line).group(0)}"')
+        if f not in generated:
+            for i, line in enumerate(prose(raw).splitlines(), 1):
+                for pattern, what in HISTORY:
+                    m = pattern.search(line)
+                    if m:
+                        out.append(f'{f}:{i}: {what} in prose (history belongs to git): "{m.group(0)}"')
         text = re.sub(r'```.*?```', '', raw, flags=re.S)
         text = re.sub(r'`[^`\n]*`', '', text)
         for m in re.finditer(r'\]\(([^)\s]+)\)', text):
@@ -64,12 +94,29 @@ def main():
         with open(p, encoding='utf-8') as fh:
             return fh.read()
 
-    # The check must be able to fail: planted faults are found
-    planted = {'/p/a.md': '# Top\nsee [b](b.md#nowhere), [c](missing.md) and issue 12\n', '/p/b.md': '# Here\n'}
-    if len(problems(['/p/a.md', '/p/b.md'], lambda p: planted[p])) != 3:
-        print('docs_test: the planted faults were not all found; the check is broken')
+    # The check must be able to fail: planted faults are found, and what is allowed passes
+    planted = {
+        '/p/a.md': '# Top\nsee [b](b.md#nowhere), [c](missing.md) and issue 12\n'
+                   'measured at commit 5417b8a in a session\nTried on 2026-12-05, at load average 1.2 (stop 47)\n'
+                   'the 1,007,620 triangles, `git show 5417b8a`, a defaced facade, 0x7f800000\n'
+                   '```\nbuild 2026-12-05 4e91409\n```\n'
+                   '<!-- results:begin -->\n| x | 2026-12-06, 5417b8a |\n<!-- results:end -->\n',
+        '/p/b.md': '# Here\n',
+        '/p/figures/c.md': 'generated 2026-12-03 at 6af7a133ae42\n'}
+    found = problems(sorted(planted), lambda p: planted[p], generated={'/p/figures/c.md'})
+    if len(found) != 9:
+        print('docs_test: the planted faults were not found as expected; the check is broken:')
+        print('\n'.join(found))
         return 1
-    found = problems(files, read)
+    generated = {f for f in files if os.sep + 'figures' + os.sep in f}
+    found = problems(files, read, generated)
+    results = os.path.join(root, 'docs', 'results.py')
+    if os.path.exists(results):
+        check = subprocess.run([sys.executable, results, '--check', os.path.join(root, 'docs', 'performance.md'),
+                                os.path.join(root, 'docs', 'figures', 'results.json')],
+                               capture_output=True, text=True)
+        if check.returncode != 0:
+            found.append('docs/performance.md: ' + (check.stdout + check.stderr).strip())
     for p in found:
         print(os.path.relpath(p, root) if p.startswith(root) else p)
     print(f'docs_test: {len(files)} documents, {len(found)} problem(s)')
