@@ -108,7 +108,7 @@ def main():
         print('docs_test: the planted faults were not found as expected; the check is broken:')
         print('\n'.join(found))
         return 1
-    generated = {f for f in files if os.sep + 'figures' + os.sep in f}
+    generated = {f for f in files if os.path.relpath(f, root).startswith(os.path.join('docs', 'figures') + os.sep)}
     found = problems(files, read, generated)
     results = os.path.join(root, 'docs', 'results.py')
     if os.path.exists(results):
