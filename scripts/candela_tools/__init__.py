@@ -95,12 +95,6 @@ def error_of(returncode, stderr):
     return "candela render failed (exit %d): %s" % (returncode, stderr.strip()[-500:])
 
 
-def require_binary(binary):
-    if not os.path.isfile(binary):
-        raise UserError("candela executable not found: %s (build it, or pass its path)" % binary)
-    return binary
-
-
 # ---- images ----
 
 def numpy_oiio():
@@ -313,9 +307,14 @@ def result_key(scene, what):
     return "%s-%s" % (SHORT_NAMES.get(stem, stem), what)
 
 
+_SCRIPT = os.path.abspath(sys.argv[0]) if sys.argv and sys.argv[0] else ""  # before a script changes folder
+
+
 def command_line(argv=None):
     """This script's command line as the user would type it from the checkout's root."""
     import shlex
-    argv = list(sys.argv if argv is None else argv)
-    script = os.path.relpath(os.path.abspath(argv[0]), ROOT)
-    return " ".join(shlex.quote(a) for a in [script] + argv[1:])
+    if argv is None:
+        argv, script = sys.argv, _SCRIPT
+    else:
+        script = os.path.abspath(argv[0])
+    return " ".join(shlex.quote(a) for a in [os.path.relpath(script, ROOT)] + list(argv[1:]))
