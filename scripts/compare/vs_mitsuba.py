@@ -86,7 +86,6 @@ def main():
 def image_size(args):
     if args.height:
         return args.size, args.height
-    import mitsuba_scene
     doc, _, _ = mitsuba_scene.load_gltf(args.scene)
     aspect = None
     for node_index, _ in mitsuba_scene.walk(doc, doc.get("scene", 0)):
