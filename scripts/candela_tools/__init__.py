@@ -8,8 +8,8 @@ A script in a folder below scripts/ imports it with
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
     import candela_tools as ct
 
-Numpy and OpenImageIO are imported on first use (Debian's python3-numpy and python3-openimageio, so
-these scripts run with /usr/bin/python3), so a script that only runs candela needs neither.
+Numpy and OpenImageIO (Debian's python3-numpy and python3-openimageio: the scripts run with
+/usr/bin/python3) are imported on first use: a script that only runs candela needs neither.
 """
 
 import datetime
