@@ -1,4 +1,4 @@
-# Shared set-up for scripts/demo, scripts/test and scripts/bench (sourced, not run):
+# Shared set-up for scripts/demo, scripts/test and scripts/bench/bench.sh (sourced, not run):
 # installs missing Debian packages, then configures and builds Release into build/
 # (scripts/fuzz sets CANDELA_SKIP_BUILD=1: it builds build-fuzz/ with clang instead).
 set -euo pipefail

@@ -287,7 +287,7 @@ if [ $rc -eq 2 ] && grep -q "^verdict: NOT consistent" "$tmp/out" &&
 else
   fail "compare: max depth 8 against 1 is NOT consistent (exit $rc)"; cat "$tmp/out" "$tmp/err"
 fi
-# kept:DIR: a render made elsewhere (scripts/gpu-check) read instead of rendered: seed 1 with
+# kept:DIR: a render made elsewhere (scripts/gpu/check.sh) read instead of rendered: seed 1 with
 # its variance, and seed 0 for the determinism check, as a device at position 1 renders them
 k="$tmp/kept"; mkdir -p "$k"
 "$bin" render "$scene" -o "$k/main.exr" --variance "$k/main-variance.exr" --stats "$k/main.json" --spp 8 --width 16 \
@@ -483,7 +483,7 @@ if "$bin" render "$scene" -o "$tmp/mpi1.exr" --mpi $shard --spp 16 >/dev/null 2>
 else
   expect_error "--mpi without MPI" "built without MPI" -- "$bin" render "$scene" -o "$tmp/x.exr" --mpi $shard --spp 16
 fi
-# (tests/app/mpi_test.sh runs two ranks under mpirun: scripts/mpi-test)
+# (tests/app/mpi_test.sh runs two ranks under mpirun: scripts/check/mpi-test.sh)
 
 # Ctrl-C during a long render writes what was rendered and exits 130
 "$bin" render "$scene" -o "$tmp/int.exr" --time 120 --width 64 --height 64 --device pocl \

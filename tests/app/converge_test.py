@@ -1,4 +1,4 @@
-"""scripts/converge: the ladder's relMSE falls as 1/spp, the CSV has the documented columns,
+"""scripts/compare/converge.py: the ladder's relMSE falls as 1/spp, the CSV has the documented columns,
 the chart is written, and bad input gives one candela: error line.
 
 Usage: /usr/bin/python3 tests/app/converge_test.py path/to/candela repo_root
@@ -15,7 +15,7 @@ import unittest
 
 CANDELA = os.path.abspath(sys.argv[1]) if len(sys.argv) > 1 else "build/candela"
 ROOT = os.path.abspath(sys.argv[2]) if len(sys.argv) > 2 else "."
-SCRIPT = os.path.join(ROOT, "scripts", "converge")
+SCRIPT = os.path.join(ROOT, "scripts", "compare", "converge.py")
 SCENE = os.path.join(ROOT, "scenes", "furnace", "closed-sphere.gltf")
 
 try:

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # MPI: two ranks under mpirun render the image of a single-process 16-spp render (the same
 # sample indices, split into blocks and merged by rank 0), and --mpi with --time is refused
-# on every rank. Needs a -DCANDELA_MPI=ON build and mpirun (scripts/mpi-test does both).
+# on every rank. Needs a -DCANDELA_MPI=ON build and mpirun (scripts/check/mpi-test.sh does both).
 # Usage: mpi_test.sh path/to/candela repo_root
 set -u
 bin=$1

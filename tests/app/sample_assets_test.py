@@ -9,8 +9,6 @@ Run by ctest: sample_assets_test.py CANDELA_BINARY SOURCE_DIR. Small renders (64
 4 spp) keep it to a few seconds per asset on PoCL; a folder that is not there skips its test.
 """
 
-import importlib.machinery
-import importlib.util
 import json
 import os
 import subprocess
@@ -20,7 +18,9 @@ import unittest
 
 BINARY = sys.argv[1] if len(sys.argv) > 1 else ""
 SOURCE = sys.argv[2] if len(sys.argv) > 2 else os.path.dirname(os.path.dirname(os.path.dirname(__file__)))
-SCRIPT = os.path.join(SOURCE, "scripts", "render-samples")
+SCRIPT = os.path.join(SOURCE, "scripts", "check", "render_samples.py")
+sys.path.insert(0, os.path.join(SOURCE, "scripts"))
+import candela_tools  # noqa: E402  (the sample assets' folder)
 
 try:
     import numpy  # noqa: F401
@@ -28,14 +28,6 @@ try:
     HAVE_DEPS = True
 except ImportError:
     HAVE_DEPS = False
-
-
-def load_script():
-    loader = importlib.machinery.SourceFileLoader("render_samples", SCRIPT)
-    spec = importlib.util.spec_from_loader("render_samples", loader)
-    module = importlib.util.module_from_spec(spec)
-    loader.exec_module(module)
-    return module
 
 
 def gltf_files(folder):
@@ -64,10 +56,10 @@ class SampleAssets(unittest.TestCase):
         self.assertEqual(run.returncode, 0, run.stdout[-4000:] + run.stderr[-2000:])
 
     def test_khronos_sample_assets_pass_the_default_command_checks(self):
-        self.check_folder(load_script().samples_folder())
+        self.check_folder(candela_tools.samples_folder())
 
     def test_exporter_roundtrip_scenes_pass_the_default_command_checks(self):
-        samples = load_script().samples_folder()
+        samples = candela_tools.samples_folder()
         self.check_folder(os.path.join(os.path.dirname(samples), "gltf-blender-io", "roundtrip"))
 
 

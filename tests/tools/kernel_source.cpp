@@ -1,5 +1,5 @@
 // Prints the renderer's OpenCL program exactly as the host hands it to a driver
-// (renderer_program_source()); scripts/gpu-compile compiles it offline for GPU targets.
+// (renderer_program_source()); scripts/gpu/compile.sh compiles it offline for GPU targets.
 // The sources are the embedded ones, or those of CANDELA_KERNEL_DIR when set.
 //
 // Usage: candela_kernel_source > program.cl
