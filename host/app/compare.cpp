@@ -289,7 +289,7 @@ void keep_images(const CompareArgs& args, const fs::path& dir, size_t i) {
 }
 
 // A device entry `kept:DIR`: a render made earlier, on a machine this one may not reach
-// (scripts/gpu-check writes them), read from DIR: main.exr, main-variance.exr and main.json,
+// (scripts/gpu/check.sh writes them), read from DIR: main.exr, main-variance.exr and main.json,
 // and cold.json and same-seed.exr where there. Its size, spp and seed must be the ones this
 // comparison plans for that position.
 bool is_kept(const DeviceRun& r) { return r.selector.rfind("kept:", 0) == 0; }

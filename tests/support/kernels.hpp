@@ -21,7 +21,7 @@ namespace candela::test {
 // ---- Devices ----------------------------------------------------------------------------
 
 // PoCL, the device every test runs on (a missing PoCL fails the test), or the device that
-// CANDELA_TEST_DEVICE selects as --device does (scripts/gpu-check runs the tests on a GPU)
+// CANDELA_TEST_DEVICE selects as --device does (scripts/gpu/check.sh runs the tests on a GPU)
 DeviceEntry pocl_device();
 
 // Mesa's rusticl device, if one is installed and enabled
