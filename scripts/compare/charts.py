@@ -454,14 +454,14 @@ def scene_markdown(s):
                    ", %d punctual (delta) light%s" % (s["punctual_lights"], "s" if s["punctual_lights"] != 1 else "")
                    if s["punctual_lights"] else "", ref["spp"], ref["seed"], ref["width"], ref["height"],
                    fmt_g(ref["noise_floor"], 2)))
-    out.append("")
     if s.get("series"):
-        out.append("![%s: relMSE against seconds](charts/%s.png)\n" % (name, name))
-        out.append("[CSV](charts/%s.csv). %s.%s Efficiency = 1 / (relMSE × seconds) at the last ladder step; "
+        out[-1] += (" [CSV](charts/%s.csv). %s.%s Efficiency = 1 / (relMSE × seconds) at the last ladder step; "
                    "slope = log–log slope of relMSE against spp over the ladder (−1 for an unbiased estimator)." %
                    (name, s["auto"][0].upper() + s["auto"][1:],
                     " %s%s." % (s["power"][0].upper(), s["power"][1:]) if s.get("power") else ""))
-        out.append("")
+    out.append("")
+    if s.get("series"):
+        out.append("![%s: relMSE against seconds](charts/%s.png)\n" % (name, name))
         out.append("| device | strategy | spp | render s | relMSE | efficiency | slope | note |")
         out.append("|---|---|---|---|---|---|---|---|")
         best = {}
@@ -486,28 +486,24 @@ def scene_markdown(s):
                 se["device"], strategy_text(se), last["spp"], last["seconds"], fmt_g(last["rel_mse"]),
                 fmt_g(last["efficiency"]), se["slope_spp"], note))
         out.append("")
+    para = []
     c = s.get("compare")
     if c:
         d0, d1 = c["devices"][0], c["devices"][1]
         zt = d1["against_first"]["z_test"]
         verdict = "statistically consistent" if zt["consistent"] else "**NOT consistent**: " + "; ".join(
             r.replace("|", "\\|") for r in zt["reasons"])
-        out.append("Devices (`candela compare`, %dx%d, %d spp, seeds %d and %d):\n" % (
-            c["width"], c["height"], c["spp"], d0["seed"], d1["seed"]))
-        out.append("| device | build cold s | build cached s | render s | Msamples/s | relMSE vs PoCL | mean z² | "
-                   "\\|z\\|>4 | verdict |")
-        out.append("|---|---|---|---|---|---|---|---|---|")
-        out.append("| %s | %.2f | %.3f | %.3f | %.3f | - | - | - | reference |" % (
-            d0["selector"], d0["kernel_build_cold_seconds"], d0["kernel_build_cached_seconds"], d0["render_seconds"],
-            d0["samples_per_second"] * 1e-6))
-        out.append("| %s | %.2f | %.3f | %.3f | %.3f | %s | %.3f | %.3f%% | %s |" % (
-            d1["selector"], d1["kernel_build_cold_seconds"], d1["kernel_build_cached_seconds"], d1["render_seconds"],
-            d1["samples_per_second"] * 1e-6, fmt_g(d1["against_first"]["rel_mse"]), zt["mean_z2"],
-            100 * zt["frac_abs_z_over_4"], verdict))
+        dev = lambda d: "%s %.3f Msamples/s (build %.2f s cold, %.3f s cached)" % (
+            d["selector"], d["samples_per_second"] * 1e-6, d["kernel_build_cold_seconds"],
+            d["kernel_build_cached_seconds"])
+        para.append("Devices (`candela compare`, %dx%d, %d spp, seeds %d and %d): %s against %s: relMSE %s, mean z² "
+                    "%.3f, %.3f%% of values with |z| > 4: %s." % (
+                        c["width"], c["height"], c["spp"], d0["seed"], d1["seed"], dev(d1), dev(d0),
+                        fmt_g(d1["against_first"]["rel_mse"]), zt["mean_z2"], 100 * zt["frac_abs_z_over_4"], verdict))
         dg = c.get("diagnosis")
         if dg and "rounding_variance" in dg:
             rv, ov = dg["rounding_variance"], dg["other_values"]
-            out.append("\nWhere the devices differ (values = pixel-channels, from the kept images): %d of %d pixels have "
+            para.append("Where the devices differ (values = pixel-channels, from the kept images): %d of %d pixels have "
                        "a channel with |z| > 4; image means %s (PoCL) and %s (rusticl), standard error of their "
                        "difference %s. %d values have a variance estimate at float-rounding level (sd < 10⁻⁶ of the "
                        "value): %d of them have |z| > 4, with |a − b| at most %s. The other %d values: mean z² %.3f, "
@@ -520,39 +516,27 @@ def scene_markdown(s):
                                fmt_g(math.sqrt(p["sd_a"][0] ** 2 + p["sd_b"][0] ** 2), 2))
                                for p in dg["largest_z"][:3])))
         for ctl in c.get("controls", []):
-            out.append("\nControl, %s: %s (mean z² %.3f, %d of %d values with |z| > 4, relMSE %s): `%s`" % (
+            para.append("Control, %s: %s (mean z² %.3f, %d of %d values with |z| > 4, relMSE %s): `%s`" % (
                 ctl["what"], "statistically consistent" if ctl["consistent"] else "**NOT consistent**",
                 ctl["mean_z2"], ctl["count_abs_z_over_4"], ctl["values"], fmt_g(ctl["rel_mse"]), ctl["command"]))
         if "same_seed" in d1:
             ss = d1["same_seed"]
-            out.append("\nSame seed on both: max |a − b| %s, %.1f%% of values bit-identical." % (
+            para.append("Same seed on both: max |a − b| %s, %.1f%% of values bit-identical." % (
                 fmt_g(ss["max_abs_diff"], 2), 100 * ss["identical_fraction"]))
-        out.append("")
     sp = s.get("specialization")
     if sp and sp.get("ratios"):
         k, r = sp["kernels"], sp["ratios"]
-        out.append("Specialization (PoCL, `scripts/bench/specialization.sh`, median of %d rounds): cold build %.2f s "
+        para.append("Specialization (PoCL, `scripts/bench/specialization.sh`, median of %d rounds): cold build %.2f s "
                    "specialized vs %.2f s generic (×%.2f), cached %.3f vs %.3f s; speed %.3f vs %.3f M samples per "
-                   "CPU-second: specialized/generic = **%.2f**.\n" % (
+                   "CPU-second: specialized/generic = **%.2f**." % (
                        sp["rounds"], k["specialized"]["build_cold"], k["generic"]["build_cold"],
                        r["cold_build_generic_over_specialized"], k["specialized"]["build_cached"],
                        k["generic"]["build_cached"], k["specialized"]["msamples_per_cpu_s"],
                        k["generic"]["msamples_per_cpu_s"], r["speed_specialized_over_generic"]))
-    out.append("Reproduce this scene: `scripts/compare/charts.py --scenes %s` (reference cached in `build/charts/refs/`), "
-               "or step by step:\n" % s["scene"])
-    out.append("```")
-    out.append(ref["command"])
-    for se in s.get("series", []):
-        out.append(se["command"])
-    if c:
-        out.append(c["command"])
-    if sp:
-        out.append(sp["command"])
-    out.append("```")
-    st = s.get("step_seconds") or {}
-    out.append("Wall seconds per step: %s. Load average %s at the start and %s at the end of the last run (%s)."
-               "\n" % (", ".join("%s %.0f" % (k, st[k]) for k in ("reference", "converge", "compare", "spec")
-                                 if k in st), s["load_start"], s["load_end"], s["date"]))
+    para.append("Reproduce this scene: `scripts/compare/charts.py --scenes %s` (reference cached in `build/charts/refs/`; "
+               "its JSON beside the chart keeps every step's command). Measured %s, load average %s to %s."
+                % (s["scene"], s["date"], s["load_start"], s["load_end"]))
+    out.append(" ".join(para) + "\n")
     return "\n".join(out)
 
 
@@ -639,7 +623,7 @@ How the numbers are made ([accuracy.md](../accuracy.md) explains each tool):
 - **Specialization**: `scripts/bench/specialization.sh` on that scene alone (PoCL, samples per CPU-second, which cancels
   most of the other load on the shared 2-core machine).
 
-[accuracy.md, Per-scene charts](../accuracy.md#per-scene-charts-scriptscharts) says what the runs show (a device
+[accuracy.md, Per-scene charts](../accuracy.md#per-scene-charts-scriptscomparechartspy) says what the runs show (a device
 difference is a bug until shown otherwise). All timings come from the shared
 2-core development machine, often while other work ran: the load average is given per scene. Reproduce everything with `scripts/compare/charts.py`, one scene with
 `scripts/compare/charts.py --scenes scenes/lights/veach.gltf`.
