@@ -91,14 +91,14 @@ std::vector<RenderSetting> make_render_settings() {
       recorded({"--width", "W", "Image width (default 512, or from --height and the camera aspect)", "", "512",
                 option(&A::width, check(integer_in(1, 65536)))},
                [](const A&, const S& s) -> SettingValue { return count(s.width); }, nullptr, "width", false,
-               "params_host_.width"),
+               "RenderParams.width"),
       recorded({"--height", "H", "Image height (default from the camera aspect ratio, else the width)",
                 "Image size, 1 to 65536. The default is 512 wide, with the height from the camera's aspect ratio: "
                 "`aspectRatio` for a perspective camera, `xmag / ymag` for an orthographic one, square without either. "
                 "Given one of them, the other follows from the same ratio.",
                 "", option(&A::height, check(integer_in(1, 65536)))},
                [](const A&, const S& s) -> SettingValue { return count(s.height); }, nullptr, "height", false,
-               "params_host_.height"),
+               "RenderParams.height"),
       {"--device", "SEL",
        "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else "
        "first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once",
@@ -112,13 +112,13 @@ std::vector<RenderSetting> make_render_settings() {
                 "how the samples are split into launches or devices.",
                 "0", in_settings(&S::seed, check(integer_in(0, kMaxIndex)))},
                [](const A&, const S& s) -> SettingValue { return count(s.seed); }, "seed", "seed", kMustMatch,
-               "params_host_.seed"),
+               "RenderParams.seed"),
       recorded({"--max-depth", "D", "Maximum number of bounces (default 16)",
                 "Maximum number of bounces, 0 to 100000 (default 16). 0 shows only emitters seen directly; 1 adds "
                 "direct lighting.",
                 "16", in_settings(&S::max_depth, check(integer_in(0, 100000)))},
                [](const A&, const S& s) -> SettingValue { return count(s.max_depth); }, "max_depth", "max_depth",
-               kMustMatch, "params_host_.max_depth"),
+               kMustMatch, "RenderParams.max_depth"),
       recorded(
           {"--strategy", choices(kStrategyNames),
            enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto",
@@ -131,7 +131,7 @@ std::vector<RenderSetting> make_render_settings() {
              if (!a.strategy.empty()) parse_enum(kStrategyNames, "--strategy", a.strategy);
            }},
           [](const A& a, const S&) -> SettingValue { return a.strategy; }, "strategy", "strategy", kMustMatch,
-          "params_host_.strategy"),
+          "RenderParams.strategy"),
       recorded({"--light-selection", "tree|power",
                 "tree|power: light selection by the light tree (estimated contribution at the shading point; "
                 "default) or by power alone",
@@ -150,7 +150,7 @@ std::vector<RenderSetting> make_render_settings() {
                 "", flag(&A::no_energy_compensation),
                 [](const A& a, S* s) { s->energy_compensation = !a.no_energy_compensation; }},
                [](const A&, const S& s) -> SettingValue { return s.energy_compensation; }, "energy_compensation",
-               "energy_compensation", kMustMatch, "params_host_.energy_compensation"),
+               "energy_compensation", kMustMatch, "RenderParams.energy_compensation"),
       // The scene's lighting: background, environment map, default light
       {"--background", "R,G,B",
        "Constant background radiance R,G,B (replaces the scene's background and environment map)",
@@ -249,7 +249,7 @@ std::vector<RenderSetting> make_render_settings() {
                 "box", option(&A::filter),
                 [](const A& a, S* s) { s->filter = parse_enum(kPixelFilterNames, "--filter", a.filter); }},
                [](const A&, const S& s) -> SettingValue { return std::string(enum_name(kPixelFilterNames, s.filter)); },
-               "filter", "filter", kMustMatch, "params_host_.filter"),
+               "filter", "filter", kMustMatch, "RenderParams.filter"),
       recorded({"--sampler", choices(kSamplerNames), "Random numbers: " + enum_names(kSamplerNames, true),
                 "Where the random numbers come from (default `sobol`: Owen-scrambled Sobol points; `independent`: "
                 "hashed independent numbers) ([integrator.md](integrator.md#sampler)).",
@@ -280,7 +280,7 @@ std::vector<RenderSetting> make_render_settings() {
                 "the scene ([architecture.md](architecture.md#kernel-specialization)).",
                 "", flag(&A::generic)},
                [](const A& a, const S&) -> SettingValue { return a.generic; }, nullptr, "generic_kernel", false,
-               "SceneFeatures::all"),
+               "CD_FEATURE_*"),
       // Several devices and machines (README); --device takes a list
       recorded({"--sample-offset", "K",
                 "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; stored as "
@@ -321,15 +321,13 @@ std::string options_markdown() {
 }
 
 std::string record_markdown() {
-  std::string out =
-      "| option | image metadata | `--stats` key | `merge` requires a match | kernel |\n|---|---|---|---|---|\n";
-  auto code = [](const char* text) { return text && *text ? "`" + std::string(text) + "`" : std::string(); };
+  std::string out = "| option | image metadata | `--stats` key | `merge` requires a match |\n|---|---|---|---|\n";
+  auto code = [](const std::string& text) { return text.empty() ? text : "`" + text + "`"; };
   for (const RenderSetting& s : render_settings()) {
     if (!s.record) continue;
-    std::string flag = s.flags.substr(s.flags.rfind(',') + 1);
-    out += "| " + code(s.flags[0] == '-' ? flag.c_str() : s.value_name.c_str()) + " | " +
-           (s.metadata ? code(("candela:" + std::string(s.metadata)).c_str()) : "") + " | " + code(s.stats) + " | " +
-           (s.must_match ? "yes" : "") + " | " + code(s.kernel) + " |\n";
+    std::string name = s.flags[0] == '-' ? s.flags.substr(s.flags.rfind(',') + 1) : s.value_name;
+    out += "| " + code(name) + " | " + code(s.metadata ? "candela:" + std::string(s.metadata) : "") + " | " +
+           code(s.stats ? s.stats : "") + " | " + (s.must_match ? "yes" : "") + " |\n";
   }
   return out;
 }
@@ -337,7 +335,7 @@ std::string record_markdown() {
 nlohmann::json settings_json() {
   nlohmann::json options = nlohmann::json::array();
   for (const RenderSetting& s : render_settings()) {
-    nlohmann::json o = {{"flags", s.flags},         {"value_name", s.value_name}, {"help", s.help},
+    nlohmann::json o = {{"flags", s.flags},         {"value_name", s.value_name}, {"help", s.help}, {"doc", s.doc},
                         {"default", s.default_value}, {"recorded", bool(s.record)}, {"must_match", s.must_match},
                         {"kernel", s.kernel}};
     o["metadata"] = s.metadata ? nlohmann::json(s.metadata) : nlohmann::json();

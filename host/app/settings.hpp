@@ -56,8 +56,9 @@ struct RenderSetting {
   const char* metadata = nullptr;
   const char* stats = nullptr;
   bool must_match = false;
-  // The kernel argument (a dev::RenderParams field) or build option it reaches, as the host
-  // spells it (host/render/renderer.cpp, host/compile/); empty: none
+  // What it reaches in the kernel: "RenderParams.FIELD" (a field of dev::RenderParams, set in
+  // host/render/renderer.cpp) or a build option's name ("CD_SAMPLER_SOBOL", "CD_FEATURE_*");
+  // empty: none
   const char* kernel = "";
 };
 
