@@ -94,6 +94,9 @@ def check_help(candela, listing):
 
 def check_kernel(root, listing):
     renderer = open(os.path.join(root, 'host', 'render', 'renderer.cpp'), encoding='utf-8').read()
+    header = open(os.path.join(root, 'host', 'render', 'renderer.hpp'), encoding='utf-8').read()
+    kernel_settings = re.findall(r'X\(\s*\w+,\s*(\w+),', header[header.index('#define CD_KERNEL_SETTINGS'):
+                                                            header.index('struct RenderSettings')])
     types = open(os.path.join(root, 'cl', 'shared', 'device_types.h'), encoding='utf-8').read()
     sources = ''
     for base in ('host', 'cl'):
@@ -108,8 +111,10 @@ def check_kernel(root, listing):
             continue
         if k.startswith('RenderParams.'):
             field = k.split('.', 1)[1]
-            check(re.search(rf'\b{field};', params) is not None and f'params_host_.{field} =' in renderer,
-                  f'{o["flags"]} reaches RenderParams.{field} (device_types.h, set in renderer.cpp)')
+            check(re.search(rf'\b{field};', params) is not None and
+                  (f'params_host_.{field} =' in renderer or field in kernel_settings),
+                  f'{o["flags"]} reaches RenderParams.{field} (device_types.h; set in renderer.cpp, or by '
+                  'CD_KERNEL_SETTINGS)')
         else:
             pattern = re.escape(k).replace(r'\*', r'\w+')
             check(re.search(pattern, sources) is not None, f'{o["flags"]} reaches the build option {k}')
