@@ -8,6 +8,7 @@
 #include "app/commands.hpp"
 #include "app/options.hpp"
 #include "app/render_command.hpp"
+#include "app/settings.hpp"
 #include "base/error.hpp"
 #include "device/device.hpp"
 #include "device/kernel_sources.hpp"
@@ -70,6 +71,8 @@ int main(int argc, char** argv) {
   CLI::App* merge_cmd = add_merge_command(&app, &merge_args);
   InfoArgs info_args;
   CLI::App* info_cmd = add_info_command(&app, &info_args);
+  HelpOptionsArgs help_options_args;
+  CLI::App* help_options_cmd = add_help_options_command(&app, &help_options_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
@@ -84,6 +87,7 @@ int main(int argc, char** argv) {
     if (*compare_cmd) return run_compare_command(compare_cmd, &compare);
     if (*merge_cmd) return run_merge(merge_args);
     if (*info_cmd) return run_info_command(info_args);
+    if (*help_options_cmd) return run_help_options(help_options_args);
     return run_render_command(render_args);
   });
 }

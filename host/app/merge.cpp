@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "app/report.hpp"
 #include "base/atomic_file.hpp"
 #include "base/error.hpp"
 #include "render/film.hpp"
@@ -15,12 +16,6 @@
 namespace candela {
 
 namespace {
-
-// Metadata that must agree: the inputs are then samples of the same estimator (camera and
-// lighting are fingerprints of the device camera and of the background and environment)
-const char* const kMustMatch[] = {
-    "scene",  "seed",    "strategy", "light_selection", "max_depth", "energy_compensation",
-    "filter", "sampler", "camera",   "lighting"};
 
 bool partial(const RgbImage& img) {
   auto it = img.metadata.find("partial_pass");
@@ -106,17 +101,19 @@ Input read_input(const std::string& path) {
   return x;
 }
 
-// Same size and the kMustMatch metadata as the first input
+// Same size as the first input, and the same metadata where a render's must match
+// (report.hpp: must_match_keys; camera and lighting are fingerprints of the device camera
+// and of the background and environment: the inputs are then samples of the same estimator)
 void check_same_render(const Input& first, const Input& x) {
   if (x.img.width != first.img.width || x.img.height != first.img.height)
     throw Error("cannot merge: " + x.path + " is " + std::to_string(x.img.width) + "x" + std::to_string(x.img.height) +
                 ", " + first.path + " is " + std::to_string(first.img.width) + "x" + std::to_string(first.img.height));
-  for (const char* key : kMustMatch) {
+  for (const std::string& key : must_match_keys()) {
     auto a = first.img.metadata.find(key), b = x.img.metadata.find(key);
     std::string va = a == first.img.metadata.end() ? "(none)" : a->second;
     std::string vb = b == x.img.metadata.end() ? "(none)" : b->second;
     if (va != vb)
-      throw Error("cannot merge: different " + std::string(key) + ": " + first.path + " has '" + va + "', " + x.path +
+      throw Error("cannot merge: different " + key + ": " + first.path + " has '" + va + "', " + x.path +
                   " has '" + vb + "'");
   }
 }

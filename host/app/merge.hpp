@@ -19,9 +19,10 @@ struct MergeArgs {
 // ("B:E,B:E", written by merge), else [sample_offset, sample_offset + spp)
 using SampleRanges = std::vector<std::pair<uint64_t, uint64_t>>;
 
-// Reads the inputs, checks that they are shards of one render (same size, scene, seed,
-// strategy, max depth, energy compensation and filter; disjoint sample ranges; candela
-// metadata present) and writes the per-pixel mean weighted by each file's spp. Throws
+// Reads the inputs, checks that they are shards of one render (same size, the same
+// settings where the settings' table says they must match (settings.hpp: scene, seed,
+// strategy, filter, ...), camera and lighting; disjoint sample ranges; candela metadata
+// present) and writes the per-pixel mean weighted by each file's spp. Throws
 // Error naming the first mismatch. Returns the process exit code.
 int run_merge(const MergeArgs& args);
 

@@ -18,6 +18,7 @@
 #include "app/render_devices.hpp"
 #include "app/render_scene.hpp"
 #include "app/report.hpp"
+#include "app/settings.hpp"
 #include "base/atomic_file.hpp"
 #include "base/file_access.hpp"
 #include "compile/camera.hpp"
@@ -25,7 +26,6 @@
 #include "compile/scene_compiler.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
-#include "scene/default_light.hpp"
 
 namespace candela {
 namespace {
@@ -73,109 +73,6 @@ void catch_signals() {
 void enter_phase(Phase phase) { g_phase.store(phase); }
 bool signalled() { return g_signal.load() != 0; }
 
-// Speed against accuracy (README): --variance and --generic
-void add_accuracy_render_options(CLI::App* render, RenderArgs* a) {
-  render->add_option("--variance", a->variance,
-                     "Also write the variance of each pixel's mean, M2 / (n (n - 1)) per channel, to this .exr "
-                     "(infinite where a pixel has fewer than 2 samples)");
-  render->add_flag("--generic", a->generic,
-                   "Build the generic kernel with every scene feature compiled in, instead of the one specialized "
-                   "to the scene (to measure what specialization gains)");
-}
-
-// Several devices and machines (README): --sample-offset and --mpi; --device takes a list
-void add_distributed_render_options(CLI::App* render, RenderArgs* a) {
-  render
-      ->add_option("--sample-offset", a->sample_offset,
-                   "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; "
-                   "stored as candela:sample_offset")
-      ->check(integer_in(0, 4294967295LL));
-  render->add_flag("--mpi", a->mpi,
-                   "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank "
-                   "renders a block of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)");
-}
-
-// The scene's lighting: background, environment map, default light
-void add_lighting_render_options(CLI::App* render, RenderArgs& a) {
-  auto* background_opt =
-      render->add_option("--background", a.background,
-                         "Constant background radiance R,G,B (replaces the scene's background and environment map)");
-  render->add_option("--env", a.env, "Equirectangular environment map (.hdr, .exr, .png, .jpg), replacing the scene's")
-      ->excludes(background_opt);
-  render
-      ->add_option("--env-strength", a.env_strength,
-                   "Environment map strength, a radiance scale (default 1, or the scene's)")
-      ->check(finite_number());
-  render
-      ->add_option(
-          "--env-rotation", a.env_rotation,
-          "Environment map rotation about +Y in degrees, counter-clockwise seen from above (default 0, or the scene's)")
-      ->check(finite_number());
-  render->add_option("--default-light", a.default_light,
-                     "The built-in studio environment: " + enum_names(kDefaultLightNames, true));
-  render->add_flag_callback(
-      "--no-default-light", [&a] { a.default_light = "off"; }, "Same as --default-light off");
-  render->add_option("--light-units", a.light_units,
-                     "KHR_lights_punctual intensities: " + enum_names(kLightUnitNames, true) +
-                         "; default: the scene's extras candela.light_units, else photometric");
-  render->add_option("--variant", a.variant,
-                     "KHR_materials_variants: render the scene's material variant NAME (candela info lists them; "
-                     "default: the default materials)");
-}
-
-// The camera, replacing or changing the scene's
-void add_camera_render_options(CLI::App* render, RenderArgs& a) {
-  render
-      ->add_option("--camera", a.camera,
-                   "The scene's camera to render through, by index (candela info lists them; "
-                   "default 0, the first)")
-      ->check(integer_in(0, 1 << 30));
-  render->add_option("--look-from", a.look_from, "Camera position X,Y,Z (overrides the scene camera)");
-  render->add_option("--look-at", a.look_at, "Camera target X,Y,Z");
-  render->add_option("--up", a.up, "Camera up vector X,Y,Z (default 0,1,0)");
-  render->add_option("--fov", a.fov, "Vertical field of view in degrees, 0 < FOV < 180 (makes the camera perspective)")
-      ->check(finite_number());
-  render
-      ->add_option(
-          "--aperture", a.aperture,
-          "Thin-lens aperture radius in scene units for depth of field (default 0: pinhole; perspective cameras)")
-      ->check(finite_number());
-  render
-      ->add_option("--focus-distance", a.focus_distance,
-                   "Distance of the sharp plane along the view axis (default: the --look-at point, else the scene "
-                   "camera's extras, else the scene bounds' centre)")
-      ->check(finite_number());
-}
-
-// Samples, size, devices and the path tracer's settings
-void add_sampling_render_options(CLI::App* render, RenderArgs& a) {
-  auto* spp_opt = render->add_option("--spp", a.spp, "Samples per pixel (default 64)")->check(integer_in(1, 1 << 24));
-  render->add_option("--time", a.time, "Render for this many seconds instead of a sample count")
-      ->check(positive_number())
-      ->excludes(spp_opt);
-  render->add_option("--width", a.width, "Image width (default 512, or from --height and the camera aspect)")
-      ->check(integer_in(1, 65536));
-  render->add_option("--height", a.height, "Image height (default from the camera aspect ratio, else the width)")
-      ->check(integer_in(1, 65536));
-  render->add_option(
-      "--device", a.device,
-      "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else first "
-      "CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once");
-  render->add_option("--seed", a.seed, "Random seed (default 0)")->check(integer_in(0, 4294967295LL));
-  render->add_option("--max-depth", a.max_depth, "Maximum number of bounces (default 16)")
-      ->check(integer_in(0, 100000));
-  render->add_option("--strategy", a.strategy,
-                     enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto");
-  render
-      ->add_option("--light-selection", a.light_selection,
-                   "tree|power: light selection by the light tree (estimated contribution at the shading point; "
-                   "default) or by power alone")
-      ->check(CLI::IsMember({"tree", "power"}));
-  render->add_flag("--no-energy-compensation", a.no_energy_compensation,
-                   "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
-                   "default: rough metal and glass keep their albedo)");
-}
-
 void check_variance_path(const RenderArgs& a) {
   if (a.variance.empty()) return;
   std::string ext = lowercase(a.variance.size() >= 4 ? a.variance.substr(a.variance.size() - 4) : "");
@@ -218,7 +115,7 @@ void check_stats_path(const RenderArgs& a) {
 
 // What can be checked before the scene loads: option names and output paths
 RenderSettings check_render_args(const RenderArgs& a) {
-  RenderSettings settings;
+  RenderSettings settings = a.settings;
   if (!a.quiet) {
     settings.before_kernel_compile = [](const std::string& device) {
       std::fprintf(stderr,
@@ -233,14 +130,7 @@ RenderSettings check_render_args(const RenderArgs& a) {
                    device.c_str());
     };
   }
-  if (!a.strategy.empty()) parse_enum(kStrategyNames, "--strategy", a.strategy);  // fails before loading
-  settings.filter = parse_enum(kPixelFilterNames, "--filter", a.filter);
-  settings.sampler = parse_enum(kSamplerNames, "--sampler", a.sampler);
-  settings.energy_compensation = !a.no_energy_compensation;
-  parse_tonemap(a.tonemap);  // a bad name fails before loading
-  parse_enum(kDefaultLightNames, "--default-light", a.default_light);
-  if (!a.light_units.empty()) parse_enum(kLightUnitNames, "--light-units", a.light_units);
-  if (a.exposure && !std::isfinite(*a.exposure)) throw Error("--exposure must be a finite number of stops");
+  apply_render_settings(a, &settings);  // names of enums, and what they set
   check_camera_options(a);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(out);
@@ -254,8 +144,6 @@ RenderSettings check_render_args(const RenderArgs& a) {
 void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* settings) {
   settings->strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
   resolve_image_size(a, scene, &settings->width, &settings->height);
-  settings->seed = a.seed;
-  settings->max_depth = a.max_depth;
   // CANDELA_LAUNCH_SECONDS: the target duration of one launch (default 0.2 s)
   if (const char* text = std::getenv("CANDELA_LAUNCH_SECONDS")) {
     char* end = nullptr;
@@ -380,33 +268,8 @@ void print_result(const RenderReport& report, bool partial_pass, const Film& fil
 }  // namespace
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
-  RenderArgs& a = *args;
   auto* render = app->add_subcommand("render", "Render a glTF scene");
-  render->add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
-  render
-      ->add_option("-o,--output", a.outputs,
-                   "Output image: .exr (linear), .png or .jpg (tone-mapped sRGB, --tonemap); repeatable")
-      ->required();
-  add_sampling_render_options(render, a);
-  add_lighting_render_options(render, a);
-  render->add_option("--stats", a.stats, "Write render statistics as JSON to this file");
-  render
-      ->add_option(
-          "--exposure", a.exposure,
-          "Exposure of PNG/JPEG outputs in stops (default 0, or lower for a scene whose own lights are over 4x the "
-          "studio's); EXR stays linear")
-      ->check(finite_number());
-  render->add_option("--tonemap", a.tonemap,
-                     "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true));
-  add_camera_render_options(render, a);
-  render->add_option("--filter", a.filter, "Pixel filter: " + enum_names(kPixelFilterNames, true));
-  render->add_option("--sampler", a.sampler, "Random numbers: " + enum_names(kSamplerNames, true));
-  render->add_flag("-q,--quiet", a.quiet, "No progress or scene summary");
-  render->add_flag("--allow-outside-paths", a.allow_outside_paths,
-                   "Let the scene read files outside its folder: absolute paths, .., links that lead out "
-                   "(by default a scene's buffers, images, maps and grids must lie inside its folder)");
-  add_accuracy_render_options(render, &a);
-  add_distributed_render_options(render, &a);
+  add_render_settings(render, args);
   return render;
 }
 

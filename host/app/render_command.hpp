@@ -1,4 +1,5 @@
-// `candela render SCENE -o OUT ...`: its options and the render they ask for.
+// `candela render SCENE -o OUT ...`: the values of its options (settings.hpp defines each
+// option) and the render they ask for.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -6,6 +7,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "render/renderer.hpp"
 
 namespace candela {
 
@@ -16,8 +19,6 @@ struct RenderArgs {
   double time = 0.0;
   int width = 0, height = 0;
   std::string device;
-  uint32_t seed = 0;
-  uint32_t max_depth = 16;
   std::string strategy;                  // empty: the scene's (extras candela.strategy), else auto
   std::string light_selection = "tree";  // --light-selection tree|power
   bool no_energy_compensation = false;
@@ -42,6 +43,9 @@ struct RenderArgs {
   uint32_t sample_offset = 0;        // --sample-offset: first sample index (shards, candela merge)
   bool mpi = false;                  // --mpi: spread the samples over the ranks of an MPI job
   bool allow_outside_paths = false;  // --allow-outside-paths: scene files outside its folder
+  // The renderer's settings that options give as they are (--seed, --max-depth); the
+  // others follow from the options above (check_render_args, complete_settings)
+  RenderSettings settings;
 };
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string_view>
+#include <variant>
 
 #include "app/mpi_render.hpp"
 #include "app/render_command.hpp"
@@ -81,28 +82,18 @@ nlohmann::json camera_json(const dev::Camera& c) {
 
 double per_triangle(size_t bytes, size_t triangles) { return double(bytes) / double(std::max<size_t>(1, triangles)); }
 
-// The render's settings and what it did
+// What the render did, and the settings it records (settings.hpp)
 void record_render(const RenderArgs& a, const RenderSettings& settings, const RenderResult& r, RenderReport* out) {
   RenderReport& report = *out;
   report.spp = r.spp;
   report.seconds = r.seconds;
-  report.seed = settings.seed;
-  report.max_depth = settings.max_depth;
-  report.sample_offset = a.sample_offset;
-  report.strategy = a.strategy;
-  report.light_selection = a.light_selection;
-  report.filter = enum_name(kPixelFilterNames, settings.filter);
-  report.sampler = enum_name(kSamplerNames, settings.sampler);
-  report.energy_compensation = settings.energy_compensation;
   report.dropped_samples = r.film.dropped_samples();
-  report.scene = a.scene;
-  report.width = settings.width;
-  report.height = settings.height;
   report.samples_per_second = r.spp * (double(settings.width) * settings.height) / std::max(r.seconds, 1e-9);
   report.interrupted = r.interrupted;
   report.partial_pass = r.partial_pass;
   report.sample_end = uint64_t(a.sample_offset) + r.samples_taken;
-  report.generic_kernel = a.generic;
+  for (const RenderSetting& s : render_settings())
+    if (s.record) report.settings.emplace_back(&s, s.record(a, settings));
 }
 
 // The compiled scene, its kernels and this process
@@ -166,66 +157,76 @@ std::string lighting_fingerprint(const Scene& scene) {
   return hex64(h);
 }
 
+namespace {
+
+// A value as the metadata spells it: a number in decimal, a flag on|off
+template <typename T>
+std::string metadata_text(const T& v) {
+  return std::to_string(v);
+}
+std::string metadata_text(const std::string& v) { return v; }
+std::string metadata_text(bool v) { return v ? "on" : "off"; }
+
+template <typename T>
+bool unset(const T&) {
+  return false;
+}
+bool unset(const std::string& v) { return v.empty(); }
+
+}  // namespace
+
+std::vector<RecordKey> result_keys() {
+  std::vector<RecordKey> keys;
+#define CD_RESULT_KEY(type, name, where) \
+  keys.push_back({#name, ((where)&kInImage) != 0, ((where)&kInStats) != 0, ((where)&kMustAgree) != 0});
+  CD_RENDER_RESULTS(CD_RESULT_KEY)
+#undef CD_RESULT_KEY
+  // Written by hand below: image_metadata's partial pass, write_stats' structured and
+  // derived keys
+  keys.push_back({"partial_pass", true, false, false, false});
+  keys.push_back({"sample_ranges", true, false, false, false});
+  for (const char* key : {"grids", "devices", "camera", "device_bytes_per_triangle", "peak_rss_bytes_per_triangle"})
+    keys.push_back({key, false, true, false, true});
+  return keys;
+}
+
+std::vector<std::string> must_match_keys() {
+  std::vector<std::string> keys;
+  for (const RenderSetting& s : render_settings())
+    if (s.must_match && s.metadata) keys.push_back(s.metadata);
+  for (const RecordKey& k : result_keys())
+    if (k.must_match) keys.push_back(k.key);
+  return keys;
+}
+
 std::map<std::string, std::string> image_metadata(const RenderReport& r) {
-  std::map<std::string, std::string> meta = {{"spp", std::to_string(r.spp)},
-                                             {"seconds", std::to_string(r.seconds)},
-                                             {"device", r.device},
-                                             {"seed", std::to_string(r.seed)},
-                                             {"strategy", r.strategy},
-                                             {"light_selection", r.light_selection},
-                                             {"max_depth", std::to_string(r.max_depth)},
-                                             {"dropped_samples", std::to_string(r.dropped_samples)},
-                                             {"scene", r.scene},
-                                             {"energy_compensation", r.energy_compensation ? "on" : "off"},
-                                             {"filter", r.filter},
-                                             {"sampler", r.sampler},
-                                             {"sample_offset", std::to_string(r.sample_offset)}};
-  if (!r.camera.empty()) meta["camera"] = r.camera;
-  if (!r.lighting.empty()) meta["lighting"] = r.lighting;
+  std::map<std::string, std::string> meta;
+  for (const auto& [setting, value] : r.settings)
+    if (setting->metadata) meta[setting->metadata] = std::visit([](const auto& v) { return metadata_text(v); }, value);
+#define CD_RESULT_METADATA(type, name, where) \
+  if (((where)&kInImage) && !(((where)&kIfSet) && unset(r.name))) meta[#name] = metadata_text(r.name);
+  CD_RENDER_RESULTS(CD_RESULT_METADATA)
+#undef CD_RESULT_METADATA
   // Stopped inside a range: its pixels hold up to sample_end (merge refuses overlaps)
   if (r.partial_pass) {
     meta["partial_pass"] = "1";
-    meta["sample_ranges"] = std::to_string(r.sample_offset) + ":" + std::to_string(r.sample_end);
+    meta["sample_ranges"] = meta.at("sample_offset") + ":" + std::to_string(r.sample_end);
   }
   return meta;
 }
 
 void write_stats(const RenderReport& r, const std::string& path) {
-  nlohmann::json j = {{"spp", r.spp},
-                      {"seconds", r.seconds},
-                      {"samples_per_second", r.samples_per_second},
-                      {"kernel_build_seconds", r.kernel_build_seconds},
-                      {"kernel_from_cache", r.kernel_from_cache},
-                      {"kernel_features", r.kernel_features},
-                      {"bvh_build_seconds", r.bvh_build_seconds},
-                      {"scene_compile_seconds", r.scene_compile_seconds},
-                      {"scene_device_bytes", r.scene_device_bytes},
-                      {"grids", grids_json(r.grids)},
-                      {"device_bytes_per_triangle", per_triangle(r.scene_device_bytes, r.triangles)},
-                      {"peak_rss_bytes", r.peak_rss_bytes},
-                      {"peak_rss_bytes_per_triangle", per_triangle(r.peak_rss_bytes, r.triangles)},
-                      {"bvh_sah_cost", r.bvh_sah_cost},
-                      {"bvh_threads", r.bvh_threads},
-                      {"triangles", r.triangles},
-                      {"lights", r.lights},
-                      {"device", r.device},
-                      {"devices", devices_json(r.devices)},
-                      {"sample_offset", r.sample_offset},
-                      {"mpi_ranks", r.mpi_ranks},
-                      {"width", r.width},
-                      {"height", r.height},
-                      {"strategy", r.strategy},
-                      {"light_selection", r.light_selection},
-                      {"energy_compensation", r.energy_compensation},
-                      {"filter", r.filter},
-                      {"sampler", r.sampler},
-                      {"max_depth", r.max_depth},
-                      {"seed", r.seed},
-                      {"interrupted", r.interrupted},
-                      {"partial_pass", r.partial_pass},
-                      {"sample_end", r.sample_end},
-                      {"dropped_samples", r.dropped_samples},
-                      {"generic_kernel", r.generic_kernel}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [setting, value] : r.settings)
+    if (setting->stats) j[setting->stats] = std::visit([](const auto& v) { return nlohmann::json(v); }, value);
+#define CD_RESULT_STATS(type, name, where) \
+  if ((where)&kInStats) j[#name] = r.name;
+  CD_RENDER_RESULTS(CD_RESULT_STATS)
+#undef CD_RESULT_STATS
+  j["grids"] = grids_json(r.grids);
+  j["devices"] = devices_json(r.devices);
+  j["device_bytes_per_triangle"] = per_triangle(r.scene_device_bytes, r.triangles);
+  j["peak_rss_bytes_per_triangle"] = per_triangle(r.peak_rss_bytes, r.triangles);
   if (r.has_view) j["camera"] = camera_json(r.view);
   write_file_atomically(path, j.dump(2) + "\n");
 }

@@ -267,14 +267,11 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.camera = camera;
   params_host_.width = uint32_t(settings.width);
   params_host_.height = uint32_t(settings.height);
-  params_host_.seed = settings.seed;
-  params_host_.max_depth = settings.max_depth;
-  params_host_.rr_depth = settings.rr_depth;
-  params_host_.strategy = uint32_t(settings.strategy);
+#define CD_SET_KERNEL_SETTING(type, name, default_value) params_host_.name = uint32_t(settings.name);
+  CD_KERNEL_SETTINGS(CD_SET_KERNEL_SETTING)
+#undef CD_SET_KERNEL_SETTING
   params_host_.num_lights = uint32_t(scene.buffers.lights.size());  // kept by release
   params_host_.environment_light = scene.environment_light;
-  params_host_.energy_compensation = settings.energy_compensation ? 1u : 0u;
-  params_host_.filter = uint32_t(settings.filter);
 
   size_t pixels = size_t(settings.width) * settings.height;
   chunk_ = std::min(pixels, std::max<size_t>(group_pixels_, 4096));

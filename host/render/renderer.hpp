@@ -45,15 +45,26 @@ inline constexpr EnumName<Sampler> kSamplerNames[] = {
 // The film's per-pixel sample count is a float: exact up to 2^24
 constexpr uint32_t kMaxSamplesPerPixel = 1u << 24;
 
+// The settings the kernel reads as they are, one line each: X(type, name, default). Each is
+// a RenderSettings member and the dev::RenderParams field of the same name (an unsigned int:
+// an enum's value, a flag's 0 or 1), which DeviceRenderer sets from it. A command-line option
+// sets them (host/app/settings.cpp). One entry per line, columns aligned:
+// clang-format off
+#define CD_KERNEL_SETTINGS(X)                               \
+  X(uint32_t,    seed,                0)                    \
+  X(uint32_t,    max_depth,           16) /* scattering events */ \
+  X(uint32_t,    rr_depth,            3)  /* Russian roulette after this many bounces */ \
+  X(Strategy,    strategy,            Strategy::Auto)       \
+  X(bool,        energy_compensation, true) /* multiple scattering of GGX lobes (cl/bsdf/energy.cl) */ \
+  X(PixelFilter, filter,              PixelFilter::Box)
+// clang-format on
+
 struct RenderSettings {
   int width = 512, height = 512;
-  uint32_t seed = 0;
-  uint32_t max_depth = 16;  // scattering events
-  uint32_t rr_depth = 3;    // Russian roulette after this many bounces
-  Strategy strategy = Strategy::Auto;
-  bool energy_compensation = true;  // multiple scattering of GGX lobes (cl/bsdf/energy.cl)
-  PixelFilter filter = PixelFilter::Box;
-  Sampler sampler = Sampler::Sobol;
+#define CD_KERNEL_SETTING_MEMBER(type, name, default_value) type name = default_value;
+  CD_KERNEL_SETTINGS(CD_KERNEL_SETTING_MEMBER)
+#undef CD_KERNEL_SETTING_MEMBER
+  Sampler sampler = Sampler::Sobol;  // a build option: CD_SAMPLER_SOBOL (render_kernel_options)
   double launch_seconds = 0.2;  // target duration of one launch
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
