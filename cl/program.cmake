@@ -6,6 +6,7 @@
 set(CANDELA_CL_SOURCES
   cl/shared/device_types.h
   cl/shared/color.h
+  cl/shared/light_profiles.h
   cl/core/rng.cl
   cl/core/sampling.cl
   cl/core/geometry.cl
@@ -31,7 +32,11 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/bsdf_gltf.cl
   cl/bsdf/bsdf.cl
   cl/bsdf/unlit.cl
+  cl/lights/light_common.cl
   cl/lights/environment.cl
+  cl/lights/triangle.cl
+  cl/lights/punctual.cl
+  cl/lights/light_tree.cl
   cl/lights/lights.cl
   cl/media/phase.cl
   cl/media/nanovdb.cl

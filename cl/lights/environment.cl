@@ -9,7 +9,7 @@
 // so the image centre (u = 1/2) is seen along -Z, u = 3/4 along +X, u = 1/4 along -X and
 // the left and right edges along +Z, as a viewer standing at the origin looking down -Z
 // sees the middle of the panorama, with the right half of the image to its right.
-// `rotation` (Light.params[2], radians) turns the map counter-clockwise seen from above
+// `rotation` (EnvironmentLight.rotation, radians) turns the map counter-clockwise seen from above
 // (right-handed about +Y): at 90 degrees the image centre is seen along -X.
 //
 // Filter: nearest texel. A direction's radiance is the texel its (u, v) falls in, times the
@@ -30,7 +30,7 @@
 // for a u in [k / g(n), (k + 1) / g(n)) starts.
 
 // The light's map (a TextureInfo index), or NO_TEXTURE for a constant environment
-int environment_map(__global const Light* light) { return (int)light->params[0]; }
+int environment_map(__global const Light* light) { return (int)light->params.environment.map; }
 
 // (u, v) of a unit direction: the mapping above
 float2 environment_uv(float3 dir, float rotation) {
@@ -62,13 +62,13 @@ int2 environment_texel_of(__global const TextureInfo* tex, float3 dir, float rot
 // Radiance of texel t: strength x the texel
 float3 environment_radiance_at(const SceneData* sc, __global const Light* light, __global const TextureInfo* tex,
                                int2 t) {
-  return light->params[1] * texture_texel(sc, tex, t.x, t.y).xyz;
+  return light->params.environment.strength * texture_texel(sc, tex, t.x, t.y).xyz;
 }
 
 // Radiance arriving along -dir: strength x the nearest texel
 float3 environment_radiance(const SceneData* sc, __global const Light* light, float3 dir) {
   __global const TextureInfo* tex = &sc->textures[environment_map(light)];
-  return environment_radiance_at(sc, light, tex, environment_texel_of(tex, dir, light->params[2]));
+  return environment_radiance_at(sc, light, tex, environment_texel_of(tex, dir, light->params.environment.rotation));
 }
 
 // Density in (u, v) of texel t: (marginal step / total) h x (conditional step / total) w
@@ -92,7 +92,7 @@ float environment_pdf_at(const SceneData* sc, __global const TextureInfo* tex, f
 // Solid-angle pdf with which environment_sample picks dir
 float environment_pdf(const SceneData* sc, __global const Light* light, float3 dir) {
   __global const TextureInfo* tex = &sc->textures[environment_map(light)];
-  return environment_pdf_at(sc, tex, dir, environment_texel_of(tex, dir, light->params[2]));
+  return environment_pdf_at(sc, tex, dir, environment_texel_of(tex, dir, light->params.environment.rotation));
 }
 
 // A coordinate in [0, 1) distributed by one CDF of n cells: the cell i with
@@ -123,11 +123,84 @@ float3 environment_sample(const SceneData* sc, __global const Light* light, floa
   float v = environment_sample_cdf(sc->env_distribution, h, guides, u.y, &row);
   float uu = environment_sample_cdf(sc->env_distribution + (h + 1) + row * (w + 1), w,
                                     guides + environment_guide_cells(h) + row * environment_guide_cells(w), u.x, &col);
-  float3 dir = environment_direction((float2)(uu, v), light->params[2]);
+  float3 dir = environment_direction((float2)(uu, v), light->params.environment.rotation);
   // Both from the direction itself (its texel found once), so that sample, pdf and radiance
   // agree exactly even where rounding puts dir across a texel edge
-  int2 t = environment_texel_of(tex, dir, light->params[2]);
+  int2 t = environment_texel_of(tex, dir, light->params.environment.rotation);
   *pdf = environment_pdf_at(sc, tex, dir, t);
   *radiance = environment_radiance_at(sc, light, tex, t);
   return dir;
 }
+
+// The environment as a light (CD_LIGHTS entry environment; EnvironmentLight): a constant,
+// or the equirectangular map above
+__global const Light* lights_environment(const SceneData* sc) {
+  int i = sc->params->environment_light;
+  return i == NO_LIGHT ? 0 : &sc->lights[i];
+}
+
+// Radiance arriving along -dir from infinitely far away
+float3 lights_environment_radiance(const SceneData* sc, float3 dir) {
+#if CD_FEATURE_ENVIRONMENT
+  __global const Light* env = lights_environment(sc);
+  if (!env) return (float3)(0.0f);
+  if (environment_map(env) != NO_TEXTURE) return environment_radiance(sc, env, dir);
+  return load3(env->radiance);
+#else
+  return (float3)(0.0f);
+#endif
+}
+
+// Reflection-only surfaces see the environment over the hemisphere of n (sampled by the
+// cosine to n); points in media and transmissive surfaces over the whole sphere
+bool lights_environment_hemisphere(const LightSampleContext* ctx) {
+  return !ctx->transmits && dot(ctx->n, ctx->n) > 0.0f;
+}
+
+// A map is importance-sampled over the whole sphere, whatever the context
+float lights_environment_pdf(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                             float3 wi) {
+  __global const Light* env = lights_environment(sc);
+  if (env && environment_map(env) != NO_TEXTURE) return environment_pdf(sc, env, wi);
+  if (lights_environment_hemisphere(ctx)) return sample_cosine_hemisphere_pdf(dot(wi, ctx->n));
+  return sample_uniform_sphere_pdf();
+}
+
+bool lights_environment_sample(const SceneData* sc, __global const Light* light, const LightSampleContext* ctx,
+                               float2 u, LightSample* ls) {
+  __global const Light* env = lights_environment(sc);
+  if (env && environment_map(env) != NO_TEXTURE) {
+    ls->wi = environment_sample(sc, env, u, &ls->pdf, &ls->radiance);
+    ls->at_infinity = true;
+    return ls->pdf > 0.0f;
+  }
+  if (lights_environment_hemisphere(ctx)) {
+    Frame f = frame_from_z(ctx->n);
+    ls->wi = frame_from_local(&f, sample_cosine_hemisphere(u.x, u.y));
+  } else {
+    ls->wi = sample_uniform_sphere(u.x, u.y);
+  }
+  ls->pdf = lights_environment_pdf(sc, light, ctx, ls->wi);
+  ls->radiance = lights_environment_radiance(sc, ls->wi);
+  ls->at_infinity = true;
+  return ls->pdf > 0.0f;
+}
+
+uint lights_environment_prim(__global const Light* light) { return UINT_MAX; }
+
+// An environment seen from anywhere: its bright part as a cone of its effective solid angle
+// (integral L)^2 / integral L^2 about the direction its L^2 is centred on (the whole
+// sphere for a constant), and integral L, L its luminance (computed on the host:
+// EnvironmentLight's solid_angle, direction and integral)
+void lights_environment_extent(const SceneData* sc, __global const Light* light, float3 p, LightExtent* e) {
+  __global const EnvironmentLight* env = &light->params.environment;
+  e->omega = env->solid_angle;
+  e->everywhere = true;
+  e->dir = (float3)(env->direction[0], env->direction[1], env->direction[2]);
+  e->radius = dot(e->dir, e->dir) > 0.0f ? acos_fast(1.0f - e->omega * (0.5f * INV_PI_F)) : PI_F;
+  bool map = environment_map(light) != NO_TEXTURE;
+  e->integral = env->integral * (map ? env->strength : luminance(load3(light->radiance)));
+}
+
+// An environment surrounds every point: no bound smaller than its extent
+float lights_environment_omega_bound(const SceneData* sc, __global const Light* light, float3 p) { return -1.0f; }

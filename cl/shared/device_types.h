@@ -90,7 +90,9 @@
 #define TEX_SLOTS 18
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
-// on Light.type (cl/lights/lights.cl; the host's light_power and name table). Each type has
+// on Light.type (cl/lights/lights.cl; on the host light_power, light_bounds and the name
+// table). Each type has its parameters, a struct of 32 bytes that is the member `name` of
+// LightParams (below; Light.params.name), and in cl/lights/NAME.cl (or the file of its family)
 //   bool lights_NAME_sample(const SceneData*, __global const Light*, const LightSampleContext*,
 //                           float2 u, LightSample*)
 //   float lights_NAME_pdf(const SceneData*, __global const Light*, const LightSampleContext*, float3 wi)
@@ -98,8 +100,9 @@
 //   float lights_NAME_omega_bound(const SceneData*, __global const Light*, float3 p): an upper
 //                           bound on its solid angle at p, cheaper than the extent (0: delta; < 0: none)
 //   uint lights_NAME_prim(__global const Light*): the emissive primitive it is, or UINT_MAX
-// in cl/lights/ and light_power_NAME on the host (host/compile/scene_compiler.cpp). `feature`
-// is the CD_SCENE_FEATURES macro that compiles the type in, or 1 (always). The ids number the list.
+// and on the host light_power_NAME and light_bounds_NAME (its power, and its bounds in the
+// light tree or none: host/compile/light_types.cpp). `feature` is the CD_SCENE_FEATURES
+// macro that compiles the type in, or 1 (always). The ids number the list.
 #define LIGHT_TRIANGLE 0u     // an emissive triangle (area light)
 #define LIGHT_ENVIRONMENT 1u  // radiance arriving from infinitely far away: constant or a map
 #define LIGHT_POINT 2u        // KHR_lights_punctual point: radiant intensity from a point
@@ -320,41 +323,79 @@ typedef struct {
   unsigned int alias;
 } AliasBin;
 
+// The parameters of each light type (LightParams, by CD_LIGHTS name), 32 bytes each.
+// LIGHT_TRIANGLE: the emissive primitive is Light.index; its radiance comes from the
+// primitive's material.
+typedef struct {
+  float area;
+  float centre[3];  // centroid (in float) of the bounding sphere lights_triangle_omega_bound uses
+  float radius;     // of that sphere: it holds the triangle's float corners
+  unsigned int pad[3];
+} TriangleLight;
+
+// LIGHT_ENVIRONMENT: without a map (map = NO_TEXTURE), radiance = Light.radiance, constant.
+// With an equirectangular map (cl/lights/environment.cl): radiance = strength x texel, and
+// its sampling distribution is the env_distribution buffer. Both, for STRATEGY_AUTO's
+// choice, L the luminance before strength: solid_angle = the effective solid angle
+// (integral L)^2 / integral L^2 (4 pi for a constant), direction = the unit direction L^2
+// is centred on (zero: none), integral = integral of L over the sphere.
+typedef struct {
+  float map;       // its TextureInfo index (an integer stored as float), or NO_TEXTURE
+  float strength;  // of the map
+  float rotation;  // of the map about +Y, radians
+  float solid_angle;
+  float direction[3];
+  float integral;
+} EnvironmentLight;
+
+// LIGHT_POINT: Light.radiance = colour x intensity (radiant intensity, W/sr),
+// Light.radiance[3] = range (0: infinite).
+typedef struct {
+  float position[3];
+  unsigned int pad[5];
+} PointLight;
+
+// LIGHT_SPOT: as LIGHT_POINT, restricted to a cone: the intensity toward a direction at
+// cosine c to the axis is scaled by spot_profile(c, cone_scale, cone_offset)
+// (cl/shared/light_profiles.h; KHR_lights_punctual).
+typedef struct {
+  float position[3];
+  float axis[3];      // unit axis the cone points along
+  float cone_scale;   // 1 / max(0.001, cos(inner) - cos(outer))
+  float cone_offset;  // -cos(outer) x cone_scale
+} SpotLight;
+
+// LIGHT_DIRECTIONAL: Light.radiance = colour x intensity (irradiance at normal incidence).
+typedef struct {
+  unsigned int pad0[3];
+  float direction[3];  // unit direction the light travels
+  unsigned int pad[2];
+} DirectionalLight;
+
+// A light type's own parameters (Light.type selects the member, named as its CD_LIGHTS
+// entry), 32 bytes; every member spans the union (the host asserts it from the list)
+typedef union {
+  TriangleLight triangle;
+  EnvironmentLight environment;
+  PointLight point;
+  SpotLight spot;
+  DirectionalLight directional;
+} LightParams;
+
 // A light, 64 bytes: a type, its selection probability, and the type's parameters.
 // Lights are selected through the alias table (light_alias, one bin per light, O(1));
 // `pmf` is exactly the probability it realizes, counted over all 2^32 integers, so the
 // estimator divides by what the kernel does.
-//   LIGHT_TRIANGLE:    index = stable primitive index, params[0] = area, params[1..3] =
-//                      centroid, params[4] = radius of the sphere about it that holds the
-//                      corners; radiance comes from the primitive's material.
-//   LIGHT_ENVIRONMENT: without a map (params[0] = NO_TEXTURE): radiance = constant radiance.
-//                      With an equirectangular map (cl/lights/environment.cl): params[0] = its
-//                      TextureInfo index (an integer stored as float), params[1] = strength
-//                      (radiance = strength x texel), params[2] = rotation about +Y in
-//                      radians; its sampling distribution is the env_distribution buffer.
-//                      Both, for STRATEGY_AUTO's choice, L the luminance before strength:
-//                      params[3] = effective solid angle (integral L)^2 / integral L^2 (4 pi
-//                      for a constant), params[4..6] = unit direction L^2 is centred on
-//                      (zero: none), params[7] = integral of L over the sphere.
-//   LIGHT_POINT:       radiance = colour x intensity (radiant intensity, W/sr),
-//                      radiance[3] = range (0: infinite), params[0..2] = position.
-//   LIGHT_SPOT:        as LIGHT_POINT, and params[3..5] = unit axis the cone points along,
-//                      params[6] = angle scale 1 / max(0.001, cos(inner) - cos(outer)),
-//                      params[7] = angle offset -cos(outer) x scale; the intensity toward
-//                      a direction at cosine c to the axis is scaled by
-//                      clamp(c x scale + offset, 0, 1)^2 (KHR_lights_punctual).
-//   LIGHT_DIRECTIONAL: radiance = colour x intensity (irradiance at normal incidence),
-//                      params[3..5] = unit direction the light travels.
 typedef struct {
   unsigned int type;  // LIGHT_*
   float pmf;
-  unsigned int index;
+  unsigned int index;  // LIGHT_TRIANGLE: the stable primitive index
   unsigned int pad0;
-  float radiance[4];  // rgb
-  float params[8];    // per-type parameters, see above
+  float radiance[4];   // rgb
+  LightParams params;  // by type
 } Light;
 
-// A node of the light tree, 224 bytes (cl/lights/lights.cl; Conty Estevez & Kulla 2018,
+// A node of the light tree, 224 bytes (cl/lights/light_tree.cl; Conty Estevez & Kulla 2018,
 // Importance Sampling of Many Lights with Adaptive Tree Splitting). The tree holds the
 // finite lights (triangles, points, spots), one per leaf; a node has up to four children,
 // stored by field across its slots (centre[axis][slot], ...) so that the kernel weighs all
@@ -384,7 +425,7 @@ typedef struct {
   unsigned int holds_all;  // root: 1 when every light is in the tree (share is then 1)
   float share;             // root: probability that selection goes into the tree
   float min_prob;          // root: least weight of a child that can light the point, as a
-                           // fraction of the sum of the importances (see lights.cl)
+                           // fraction of the sum of the importances (see light_tree.cl)
 } LightTreeNode;
 
 // The path from the root of the light tree to a light's leaf, 32 bytes: step k (k < depth)
@@ -535,6 +576,14 @@ static inline int environment_guide_cells(int n) { return (n + 3) / 4 > 1 ? (n +
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
   SIZE(TexelF, 16)                                                                                            \
   SIZE(AliasBin, 8) FIELD(AliasBin, alias, 4)                                                                 \
+  SIZE(TriangleLight, 32) FIELD(TriangleLight, centre, 4) FIELD(TriangleLight, radius, 16)                    \
+  SIZE(EnvironmentLight, 32) FIELD(EnvironmentLight, strength, 4) FIELD(EnvironmentLight, rotation, 8)        \
+    FIELD(EnvironmentLight, solid_angle, 12) FIELD(EnvironmentLight, direction, 16)                           \
+    FIELD(EnvironmentLight, integral, 28)                                                                     \
+  SIZE(PointLight, 32) SIZE(SpotLight, 32) FIELD(SpotLight, axis, 12) FIELD(SpotLight, cone_scale, 24)        \
+    FIELD(SpotLight, cone_offset, 28)                                                                         \
+  SIZE(DirectionalLight, 32) FIELD(DirectionalLight, direction, 12)                                           \
+  SIZE(LightParams, 32)                                                                                       \
   SIZE(Light, 64) FIELD(Light, pmf, 4) FIELD(Light, index, 8) FIELD(Light, radiance, 16)                      \
     FIELD(Light, params, 32)                                                                                  \
   SIZE(LightTreeNode, 224) FIELD(LightTreeNode, radius, 48) FIELD(LightTreeNode, axis, 64)                    \

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "scene/default_light.hpp"
 #include "scene/environment.hpp"
@@ -54,13 +55,16 @@ void print_cameras(const Scene& s) {
   }
 }
 
+// A type's name from its list (dev::material_type_name, light_type_name), "?" for none
+const char* or_unknown(const char* name) { return name ? name : "?"; }
+
 void print_lights(const Scene& s) {
-  const char* kTypes[] = {"point", "spot", "directional"};
   std::printf("punctual lights: %zu (intensities read as %s)\n", s.punctual_lights.size(),
               enum_name(kLightUnitNames, s.light_units));
   for (const PunctualLightDesc& l : s.punctual_lights)
-    std::printf("  %s, colour %s x %.4g %s, at %s\n", kTypes[int(l.type)], vec(l.color).c_str(), l.intensity,
-                l.type == PunctualType::Directional ? "W/m^2" : "W/sr", vec(l.position).c_str());
+    std::printf("  %s, colour %s x %.4g %s, at %s\n", or_unknown(dev::light_type_name(punctual_light(l).type)),
+                vec(l.color).c_str(), l.intensity, l.type == PunctualType::Directional ? "W/m^2" : "W/sr",
+                vec(l.position).c_str());
   size_t emissive = 0, triangles = 0;
   for (const MeshDesc& m : s.meshes) {
     const glm::vec3& e = s.materials.at(m.material).emission;
@@ -112,9 +116,8 @@ void print_materials(const Scene& s) {
     if (m.has_dispersion()) std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
     if (m.has_diffuse_roughness())
       std::snprintf(diffuse_roughness, sizeof diffuse_roughness, ", diffuse roughness %.3g", m.diffuse_roughness);
-    std::printf("  %zu: %s %s, metallic %.3g, roughness %.3g%s%s%s%s%s%s%s\n", i,
-                quoted_or(m.name, "(unnamed)").c_str(),
-                m.type == MATERIAL_CONDUCTOR ? "measured conductor" : "glTF metallic-roughness", m.metallic,
+    std::printf("  %zu: %s %s material, metallic %.3g, roughness %.3g%s%s%s%s%s%s%s\n", i,
+                quoted_or(m.name, "(unnamed)").c_str(), or_unknown(dev::material_type_name(m.type)), m.metallic,
                 m.roughness, m.transmission > 0.0f ? ", transmissive" : "", m.clearcoat > 0.0f ? ", clearcoat" : "",
                 m.diffuse_transmission > 0.0f ? ", diffuse transmission" : "", dispersion,
                 m.iridescence > 0.0f ? ", iridescence" : "", diffuse_roughness,

@@ -2,9 +2,10 @@
 // the device, with its layout pinned down by static_asserts generated from CD_LAYOUT;
 // tests/device/layout_test.cpp checks the same list on each device. The name tables of the
 // material and light types come from their lists (CD_MATERIALS, CD_LIGHTS). cl/shared/color.h
-// brings the colour helpers both sides share.
+// brings the colour helpers both sides share, cl/shared/light_profiles.h the lights' profiles.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <initializer_list>
@@ -15,6 +16,7 @@
 namespace candela::dev {
 #include "cl/shared/color.h"
 #include "cl/shared/device_types.h"
+#include "cl/shared/light_profiles.h"
 }  // namespace candela::dev
 
 namespace candela::dev {
@@ -85,6 +87,25 @@ constexpr unsigned kLightTypeCount = 0 CD_LIGHTS(CD_COUNT_TYPE);
 constexpr const char* kMaterialTypeNames[] = {CD_MATERIALS(CD_TYPE_NAME)};
 constexpr const char* kLightTypeNames[] = {CD_LIGHTS(CD_TYPE_NAME)};
 #undef CD_TYPE_NAME
+
+// Every light type has its parameters, the member of LightParams named as its entry, spanning the union
+#define CD_LIGHT_PARAMS(id, name, feature)                         \
+  static_assert(sizeof(LightParams{}.name) == sizeof(LightParams), \
+                "CD_LIGHTS entry " #name ": its LightParams member must span the union");
+CD_LIGHTS(CD_LIGHT_PARAMS)
+#undef CD_LIGHT_PARAMS
+
+// A spot light's cone parameters (SpotLight.cone_scale, cone_offset; spot_profile) from
+// KHR_lights_punctual's inner and outer cone angles in radians: the extension's reference
+// form t = cos x scale + offset
+struct SpotCone {
+  float scale, offset;
+};
+inline SpotCone spot_cone(double inner_cone, double outer_cone) {
+  double cos_outer = std::cos(outer_cone);
+  double scale = 1.0 / std::max(0.001, std::cos(inner_cone) - cos_outer);
+  return {float(scale), float(-cos_outer * scale)};
+}
 
 // Names of the kernel features (the name column of CD_SCENE_FEATURES; SceneFeatures' fields)
 #define CD_FEATURE_NAME(name, macro, fallback, needs) #name,

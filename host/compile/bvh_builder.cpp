@@ -8,88 +8,22 @@
 #include <cstring>
 #include <thread>
 
-#include "scene/scene.hpp"
+#include "compile/bvh_sah.hpp"
 
 namespace candela {
 namespace {
 
-// The builder's hot functions compiled twice, for AVX2 and for the baseline ISA candela
-// is built for (SSE2 on x86-64); the loader picks one for the CPU. No FMA: each operation
-// rounds as in the baseline code, so both give the same tree.
-#if defined(__x86_64__) && defined(__GNUC__)
-#define CD_BUILD_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define CD_BUILD_CLONES
-#endif
+using namespace bvh_build;
 
-constexpr int kBins = 16;
-constexpr int kMaxLeafSize = 8;
-constexpr float kTraversalCost = 1.0f;                // relative to one triangle test
-constexpr float kEmptyLo = 1e30f, kEmptyHi = -1e30f;  // an unused child slot's box
-// Ranges of at least this many refs bin on every thread during the serial top phase
-constexpr uint32_t kParallelBinning = 32768;
-// Ranges of at least this many refs are binned into two sets of bins (Builder::bin)
-constexpr uint32_t kTwoBinSets = 256;
-// Ranges of at least kSampledBinning refs choose their split plane from the bins of every
-// kSampleStride-th ref (8192 refs or more): half the binning work at the top levels, where
-// it streams the array from memory, for trees of the same SAH cost within 0.01 % on the
-// 1 M and 10 M meshes measured (every fourth ref gave 1.4 % more on the 10 M one). The sides' boxes then come from the
-// partition, which reads every ref.
-constexpr uint32_t kSampledBinning = 16384;
-constexpr uint32_t kSampleStride = 2;
 // The top phase hands subtrees of at most max(kMinJobRefs, refs / kJobsPerTree) refs to
 // the workers: independent of the thread count, so that the tree (node order included) is
+// the same for any thread count
 constexpr uint32_t kMinJobRefs = 4096;
 constexpr size_t kJobsPerTree = 128;
 
 // Each 4-wide node on a path down pushes at most 3 entries, and the nodes sit two
 // binary levels apart, at binary depths 1, 3, ..., below kMaxBvhDepth
 static_assert(3 * (kMaxBvhDepth / 2) <= BVH_STACK_SIZE, "traversal stack too small for the depth limit");
-
-// Four floats in one SSE/NEON register (GCC and Clang vector extensions); lane 3 unused
-typedef float v4f __attribute__((vector_size(16)));
-typedef int32_t v4i __attribute__((vector_size(16)));
-
-inline v4f vmin(v4f a, v4f b) { return a < b ? a : b; }
-inline v4f vmax(v4f a, v4f b) { return a > b ? a : b; }
-inline v4f vec(const glm::vec3& p) { return v4f{p.x, p.y, p.z, 0.0f}; }
-inline glm::vec3 glm3(v4f v) { return glm::vec3(v[0], v[1], v[2]); }
-
-float surface_area(const Bounds& b) {
-  if (b.empty()) return 0.0f;
-  glm::vec3 d = b.hi - b.lo;
-  return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
-}
-
-float surface_area(v4f lo, v4f hi) {
-  if (lo[0] > hi[0]) return 0.0f;
-  v4f d = hi - lo;
-  return 2.0f * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
-}
-
-// A primitive during the build, 32 bytes: its box, with the stable primitive index in the
-// low box's lane 3 (masked off before any arithmetic: as a float it is a denormal) and 0
-// in the high box's. Partitioned in place, so that binning reads memory in order.
-struct Ref {
-  v4f lo, hi;
-  uint32_t prim() const {
-    uint32_t p;
-    std::memcpy(&p, reinterpret_cast<const char*>(&lo) + 12, 4);
-    return p;
-  }
-  v4f box_lo() const { return v4f((v4i)lo & v4i{-1, -1, -1, 0}); }
-  // Twice the centroid, in lane 3 zero
-  v4f centroid2() const { return box_lo() + hi; }
-};
-
-// A range of refs with its bounds and its centroids' bounds (twice the centroids, as
-// Ref::centroid2); leaf once the SAH says so
-struct Range {
-  uint32_t begin = 0, end = 0;
-  int depth = 1;  // of the binary SAH tree
-  Bounds box, cbox;
-  bool leaf = false;
-};
 
 // 4-wide nodes of one subtree (the top of the tree, or one worker's job): child
 // references inside it are indices into `nodes`, relocated when the subtrees are joined
@@ -106,44 +40,6 @@ struct Job {
   int slot = 0;
   Subtree out;
   int ref = 0;  // the job's root reference within out
-};
-
-struct Bins {
-  v4f lo[3][kBins], hi[3][kBins];
-  uint32_t count[3][kBins];
-  void clear(int nbins) {
-    for (int a = 0; a < 3; ++a)
-      for (int i = 0; i < nbins; ++i) {
-        lo[a][i] = v4f{kEmptyLo, kEmptyLo, kEmptyLo, 0.0f};
-        hi[a][i] = v4f{kEmptyHi, kEmptyHi, kEmptyHi, 0.0f};
-      }
-    // Every count, four at a time: twelve vector stores (GCC turns a loop of variable
-    // length, or a memset of them all, into a `rep stos`, which takes longer to start)
-    static_assert(kBins % 4 == 0, "counts are cleared four at a time");
-    const v4i zero{};
-    for (int a = 0; a < 3; ++a)
-      for (int i = 0; i < kBins; i += 4) std::memcpy(&count[a][i], &zero, sizeof zero);
-  }
-  void merge(const Bins& o, int nbins) {
-    for (int a = 0; a < 3; ++a)
-      for (int i = 0; i < nbins; ++i) {
-        lo[a][i] = vmin(lo[a][i], o.lo[a][i]);
-        hi[a][i] = vmax(hi[a][i], o.hi[a][i]);
-        count[a][i] += o.count[a][i];
-      }
-  }
-};
-
-// The bin of each axis for a ref's doubled centroid c2 (binning and partition share it,
-// so that the bins' bounds are exactly the sides' bounds)
-struct Binner {
-  v4f lo2, scale2;
-  v4i top;
-  v4i index(v4f c2) const {
-    v4i i = __builtin_convertvector((c2 - lo2) * scale2, v4i);
-    i = i < top ? i : top;
-    return i > 0 ? i : v4i{0, 0, 0, 0};
-  }
 };
 
 class Builder {
@@ -247,16 +143,7 @@ class Builder {
   }
   template <class Fn>
   void parallel_for_indexed(size_t n, Fn fn, size_t grain = 4096) {
-    int t = int(std::min<size_t>(size_t(threads_), std::max<size_t>(1, n / grain)));
-    if (t <= 1) {
-      fn(0, 0, n);
-      return;
-    }
-    std::vector<std::thread> pool;
-    for (int i = 1; i < t; ++i)
-      pool.emplace_back([&, i] { fn(i, n * size_t(i) / size_t(t), n * size_t(i + 1) / size_t(t)); });
-    fn(0, 0, n / size_t(t));
-    for (std::thread& th : pool) th.join();
+    bvh_build::parallel_for_indexed(threads_, n, fn, grain);
   }
 
   // fn(k) for k < n on up to threads_ threads, each taking the next k when it is free
@@ -463,232 +350,9 @@ class Builder {
     }
   }
 
-  // Bins refs begin, begin + stride, ... before end
-  CD_BUILD_CLONES void bin(const Binner& b, uint32_t begin, uint32_t end, uint32_t stride, int nbins,
-                           Bins* bins) const {
-    auto add = [&](const Ref& ref, Bins* to) {
-      v4f lo = ref.box_lo(), hi = ref.hi;
-      v4i k = b.index(lo + hi);
-      for (int a = 0; a < 3; ++a) {
-        int j = k[a];
-        to->lo[a][j] = vmin(to->lo[a][j], lo);
-        to->hi[a][j] = vmax(to->hi[a][j], hi);
-        to->count[a][j]++;
-      }
-    };
-    if (end - begin < kTwoBinSets * stride) {
-      for (uint32_t i = begin; i < end; i += stride) add(refs_[i], bins);
-      return;
-    }
-    // Neighbouring refs mostly share their bins (the partitions keep them in space order):
-    // even and odd refs go to separate sets, so that one ref's update does not wait for the
-    // store of the one before. min, max and counts do not depend on the order: the same bins
-    Bins odd;
-    odd.clear(nbins);
-    uint32_t i = begin;
-    for (; i + stride < end; i += 2 * stride) {
-      add(refs_[i], bins);
-      add(refs_[i + stride], &odd);
-    }
-    if (i < end) add(refs_[i], bins);
-    bins->merge(odd, nbins);
-  }
-
-  // The bins of range r's centroid bounds; usable[a]: whether axis a can be binned
-  static Binner make_binner(const Range& r, int nbins, bool usable[3]) {
-    glm::vec3 extent = r.cbox.hi - r.cbox.lo;
-    Binner binner;
-    binner.lo2 = vec(r.cbox.lo);
-    binner.top = v4i{nbins - 1, nbins - 1, nbins - 1, 0};
-    for (int a = 0; a < 3; ++a) {
-      float scale = float(nbins) / extent[a];
-      // A flat or denormal extent cannot be binned
-      usable[a] = extent[a] > 0.0f && std::isfinite(scale);
-      binner.scale2[a] = usable[a] ? scale : 0.0f;
-    }
-    binner.scale2[3] = 0.0f;
-    return binner;
-  }
-
-  // split() of a range of two refs, without bins and the sweep (ranges of two are a third
-  // of all splits): on every usable axis where the two fall in different bins, each plane
-  // between them costs the sum of their boxes' areas, so the binned split takes the first
-  // such axis and the plane right after the lower ref. The same result as binning, bit for
-  // bit: the boxes are grown from the empty box as the bins' are.
-  bool split_pair(const Range& r, const Binner& binner, const bool usable[3], Range* left, Range* right) {
-    v4f c[2] = {refs_[r.begin].centroid2(), refs_[r.begin + 1].centroid2()};
-    v4i k0 = binner.index(c[0]), k1 = binner.index(c[1]);
-    int a = 0;
-    while (a < 3 && !(usable[a] && k0[a] != k1[a])) ++a;
-    if (a == 3) return false;
-    int low = k0[a] < k1[a] ? 0 : 1;
-    const v4f empty_lo = vec(Bounds().lo), empty_hi = vec(Bounds().hi);
-    v4f lo[2], hi[2];
-    for (int i = 0; i < 2; ++i) {
-      lo[i] = vmin(empty_lo, refs_[r.begin + uint32_t(i)].box_lo());
-      hi[i] = vmax(empty_hi, refs_[r.begin + uint32_t(i)].hi);
-    }
-    float cost = surface_area(lo[low], hi[low]) + surface_area(lo[1 - low], hi[1 - low]);
-    if (!(cost < 1e30f)) return false;
-    float split_cost = kTraversalCost + cost / std::max(surface_area(r.box), 1e-30f);
-    if (!(split_cost < 2.0f)) return false;  // the leaf's cost
-    if (low == 1) std::swap(refs_[r.begin], refs_[r.begin + 1]);
-    *left = Range();
-    *right = Range();
-    left->depth = right->depth = r.depth + 1;
-    left->begin = r.begin;
-    left->end = right->begin = r.begin + 1;
-    right->end = r.end;
-    Range* side[2] = {left, right};
-    for (int s = 0; s < 2; ++s) {
-      int i = s == 0 ? low : 1 - low;
-      side[s]->box = Bounds{glm3(lo[i]), glm3(hi[i])};
-      side[s]->cbox = Bounds{glm3(vmin(empty_lo, c[i])), glm3(vmax(empty_hi, c[i]))};
-    }
-    return true;
-  }
-
-  // The two sides of a partition: their centroid bounds (twice the centroids) and boxes
-  struct Sides {
-    v4f cmin[2], cmax[2], bmin[2], bmax[2];
-    Sides() {
-      for (int s = 0; s < 2; ++s) {
-        cmin[s] = bmin[s] = vec(Bounds().lo);
-        cmax[s] = bmax[s] = vec(Bounds().hi);
-      }
-    }
-  };
-
-  // Partitions range r in place: refs whose bin on axis a is at most `plane` first. Returns
-  // where the second side begins; the sides' centroid bounds in *sides, and with kBoxes
-  // their boxes too. Inlined into split, so that it is compiled for split's ISA.
-  template <bool kBoxes>
-  [[gnu::always_inline]] uint32_t partition(const Range& r, const Binner& binner, int a, int plane, Sides* sides) {
-    uint32_t i = r.begin, j = r.end;
-    auto grow = [&](int s, const Ref& ref, v4f c) {
-      sides->cmin[s] = vmin(sides->cmin[s], c);
-      sides->cmax[s] = vmax(sides->cmax[s], c);
-      if (kBoxes) {
-        sides->bmin[s] = vmin(sides->bmin[s], ref.box_lo());
-        sides->bmax[s] = vmax(sides->bmax[s], ref.hi);
-      }
-    };
-    while (true) {
-      for (; i < j; ++i) {
-        v4f c = refs_[i].centroid2();
-        if (binner.index(c)[a] > plane) break;
-        grow(0, refs_[i], c);
-      }
-      for (; i < j; --j) {
-        v4f c = refs_[j - 1].centroid2();
-        if (binner.index(c)[a] <= plane) break;
-        grow(1, refs_[j - 1], c);
-      }
-      if (i >= j) break;
-      std::swap(refs_[i], refs_[j - 1]);
-    }
-    return i;
-  }
-
-  // Binned SAH split of r into *left and *right (bounds included); false: r is a leaf.
-  // `parallel`: bin large ranges on every thread (the top phase, where the workers wait)
-  CD_BUILD_CLONES bool split(const Range& r, Range* left, Range* right, bool parallel) {
-    uint32_t count = r.end - r.begin;
-    if (count <= 1 || r.depth >= kMaxBvhDepth) return false;
-    // One pass bins the centroids along all three axes; small ranges get fewer bins (the
-    // sweep over the bins costs as much as binning a few dozen triangles)
-    int nbins = int(std::clamp<uint32_t>(count, 4, kBins));
-    bool usable[3];
-    Binner binner = make_binner(r, nbins, usable);
-    if (count == 2) return split_pair(r, binner, usable, left, right);
-    Bins bins;
-    bins.clear(nbins);
-    const bool sampled = count >= kSampledBinning;
-    const uint32_t stride = sampled ? kSampleStride : 1;
-    if (parallel && count >= kParallelBinning && threads_ > 1 && busy_.load() < threads_) {
-      std::vector<Bins> part(static_cast<size_t>(threads_));
-      for (Bins& p : part) p.clear(nbins);
-      parallel_for_indexed(count, [&](int t, size_t b, size_t e) {
-        size_t first = (b + stride - 1) / stride * stride;  // the chunk's first sampled ref
-        if (first < e) bin(binner, r.begin + uint32_t(first), r.begin + uint32_t(e), stride, nbins, &part[size_t(t)]);
-      });
-      for (const Bins& p : part) bins.merge(p, nbins);
-    } else {
-      bin(binner, r.begin, r.end, stride, nbins, &bins);
-    }
-    int best_axis = -1, best_plane = 0;
-    float best_cost = 1e30f;
-    for (int a = 0; a < 3; ++a) {
-      if (!usable[a]) continue;
-      // Sweep: areas and counts left of each plane, then right
-      std::array<float, kBins - 1> left_area, right_area;
-      std::array<uint32_t, kBins - 1> left_count, right_count;
-      v4f alo = bins.lo[a][0], ahi = bins.hi[a][0];
-      uint32_t c = 0;
-      for (int i = 0; i < nbins - 1; ++i) {
-        alo = vmin(alo, bins.lo[a][i]);
-        ahi = vmax(ahi, bins.hi[a][i]);
-        c += bins.count[a][i];
-        left_area[i] = surface_area(alo, ahi);
-        left_count[i] = c;
-      }
-      alo = bins.lo[a][nbins - 1];
-      ahi = bins.hi[a][nbins - 1];
-      c = 0;
-      for (int i = nbins - 1; i > 0; --i) {
-        alo = vmin(alo, bins.lo[a][i]);
-        ahi = vmax(ahi, bins.hi[a][i]);
-        c += bins.count[a][i];
-        right_area[i - 1] = surface_area(alo, ahi);
-        right_count[i - 1] = c;
-      }
-      for (int i = 0; i < nbins - 1; ++i) {
-        if (left_count[i] == 0 || right_count[i] == 0) continue;
-        float cost = left_area[i] * left_count[i] + right_area[i] * right_count[i];
-        if (cost < best_cost) {
-          best_axis = a;
-          best_plane = i;
-          best_cost = cost;
-        }
-      }
-    }
-    float leaf_cost = float(count);
-    float split_cost = kTraversalCost + best_cost / std::max(surface_area(r.box), 1e-30f);
-    *left = Range();
-    *right = Range();
-    left->depth = right->depth = r.depth + 1;
-    left->begin = r.begin;
-    right->end = r.end;
-    if (best_axis >= 0 && (split_cost < leaf_cost || count > kMaxLeafSize)) {
-      // Partition by the same bin index as above, so that the bins' bounds are exact; the
-      // sides' centroid bounds (and, for sampled bins, boxes) on the way
-      int a = best_axis;
-      Sides sides;
-      uint32_t mid = sampled ? partition<true>(r, binner, a, best_plane, &sides)
-                             : partition<false>(r, binner, a, best_plane, &sides);
-      left->end = right->begin = mid;
-      left->cbox = Bounds{glm3(sides.cmin[0]), glm3(sides.cmax[0])};
-      right->cbox = Bounds{glm3(sides.cmin[1]), glm3(sides.cmax[1])};
-      if (!sampled) {
-        for (int k = 0; k < nbins; ++k) {
-          int s = k <= best_plane ? 0 : 1;
-          sides.bmin[s] = vmin(sides.bmin[s], bins.lo[a][k]);
-          sides.bmax[s] = vmax(sides.bmax[s], bins.hi[a][k]);
-        }
-      }
-      left->box = Bounds{glm3(sides.bmin[0]), glm3(sides.bmax[0])};
-      right->box = Bounds{glm3(sides.bmin[1]), glm3(sides.bmax[1])};
-      return true;
-    }
-    if (count <= kMaxLeafSize) return false;
-    // All centroids coincide (or no useful plane): split the range in half
-    left->end = right->begin = r.begin + count / 2;
-    for (Range* side : {left, right})
-      for (uint32_t i = side->begin; i < side->end; ++i) {
-        side->box.grow(Bounds{glm3(refs_[i].box_lo()), glm3(refs_[i].hi)});
-        side->cbox.grow(glm3(refs_[i].centroid2()));
-      }
-    return true;
+  // Binned SAH split of r into *left and *right (bvh_sah.cpp); false: r is a leaf
+  bool split(const Range& r, Range* left, Range* right, bool parallel) {
+    return sah_split(refs_, threads_, busy_, r, left, right, parallel);
   }
 
   const std::vector<float>& positions_;

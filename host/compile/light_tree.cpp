@@ -7,22 +7,12 @@
 #include <numeric>
 
 #include "base/error.hpp"
+#include "compile/light_types.hpp"
 
 namespace candela {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Where a set of lights lies and which way it emits: positions in [lo, hi], emission axes
-// within theta_o of `axis`, each light emitting within theta_e beyond its own axis
-struct LightBounds {
-  glm::vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
-  double intensity = 0.0;
-  glm::dvec3 axis{0.0, 0.0, 1.0};
-  double theta_o = 0.0, theta_e = 0.0;
-  bool empty() const { return !(intensity > 0.0) && lo.x > hi.x; }
-  glm::vec3 centroid() const { return 0.5f * (lo + hi); }
-};
 
 double angle_between(const glm::dvec3& a, const glm::dvec3& b) {
   return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
@@ -80,46 +70,6 @@ double surface_area(const LightBounds& b) {
 
 float cos_down(double theta) {  // float cosine no larger than the exact one: a cone never shrinks
   return std::nextafter(float(std::cos(theta)), -2.0f);
-}
-
-// One light's bounds (triangles: radiance L times area A per emitting side, about the front
-// normal, or both ways when double-sided; points: intensity I in all directions; spots: I
-// about the axis out to the outer cone angle)
-LightBounds light_bounds(const dev::Light& l, const dev::SceneBuffers& b, double power) {
-  LightBounds lb;
-  if (l.type == LIGHT_TRIANGLE) {
-    const dev::Prim& p = b.prims[l.index];
-    glm::dvec3 v[3];
-    for (int k = 0; k < 3; ++k) {
-      glm::vec3 f(b.positions[3 * size_t(p.v[k])], b.positions[3 * size_t(p.v[k]) + 1],
-                  b.positions[3 * size_t(p.v[k]) + 2]);
-      lb.lo = glm::min(lb.lo, f);
-      lb.hi = glm::max(lb.hi, f);
-      v[k] = glm::dvec3(f);
-    }
-    glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-    double nl = glm::length(n);
-    lb.axis = nl > 0.0 ? n / nl : glm::dvec3(0, 0, 1);
-    bool two_sided = (b.materials[p.material].flags & MATERIAL_DOUBLE_SIDED) != 0u;
-    lb.theta_o = two_sided || !(nl > 0.0) ? kPi : 0.0;
-    lb.theta_e = 0.5 * kPi;
-    lb.intensity = power / (kPi * (two_sided ? 2.0 : 1.0));
-  } else {
-    glm::vec3 pos(l.params[0], l.params[1], l.params[2]);
-    lb.lo = lb.hi = pos;
-    lb.intensity = dev::luminance_rgb(l.radiance[0], l.radiance[1], l.radiance[2]);
-    if (l.type == LIGHT_SPOT) {
-      lb.axis = glm::normalize(glm::dvec3(l.params[3], l.params[4], l.params[5]));
-      lb.theta_o = 0.0;
-      lb.theta_e = std::acos(std::clamp(-double(l.params[7]) / double(l.params[6]), -1.0, 1.0));
-    } else {
-      lb.theta_o = kPi;
-      lb.theta_e = 0.5 * kPi;
-    }
-  }
-  // Every light keeps an intensity > 0: a light the alias table can pick, the tree can too
-  lb.intensity = std::max(lb.intensity, 1e-30);
-  return lb;
 }
 
 glm::dvec3 triangle_vertex(const dev::SceneBuffers& b, const dev::Light& l, int k) {
@@ -270,7 +220,7 @@ struct Builder {
         if (std::abs(glm::dot(d, n)) > tolerance) return false;
         points.emplace_back(glm::dot(d, t), glm::dot(d, s));
       }
-      area += 2.0 * double(l.params[0]);
+      area += 2.0 * double(l.params.triangle.area);
     }
     return area >= kClusterCover * hull_area(std::move(points));
   }
@@ -371,9 +321,7 @@ LightTree build_light_tree(const dev::SceneBuffers& buffers, const std::vector<d
   std::vector<uint32_t> order;
   double share = 0.0;
   for (size_t i = 0; i < buffers.lights.size(); ++i) {
-    const dev::Light& l = buffers.lights[i];
-    if (l.type != LIGHT_TRIANGLE && l.type != LIGHT_POINT && l.type != LIGHT_SPOT) continue;
-    bounds[i] = light_bounds(l, buffers, power[i]);
+    if (!light_bounds(buffers.lights[i], buffers, power[i], &bounds[i])) continue;  // a light at infinity
     order.push_back(uint32_t(i));
     share += pmf[i];
   }

@@ -1,7 +1,7 @@
 // The light tree (Conty Estevez & Kulla 2018, Importance Sampling of Many Lights with
 // Adaptive Tree Splitting) over a scene's finite lights: the LightTreeNode records the
 // kernel descends to pick a light by its estimated contribution at the shading point, and
-// each light's trail to its leaf (cl/shared/device_types.h, cl/lights/lights.cl).
+// each light's trail to its leaf (cl/shared/device_types.h, cl/lights/light_tree.cl).
 #pragma once
 
 #include <vector>
@@ -16,7 +16,8 @@ struct LightTree {
   int depth = 0;                            // of the deepest leaf
 };
 
-// The tree over the triangle, point and spot lights of `buffers.lights`; `power` is each
+// The tree over the lights of `buffers.lights` that have bounds (light_bounds,
+// light_types.hpp: the finite ones, triangles, points and spots); `power` is each
 // light's light_power, `pmf` the probability the alias table picks it (the root's share is
 // the sum over the tree's lights, exactly 1 when the tree holds every light: holds_all). Nodes are split where Conty &
 // Kulla's surface area orientation heuristic is lowest over 12 buckets of the centroids on each axis. No tree (empty

@@ -336,35 +336,6 @@ glm::vec3 vertex(const dev::SceneBuffers& b, uint32_t v) {
   return glm::vec3(b.positions[3 * size_t(v)], b.positions[3 * size_t(v) + 1], b.positions[3 * size_t(v) + 2]);
 }
 
-// The device record of a punctual light (the parameter table in cl/shared/device_types.h)
-dev::Light punctual_light(const PunctualLightDesc& p) {
-  dev::Light l{};
-  l.type = p.type == PunctualType::Point ? LIGHT_POINT : p.type == PunctualType::Spot ? LIGHT_SPOT : LIGHT_DIRECTIONAL;
-  for (int c = 0; c < 3; ++c) {
-    l.radiance[c] = p.color[c] * p.intensity;
-    l.params[c] = p.position[c];
-    l.params[3 + c] = p.direction[c];
-  }
-  l.radiance[3] = p.type == PunctualType::Directional ? 0.0f : p.range;
-  if (p.type == PunctualType::Spot) {
-    // KHR_lights_punctual's reference form: t = cos * scale + offset
-    double cos_outer = std::cos(double(p.outer_cone));
-    double scale = 1.0 / std::max(0.001, std::cos(double(p.inner_cone)) - cos_outer);
-    l.params[6] = float(scale);
-    l.params[7] = float(-cos_outer * scale);
-  }
-  return l;
-}
-
-// Solid-angle integral of the spot profile clamp(c * scale + offset, 0, 1)^2 over the
-// sphere, c = cos(angle to the axis): with s = 1 / scale and c0 = -offset / scale (the
-// outer cosine), t = (c - c0) / s rises from 0 at c0 to 1 at c0 + s and stays 1 up to c = 1
-double spot_solid_angle(double scale, double offset) {
-  double s = 1.0 / scale, c0 = -offset / scale;
-  double t_max = std::min(1.0, (1.0 - c0) / s);
-  return 2.0 * kPi * (s * t_max * t_max * t_max / 3.0 + std::max(0.0, 1.0 - c0 - s));
-}
-
 // An environment map as a LIGHT_ENVIRONMENT: its texels appended to the float texel
 // array as one more texture, its sampling CDFs as env_distribution (cl/lights/environment.cl).
 // *power_scale gets its mean radiance luminance, strength included.
@@ -383,29 +354,30 @@ dev::Light compile_environment_map(const EnvironmentDesc& env, dev::SceneBuffers
     b->texelsf.push_back({{t.rgbaf[4 * i], t.rgbaf[4 * i + 1], t.rgbaf[4 * i + 2], 1.0f}});
   dev::Light l{};
   l.type = LIGHT_ENVIRONMENT;
-  l.params[0] = float(b->textures.size());  // exact: fewer than 2^24 textures
-  l.params[1] = env.strength;
-  l.params[2] = float(double(env.rotation) * kPi / 180.0);
-  EnvironmentExtent extent = environment_extent(t, double(l.params[2]));
-  l.params[3] = float(extent.solid_angle);
-  for (int k = 0; k < 3; ++k) l.params[4 + k] = float(extent.direction[k]);
-  l.params[7] = float(extent.integral);
+  dev::EnvironmentLight& e = l.params.environment;
+  e.map = float(b->textures.size());  // exact: fewer than 2^24 textures
+  e.strength = env.strength;
+  e.rotation = float(double(env.rotation) * kPi / 180.0);
+  EnvironmentExtent extent = environment_extent(t, double(e.rotation));
+  e.solid_angle = float(extent.solid_angle);
+  for (int k = 0; k < 3; ++k) e.direction[k] = float(extent.direction[k]);
+  e.integral = float(extent.integral);
   b->textures.push_back(info);
   b->env_distribution = environment_distribution(t);
   *power_scale = environment_mean_luminance(t) * env.strength;
   return l;
 }
 
-// A triangle light's bounding sphere for lights_triangle_omega_bound: params[1..3] = its
-// centroid in float, params[4] = the largest distance from that point to a corner, rounded
+// A triangle light's bounding sphere for lights_triangle_omega_bound: TriangleLight.centre =
+// its centroid in float, radius = the largest distance from that point to a corner, rounded
 // up, so that the sphere holds the float corners the kernel sees
 void set_triangle_bounding_sphere(const dev::SceneBuffers& b, const dev::Prim& p, dev::Light* l) {
   glm::dvec3 v[3] = {vertex(b, p.v[0]), vertex(b, p.v[1]), vertex(b, p.v[2])};
   glm::vec3 c = glm::vec3((v[0] + v[1] + v[2]) / 3.0);
   double r = 0.0;
   for (const glm::dvec3& x : v) r = std::max(r, glm::length(x - glm::dvec3(c)));
-  for (int a = 0; a < 3; ++a) l->params[1 + a] = c[a];
-  l->params[4] = std::nextafter(float(r * (1.0 + 1e-6)), INFINITY);
+  for (int a = 0; a < 3; ++a) l->params.triangle.centre[a] = c[a];
+  l->params.triangle.radius = std::nextafter(float(r * (1.0 + 1e-6)), INFINITY);
 }
 
 // Every emissive triangle, punctual light and the environment, with the selection table
@@ -430,7 +402,7 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
     dev::Light l{};
     l.type = LIGHT_TRIANGLE;
     l.index = uint32_t(i);
-    l.params[0] = float(area);
+    l.params.triangle.area = float(area);
     set_triangle_bounding_sphere(*b, p, &l);
     double w = light_power(l, *b, scale, radius);
     if (!(w > 0.0)) continue;  // includes emissive textures that are black throughout
@@ -458,9 +430,9 @@ int compile_lights(const Scene& scene, dev::SceneBuffers* b) {
   } else if (dev::luminance_rgb(scene.background.x, scene.background.y, scene.background.z) > 0.0f) {
     dev::Light l{};
     l.type = LIGHT_ENVIRONMENT;
-    l.params[0] = float(NO_TEXTURE);  // constant radiance
-    l.params[3] = float(4.0 * kPi);   // its solid angle: the sphere, no direction
-    l.params[7] = float(4.0 * kPi);   // integral of a unit radiance over it
+    l.params.environment.map = float(NO_TEXTURE);         // constant radiance
+    l.params.environment.solid_angle = float(4.0 * kPi);  // the sphere, no direction
+    l.params.environment.integral = float(4.0 * kPi);     // of a unit radiance over it
     for (int c = 0; c < 3; ++c) l.radiance[c] = scene.background[c];
     environment = int(b->lights.size());
     b->lights.push_back(l);
@@ -494,50 +466,27 @@ void check_extent(const Scene& scene, const CameraDesc& camera) {
     throw Error("the camera has no viewing direction (its node transform is degenerate or not finite)");
 }
 
-// Emitted power of each light type (CD_LIGHTS), as light_power documents
-double light_power_triangle(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale, double) {
-  // Diffuse emitter: power = pi * L * A per emitting side
-  const dev::Material& m = buffers.materials[buffers.prims[light.index].material];
-  double lum = dev::luminance_rgb(m.emission[0], m.emission[1], m.emission[2]) * emission_scale;
-  return kPi * lum * light.params[0] * ((m.flags & MATERIAL_DOUBLE_SIDED) ? 2.0 : 1.0);
-}
-
-// A constant environment's power through the scene's bounding sphere; a map's (params[0] a
-// texture) with its mean radiance luminance, passed as emission_scale
-double light_power_environment(const dev::Light& light, const dev::SceneBuffers&, double emission_scale,
-                               double scene_radius) {
-  bool map = int(light.params[0]) != NO_TEXTURE;
-  double lum = map ? emission_scale : dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-  return 4.0 * kPi * kPi * scene_radius * scene_radius * lum;
-}
-
-// Radiant intensity I over the sphere, or over the spot's profile. A finite range is left
-// out: the power is then an upper bound, which only costs variance.
-double light_power_point(const dev::Light& light, const dev::SceneBuffers&, double, double) {
-  double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-  return lum * (4.0 * kPi);
-}
-
-double light_power_spot(const dev::Light& light, const dev::SceneBuffers&, double, double) {
-  double lum = dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-  return lum * spot_solid_angle(light.params[6], light.params[7]);
-}
-
-// Irradiance E through the disc the scene's bounding sphere shows the light
-double light_power_directional(const dev::Light& light, const dev::SceneBuffers&, double, double scene_radius) {
-  return kPi * scene_radius * scene_radius *
-         dev::luminance_rgb(light.radiance[0], light.radiance[1], light.radiance[2]);
-}
-
 }  // namespace
 
-double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
-                   double scene_radius) {
-#define CD_LIGHT_POWER(id, name, feature) \
-  if (light.type == id) return light_power_##name(light, buffers, emission_scale, scene_radius);
-  CD_LIGHTS(CD_LIGHT_POWER)
-#undef CD_LIGHT_POWER
-  throw Error("light_power: unknown light type " + std::to_string(light.type));
+dev::Light punctual_light(const PunctualLightDesc& p) {
+  dev::Light l{};
+  l.type = p.type == PunctualType::Point ? LIGHT_POINT : p.type == PunctualType::Spot ? LIGHT_SPOT : LIGHT_DIRECTIONAL;
+  for (int c = 0; c < 3; ++c) l.radiance[c] = p.color[c] * p.intensity;
+  l.radiance[3] = p.type == PunctualType::Directional ? 0.0f : p.range;
+  if (p.type == PunctualType::Point) {
+    for (int c = 0; c < 3; ++c) l.params.point.position[c] = p.position[c];
+  } else if (p.type == PunctualType::Spot) {
+    for (int c = 0; c < 3; ++c) {
+      l.params.spot.position[c] = p.position[c];
+      l.params.spot.axis[c] = p.direction[c];
+    }
+    dev::SpotCone cone = dev::spot_cone(double(p.inner_cone), double(p.outer_cone));
+    l.params.spot.cone_scale = cone.scale;
+    l.params.spot.cone_offset = cone.offset;
+  } else {
+    for (int c = 0; c < 3; ++c) l.params.directional.direction[c] = p.direction[c];
+  }
+  return l;
 }
 
 std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf) {

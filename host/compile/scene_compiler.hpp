@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "compile/compiled_scene.hpp"
+#include "compile/light_types.hpp"  // light_power
 #include "scene/scene.hpp"
 
 namespace candela {
@@ -23,16 +24,13 @@ CompiledScene compile_scene(const Scene& scene, const FeaturesKnown& features_kn
 CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features,
                             const FeaturesKnown& features_known = {});
 
+// The device record of a punctual light: its type (LIGHT_POINT, LIGHT_SPOT or
+// LIGHT_DIRECTIONAL) and parameters (PointLight, SpotLight, DirectionalLight)
+dev::Light punctual_light(const PunctualLightDesc& p);
+
 // Alias table (Walker 1977, Vose 1991) for selecting index i with probability ~ weights[i]
 // (all > 0) from a uniform 32-bit integer (sample_discrete_alias in sampling.cl); the exact
 // probabilities it realizes go to *pmf. Each index gets at least one of the 2^32 integers.
 std::vector<dev::AliasBin> alias_table(const std::vector<double>& weights, std::vector<double>* pmf);
-
-// Emitted power of a light (luminance-weighted, for light selection). `emission_scale`
-// is the mean luminance of a triangle light's emissive texture (1 without one), or an
-// environment map's mean radiance luminance (strength included);
-// `scene_radius` bounds the scene for environment lights.
-double light_power(const dev::Light& light, const dev::SceneBuffers& buffers, double emission_scale,
-                   double scene_radius);
 
 }  // namespace candela

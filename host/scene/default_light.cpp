@@ -130,11 +130,9 @@ double irradiance(const Point& q, const std::vector<Emitter>& emitters, const Sc
     glm::dvec3 w = d / std::sqrt(r2);
     double scale = 1.0;
     if (l.range > 0.0f) scale = std::clamp(1.0 - std::pow(std::sqrt(r2) / l.range, 4.0), 0.0, 1.0);
-    if (l.type == PunctualType::Spot) {
-      double c = -glm::dot(w, glm::dvec3(l.direction));
-      double lo = std::cos(double(l.outer_cone)), hi = std::cos(double(l.inner_cone));
-      double t = std::clamp((c - lo) / std::max(hi - lo, 1e-3), 0.0, 1.0);
-      scale *= t * t;
+    if (l.type == PunctualType::Spot) {  // the kernel's cone profile, with its parameters
+      dev::SpotCone cone = dev::spot_cone(double(l.inner_cone), double(l.outer_cone));
+      scale *= dev::spot_profile(float(-glm::dot(w, glm::dvec3(l.direction))), cone.scale, cone.offset);
     }
     add(power * scale / r2, glm::dot(w, q.n));
   }

@@ -135,7 +135,7 @@ TEST(Lists, LightPowerHasEveryType) {
     dev::Light l = c.buffers.lights[0];
     l.type = e.id;
     for (float& r : l.radiance) r = 1.0f;
-    l.params[6] = 1.0f;  // a spot's cone
+    l.params.spot.cone_scale = 1.0f;  // a spot's cone
     EXPECT_GT(light_power(l, c.buffers, 1.0, 1.0), 0.0) << e.name;
   }
   dev::Light unknown = c.buffers.lights[0];

@@ -396,9 +396,9 @@ TEST(EnvironmentLoader, SceneExtras) {
   ASSERT_NE(c.environment_light, NO_LIGHT);
   const dev::Light& l = c.buffers.lights[size_t(c.environment_light)];
   EXPECT_EQ(l.type, LIGHT_ENVIRONMENT);
-  EXPECT_EQ(int(l.params[0]), int(c.buffers.textures.size()) - 1);
-  EXPECT_FLOAT_EQ(l.params[1], 2.5f);
-  EXPECT_NEAR(l.params[2], 30.0 * kPi / 180.0, 1e-6);
+  EXPECT_EQ(int(l.params.environment.map), int(c.buffers.textures.size()) - 1);
+  EXPECT_FLOAT_EQ(l.params.environment.strength, 2.5f);
+  EXPECT_NEAR(l.params.environment.rotation, 30.0 * kPi / 180.0, 1e-6);
 
   g.doc["scenes"][0]["extras"]["candela"]["environment"]["file"] = "no-such-map.hdr";
   EXPECT_THROW(load_gltf_from_memory(g.document().dump(), scene_path("lights")), Error);

@@ -1,4 +1,4 @@
-// The light tree (host/compile/light_tree.cpp, cl/lights/lights.cl) on the real kernel code:
+// The light tree (host/compile/light_tree.cpp, cl/lights/light_tree.cl) on the real kernel code:
 //  - its structure: every tree light's trail leads to its leaf, every slot of a node bounds
 //    its child's positions and emission cones;
 //  - lights_select_pmf sums to 1 over the lights at random shading points (inside the
@@ -63,7 +63,8 @@ std::vector<glm::dvec3> light_points(const CompiledScene& c, const dev::Light& l
       points.emplace_back(c.buffers.positions[v], c.buffers.positions[v + 1], c.buffers.positions[v + 2]);
     }
   } else {
-    points.emplace_back(light.params[0], light.params[1], light.params[2]);
+    const float* pos = light.type == LIGHT_SPOT ? light.params.spot.position : light.params.point.position;
+    points.emplace_back(pos[0], pos[1], pos[2]);
   }
   return points;
 }
@@ -207,7 +208,7 @@ CompiledScene deep_tree_scene(int* depth) {
     dev::Light light{};
     light.type = LIGHT_TRIANGLE;
     light.index = uint32_t(i);
-    light.params[0] = 0.5f * x * x;  // area
+    light.params.triangle.area = 0.5f * x * x;
     light.pmf = float(pmf[size_t(i)]);
     c.buffers.lights.push_back(light);
   }
@@ -247,9 +248,10 @@ bool can_light(const CompiledScene& c, size_t l, const glm::dvec3& p) {
   const dev::Light& light = c.buffers.lights[l];
   if (light.type == LIGHT_POINT) return true;
   if (light.type == LIGHT_SPOT) {
-    glm::dvec3 d = glm::normalize(p - glm::dvec3(light.params[0], light.params[1], light.params[2]));
-    double cos_outer = -double(light.params[7]) / double(light.params[6]);
-    return glm::dot(d, glm::dvec3(light.params[3], light.params[4], light.params[5])) > cos_outer + 1e-3;
+    const dev::SpotLight& s = light.params.spot;
+    glm::dvec3 d = glm::normalize(p - glm::dvec3(s.position[0], s.position[1], s.position[2]));
+    double cos_outer = -double(s.cone_offset) / double(s.cone_scale);
+    return glm::dot(d, glm::dvec3(s.axis[0], s.axis[1], s.axis[2])) > cos_outer + 1e-3;
   }
   if (light.type != LIGHT_TRIANGLE) return true;
   const dev::Prim& pr = c.buffers.prims[light.index];
