@@ -113,8 +113,8 @@ void check_same_render(const Input& first, const Input& x) {
     std::string va = a == first.img.metadata.end() ? "(none)" : a->second;
     std::string vb = b == x.img.metadata.end() ? "(none)" : b->second;
     if (va != vb)
-      throw Error("cannot merge: different " + key + ": " + first.path + " has '" + va + "', " + x.path +
-                  " has '" + vb + "'");
+      throw Error("cannot merge: different " + key + ": " + first.path + " has '" + va + "', " + x.path + " has '" +
+                  vb + "'");
   }
 }
 

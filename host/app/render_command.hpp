@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,8 +36,6 @@ struct RenderArgs {
   std::string look_from, look_at, up;
   std::optional<float> fov;  // degrees
   std::optional<float> aperture, focus_distance;
-  std::string filter = "box";
-  std::string sampler = "sobol";
   bool quiet = false;
   std::string variance;              // --variance: variance-of-the-mean image (render/image_stats.hpp)
   bool generic = false;              // --generic: the kernel with every scene feature compiled in
@@ -44,8 +43,11 @@ struct RenderArgs {
   bool mpi = false;                  // --mpi: spread the samples over the ranks of an MPI job
   bool allow_outside_paths = false;  // --allow-outside-paths: scene files outside its folder
   // The renderer's settings that options give as they are (--seed, --max-depth); the
-  // others follow from the options above (check_render_args, complete_settings)
+  // others follow from the options above and `names` (check_render_args, complete_settings)
   RenderSettings settings;
+  // The names given to the options of enum settings, by flag ("--filter": "box"); each
+  // option's apply sets its setting from its name (settings.cpp: enum_setting)
+  std::map<std::string, std::string> names;
 };
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args);

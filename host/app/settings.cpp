@@ -52,11 +52,33 @@ std::string choices(const EnumName<E> (&table)[N]) {
   return s;
 }
 
-// The row's entries that only the record of a render needs
-template <typename F>
-RenderSetting recorded(RenderSetting s, F record, const char* metadata, const char* stats, bool must_match,
-                       const char* kernel = "") {
-  s.record = record;
+// An option naming a value of an enum setting, `member` of RenderSettings: the name is
+// kept in args.names[flag] (the default until given), checked and turned into the setting
+// by apply, and recorded as the setting's name
+template <typename E, size_t N>
+RenderSetting enum_setting(const std::string& flag, const EnumName<E> (&table)[N], E RenderSettings::*member,
+                           std::string help, std::string doc, std::string default_value) {
+  RenderSetting s(
+      flag, choices(table), std::move(help), std::move(doc), std::move(default_value),
+      [](CLI::App* render, RenderArgs& a, const RenderSetting& self) {
+        std::string& name = a.names[self.flags];
+        name = self.default_value;
+        return render->add_option(self.flags, name, self.help);
+      },
+      [&table, member, flag](const RenderArgs& a, RenderSettings* settings) {
+        settings->*member = parse_enum(table, flag, a.names.at(flag));
+      });
+  s.record = [&table, member](const RenderArgs&, const RenderSettings& settings) -> SettingValue {
+    return std::string(enum_name(table, settings.*member));
+  };
+  return s;
+}
+
+// The row's entries that only the record of a render needs: the value, unless the row has
+// it (enum_setting), and where it goes
+RenderSetting recorded(RenderSetting s, std::function<SettingValue(const RenderArgs&, const RenderSettings&)> record,
+                       const char* metadata, const char* stats, bool must_match, const char* kernel = "") {
+  if (record) s.record = record;
   s.metadata = metadata;
   s.stats = stats;
   s.must_match = must_match;
@@ -73,10 +95,11 @@ std::vector<RenderSetting> make_render_settings() {
   using S = RenderSettings;
   const uint64_t kMaxIndex = 4294967295LL;
   return {
-      recorded({"scene", "SCENE", "Scene file (.gltf or .glb)",
-                "The scene, `.gltf` or `.glb` ([scene-format.md](scene-format.md)).", "",
-                option(&A::scene, [](CLI::Option* o) { o->required(); })},
-               [](const A& a, const S&) -> SettingValue { return a.scene; }, "scene", nullptr, kMustMatch),
+      recorded(
+          {"scene", "SCENE", "Scene file (.gltf or .glb)",
+           "The scene, `.gltf` or `.glb` ([scene-format.md](scene-format.md)).", "",
+           option(&A::scene, [](CLI::Option* o) { o->required(); })},
+          [](const A& a, const S&) -> SettingValue { return a.scene; }, "scene", nullptr, kMustMatch),
       {"-o,--output", "FILE", "Output image: .exr (linear), .png or .jpg (tone-mapped sRGB, --tonemap); repeatable",
        "Required, repeatable. `.exr`: linear float RGB with the metadata below. `.png`, `.jpg` (or `.jpeg`): 8-bit "
        "sRGB after `--exposure` and the `--tonemap` display transform.",
@@ -88,17 +111,19 @@ std::vector<RenderSetting> make_render_settings() {
        "Render for this long instead of a fixed sample count (no launch starts after the time is up; the first "
        "always runs). Excludes `--spp`.",
        "", option(&A::time, [](CLI::Option* o) { o->check(positive_number())->excludes("--spp"); })},
-      recorded({"--width", "W", "Image width (default 512, or from --height and the camera aspect)", "", "512",
-                option(&A::width, check(integer_in(1, 65536)))},
-               [](const A&, const S& s) -> SettingValue { return count(s.width); }, nullptr, "width", false,
-               "RenderParams.width"),
-      recorded({"--height", "H", "Image height (default from the camera aspect ratio, else the width)",
-                "Image size, 1 to 65536. The default is 512 wide, with the height from the camera's aspect ratio: "
-                "`aspectRatio` for a perspective camera, `xmag / ymag` for an orthographic one, square without either. "
-                "Given one of them, the other follows from the same ratio.",
-                "", option(&A::height, check(integer_in(1, 65536)))},
-               [](const A&, const S& s) -> SettingValue { return count(s.height); }, nullptr, "height", false,
-               "RenderParams.height"),
+      recorded(
+          {"--width", "W", "Image width (default 512, or from --height and the camera aspect)", "", "512",
+           option(&A::width, check(integer_in(1, 65536)))},
+          [](const A&, const S& s) -> SettingValue { return count(s.width); }, nullptr, "width", false,
+          "RenderParams.width"),
+      recorded(
+          {"--height", "H", "Image height (default from the camera aspect ratio, else the width)",
+           "Image size, 1 to 65536. The default is 512 wide, with the height from the camera's aspect ratio: "
+           "`aspectRatio` for a perspective camera, `xmag / ymag` for an orthographic one, square without either. "
+           "Given one of them, the other follows from the same ratio.",
+           "", option(&A::height, check(integer_in(1, 65536)))},
+          [](const A&, const S& s) -> SettingValue { return count(s.height); }, nullptr, "height", false,
+          "RenderParams.height"),
       {"--device", "SEL",
        "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else "
        "first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once",
@@ -107,18 +132,20 @@ std::vector<RenderSetting> make_render_settings() {
        "`nvidia`). The default is the first GPU, else the first CPU. A comma-separated list (`pocl,rusticl`) or "
        "`all` (every listed device, once each) renders on several devices at once ([devices.md](devices.md)).",
        "", option(&A::device)},
-      recorded({"--seed", "S", "Random seed (default 0)",
-                "Random seed (default 0). The image depends only on the seed, the spp and `--sample-offset`, never on "
-                "how the samples are split into launches or devices.",
-                "0", in_settings(&S::seed, check(integer_in(0, kMaxIndex)))},
-               [](const A&, const S& s) -> SettingValue { return count(s.seed); }, "seed", "seed", kMustMatch,
-               "RenderParams.seed"),
-      recorded({"--max-depth", "D", "Maximum number of bounces (default 16)",
-                "Maximum number of bounces, 0 to 100000 (default 16). 0 shows only emitters seen directly; 1 adds "
-                "direct lighting.",
-                "16", in_settings(&S::max_depth, check(integer_in(0, 100000)))},
-               [](const A&, const S& s) -> SettingValue { return count(s.max_depth); }, "max_depth", "max_depth",
-               kMustMatch, "RenderParams.max_depth"),
+      recorded(
+          {"--seed", "S", "Random seed (default 0)",
+           "Random seed (default 0). The image depends only on the seed, the spp and `--sample-offset`, never on "
+           "how the samples are split into launches or devices.",
+           "0", in_settings(&S::seed, check(integer_in(0, kMaxIndex)))},
+          [](const A&, const S& s) -> SettingValue { return count(s.seed); }, "seed", "seed", kMustMatch,
+          "RenderParams.seed"),
+      recorded(
+          {"--max-depth", "D", "Maximum number of bounces (default 16)",
+           "Maximum number of bounces, 0 to 100000 (default 16). 0 shows only emitters seen directly; 1 adds "
+           "direct lighting.",
+           "16", in_settings(&S::max_depth, check(integer_in(0, 100000)))},
+          [](const A&, const S& s) -> SettingValue { return count(s.max_depth); }, "max_depth", "max_depth", kMustMatch,
+          "RenderParams.max_depth"),
       recorded(
           {"--strategy", choices(kStrategyNames),
            enum_names(kStrategyNames, true) + "; default: the scene's extras candela.strategy, else auto",
@@ -132,25 +159,27 @@ std::vector<RenderSetting> make_render_settings() {
            }},
           [](const A& a, const S&) -> SettingValue { return a.strategy; }, "strategy", "strategy", kMustMatch,
           "RenderParams.strategy"),
-      recorded({"--light-selection", "tree|power",
-                "tree|power: light selection by the light tree (estimated contribution at the shading point; "
-                "default) or by power alone",
-                "How a shadow ray picks its light (default `tree`): `tree` descends the light tree, weighing the "
-                "emissive triangles, point and spot lights by what each can send to the shading point (directional "
-                "lights and the environment keep their share by power); `power` picks every light in proportion to "
-                "its power alone ([lights.md](lights.md#light-selection)).",
-                "tree", option(&A::light_selection, check(CLI::IsMember({"tree", "power"})))},
-               [](const A& a, const S&) -> SettingValue { return a.light_selection; }, "light_selection",
-               "light_selection", kMustMatch, "CD_FEATURE_LIGHT_TREE"),
-      recorded({"--no-energy-compensation", "",
-                "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
-                "default: rough metal and glass keep their albedo)",
-                "Leave out the multiple-scattering compensation of rough GGX lobes, rough glass and the clear coat "
-                "([materials.md](materials.md#energy-compensation)), which is on by default.",
-                "", flag(&A::no_energy_compensation),
-                [](const A& a, S* s) { s->energy_compensation = !a.no_energy_compensation; }},
-               [](const A&, const S& s) -> SettingValue { return s.energy_compensation; }, "energy_compensation",
-               "energy_compensation", kMustMatch, "RenderParams.energy_compensation"),
+      recorded(
+          {"--light-selection", "tree|power",
+           "tree|power: light selection by the light tree (estimated contribution at the shading point; "
+           "default) or by power alone",
+           "How a shadow ray picks its light (default `tree`): `tree` descends the light tree, weighing the "
+           "emissive triangles, point and spot lights by what each can send to the shading point (directional "
+           "lights and the environment keep their share by power); `power` picks every light in proportion to "
+           "its power alone ([lights.md](lights.md#light-selection)).",
+           "tree", option(&A::light_selection, check(CLI::IsMember({"tree", "power"})))},
+          [](const A& a, const S&) -> SettingValue { return a.light_selection; }, "light_selection", "light_selection",
+          kMustMatch, "CD_FEATURE_LIGHT_TREE"),
+      recorded(
+          {"--no-energy-compensation", "",
+           "Leave out the multiple scattering of rough GGX lobes, rough glass and the clear coat (on by "
+           "default: rough metal and glass keep their albedo)",
+           "Leave out the multiple-scattering compensation of rough GGX lobes, rough glass and the clear coat "
+           "([materials.md](materials.md#energy-compensation)), which is on by default.",
+           "", flag(&A::no_energy_compensation),
+           [](const A& a, S* s) { s->energy_compensation = !a.no_energy_compensation; }},
+          [](const A&, const S& s) -> SettingValue { return s.energy_compensation; }, "energy_compensation",
+          "energy_compensation", kMustMatch, "RenderParams.energy_compensation"),
       // The scene's lighting: background, environment map, default light
       {"--background", "R,G,B",
        "Constant background radiance R,G,B (replaces the scene's background and environment map)",
@@ -181,7 +210,8 @@ std::vector<RenderSetting> make_render_settings() {
       {"--no-default-light", "", "Same as --default-light off",
        "The same as `--default-light off` (the option of earlier versions, kept).", "",
        [](CLI::App* render, A& a, const RenderSetting& s) {
-         return render->add_flag_callback(s.flags, [&a] { a.default_light = "off"; }, s.help);
+         return render->add_flag_callback(
+             s.flags, [&a] { a.default_light = "off"; }, s.help);
        }},
       {"--light-units", choices(kLightUnitNames),
        "KHR_lights_punctual intensities: " + enum_names(kLightUnitNames, true) +
@@ -212,10 +242,9 @@ std::vector<RenderSetting> make_render_settings() {
        [](const A& a, S*) {
          if (a.exposure && !std::isfinite(*a.exposure)) throw Error("--exposure must be a finite number of stops");
        }},
-      {"--tonemap", choices(kTonemapNames),
-       "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true),
-       "Display transform of PNG/JPEG outputs ([below](#outputs)); default `neutral`.", "neutral",
-       option(&A::tonemap), [](const A& a, S*) { parse_tonemap(a.tonemap); }},
+      {"--tonemap", choices(kTonemapNames), "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true),
+       "Display transform of PNG/JPEG outputs ([below](#outputs)); default `neutral`.", "neutral", option(&A::tonemap),
+       [](const A& a, S*) { parse_tonemap(a.tonemap); }},
       // The camera, replacing or changing the scene's (checked together: check_camera_options)
       {"--camera", "N",
        "The scene's camera to render through, by index (candela info lists them; default 0, the first)",
@@ -243,20 +272,18 @@ std::vector<RenderSetting> make_render_settings() {
        "one is given, else the scene camera's extras, else the distance from the camera to the centre of the scene's "
        "bounds along the view axis (the bounds' radius when that centre is not in front of the camera).",
        "", option(&A::focus_distance, check(finite_number()))},
-      recorded({"--filter", choices(kPixelFilterNames), "Pixel filter: " + enum_names(kPixelFilterNames, true),
-                "Pixel filter (default `box`); `tent` has radius 1 pixel, `gaussian` σ = 0.5 pixel "
-                "([integrator.md](integrator.md#pixel-filters)).",
-                "box", option(&A::filter),
-                [](const A& a, S* s) { s->filter = parse_enum(kPixelFilterNames, "--filter", a.filter); }},
-               [](const A&, const S& s) -> SettingValue { return std::string(enum_name(kPixelFilterNames, s.filter)); },
-               "filter", "filter", kMustMatch, "RenderParams.filter"),
-      recorded({"--sampler", choices(kSamplerNames), "Random numbers: " + enum_names(kSamplerNames, true),
-                "Where the random numbers come from (default `sobol`: Owen-scrambled Sobol points; `independent`: "
-                "hashed independent numbers) ([integrator.md](integrator.md#sampler)).",
-                "sobol", option(&A::sampler),
-                [](const A& a, S* s) { s->sampler = parse_enum(kSamplerNames, "--sampler", a.sampler); }},
-               [](const A&, const S& s) -> SettingValue { return std::string(enum_name(kSamplerNames, s.sampler)); },
-               "sampler", "sampler", kMustMatch, "CD_SAMPLER_SOBOL"),
+      recorded(enum_setting("--filter", kPixelFilterNames, &S::filter,
+                            "Pixel filter: " + enum_names(kPixelFilterNames, true),
+                            "Pixel filter (default `box`); `tent` has radius 1 pixel, `gaussian` σ = 0.5 pixel "
+                            "([integrator.md](integrator.md#pixel-filters)).",
+                            "box"),
+               nullptr, "filter", "filter", kMustMatch, "RenderParams.filter"),
+      recorded(
+          enum_setting("--sampler", kSamplerNames, &S::sampler, "Random numbers: " + enum_names(kSamplerNames, true),
+                       "Where the random numbers come from (default `sobol`: Owen-scrambled Sobol points; "
+                       "`independent`: hashed independent numbers) ([integrator.md](integrator.md#sampler)).",
+                       "sobol"),
+          nullptr, "sampler", "sampler", kMustMatch, "CD_SAMPLER_SOBOL"),
       {"-q,--quiet", "", "No progress or scene summary", "No progress output and no scene summary.", "",
        flag(&A::quiet)},
       {"--allow-outside-paths", "",
@@ -273,24 +300,26 @@ std::vector<RenderSetting> make_render_settings() {
        "where a pixel has fewer than 2 samples), with the image's metadata and `candela:image` = `variance_of_mean` "
        "([accuracy.md](accuracy.md#variance-images)).",
        "", option(&A::variance)},
-      recorded({"--generic", "",
-                "Build the generic kernel with every scene feature compiled in, instead of the one specialized to "
-                "the scene (to measure what specialization gains)",
-                "Build the generic kernel, with every scene feature compiled in, instead of the one specialized to "
-                "the scene ([architecture.md](architecture.md#kernel-specialization)).",
-                "", flag(&A::generic)},
-               [](const A& a, const S&) -> SettingValue { return a.generic; }, nullptr, "generic_kernel", false,
-               "CD_FEATURE_*"),
+      recorded(
+          {"--generic", "",
+           "Build the generic kernel with every scene feature compiled in, instead of the one specialized to "
+           "the scene (to measure what specialization gains)",
+           "Build the generic kernel, with every scene feature compiled in, instead of the one specialized to "
+           "the scene ([architecture.md](architecture.md#kernel-specialization)).",
+           "", flag(&A::generic)},
+          [](const A& a, const S&) -> SettingValue { return a.generic; }, nullptr, "generic_kernel", false,
+          "CD_FEATURE_*"),
       // Several devices and machines (README); --device takes a list
-      recorded({"--sample-offset", "K",
-                "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; stored as "
-                "candela:sample_offset",
-                "First sample index (default 0): renders the sample indices [K, K + spp) of every pixel, a shard "
-                "that `candela merge` combines with others "
-                "([devices.md](devices.md#several-machines-shards-and-candela-merge)).",
-                "0", option(&A::sample_offset, check(integer_in(0, kMaxIndex)))},
-               [](const A& a, const S&) -> SettingValue { return count(a.sample_offset); }, "sample_offset",
-               "sample_offset", false),
+      recorded(
+          {"--sample-offset", "K",
+           "First sample index (default 0): renders indices [K, K+spp), a shard for `candela merge`; stored as "
+           "candela:sample_offset",
+           "First sample index (default 0): renders the sample indices [K, K + spp) of every pixel, a shard "
+           "that `candela merge` combines with others "
+           "([devices.md](devices.md#several-machines-shards-and-candela-merge)).",
+           "0", option(&A::sample_offset, check(integer_in(0, kMaxIndex)))},
+          [](const A& a, const S&) -> SettingValue { return count(a.sample_offset); }, "sample_offset", "sample_offset",
+          false),
       {"--mpi", "",
        "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank renders a block "
        "of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)",
@@ -335,8 +364,13 @@ std::string record_markdown() {
 nlohmann::json settings_json() {
   nlohmann::json options = nlohmann::json::array();
   for (const RenderSetting& s : render_settings()) {
-    nlohmann::json o = {{"flags", s.flags},         {"value_name", s.value_name}, {"help", s.help}, {"doc", s.doc},
-                        {"default", s.default_value}, {"recorded", bool(s.record)}, {"must_match", s.must_match},
+    nlohmann::json o = {{"flags", s.flags},
+                        {"value_name", s.value_name},
+                        {"help", s.help},
+                        {"doc", s.doc},
+                        {"default", s.default_value},
+                        {"recorded", bool(s.record)},
+                        {"must_match", s.must_match},
                         {"kernel", s.kernel}};
     o["metadata"] = s.metadata ? nlohmann::json(s.metadata) : nlohmann::json();
     o["stats"] = s.stats ? nlohmann::json(s.stats) : nlohmann::json();
@@ -344,7 +378,10 @@ nlohmann::json settings_json() {
   }
   nlohmann::json results = nlohmann::json::array();
   for (const RecordKey& k : result_keys())
-    results.push_back({{"key", k.key}, {"metadata", k.metadata}, {"stats", k.stats}, {"must_match", k.must_match},
+    results.push_back({{"key", k.key},
+                       {"metadata", k.metadata},
+                       {"stats", k.stats},
+                       {"must_match", k.must_match},
                        {"always", k.always}});
   return {{"options", options}, {"results", results}, {"must_match", must_match_keys()}};
 }

@@ -28,8 +28,8 @@ using SettingValue = std::variant<bool, uint64_t, std::string>;
 struct RenderSetting {
   using Add = std::function<CLI::Option*(CLI::App* render, RenderArgs& args, const RenderSetting& self)>;
   using Apply = std::function<void(const RenderArgs&, RenderSettings*)>;
-  RenderSetting(std::string flags, std::string value_name, std::string help, std::string doc,
-                std::string default_value, Add add, Apply apply = {})
+  RenderSetting(std::string flags, std::string value_name, std::string help, std::string doc, std::string default_value,
+                Add add, Apply apply = {})
       : flags(std::move(flags)),
         value_name(std::move(value_name)),
         help(std::move(help)),

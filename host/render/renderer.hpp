@@ -65,7 +65,7 @@ struct RenderSettings {
   CD_KERNEL_SETTINGS(CD_KERNEL_SETTING_MEMBER)
 #undef CD_KERNEL_SETTING_MEMBER
   Sampler sampler = Sampler::Sobol;  // a build option: CD_SAMPLER_SOBOL (render_kernel_options)
-  double launch_seconds = 0.2;  // target duration of one launch
+  double launch_seconds = 0.2;       // target duration of one launch
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
   bool packets = true;
