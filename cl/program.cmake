@@ -1,8 +1,10 @@
 # The renderer's OpenCL program: every kernel source in program order (each file may use
 # what the files before it define; shared/device_types.h comes first). A new .cl file is
-# added here, in the folder of its subsystem. The files up to and including
-# cl/bsdf/energy_dielectric.cl (kLastTablesFile, host/device/kernel_sources.hpp) also make
-# the tables program, which holds every table kernel (energy.cl, sheen.cl, energy_dielectric.cl).
+# added here, in the folder of its subsystem; a component of the glTF mixture
+# (cl/bsdf/gltf/NAME.cl) between gltf/mixture.cl and bsdf_gltf.cl, after the components it
+# uses. The files up to and including cl/bsdf/energy_dielectric.cl (kLastTablesFile,
+# host/device/kernel_sources.hpp) also make the tables program, which holds every table
+# kernel (energy.cl, sheen.cl, energy_dielectric.cl).
 set(CANDELA_CL_SOURCES
   cl/shared/device_types.h
   cl/shared/color.h
@@ -29,6 +31,16 @@ set(CANDELA_CL_SOURCES
   cl/bsdf/bsdf_conductor.cl
   cl/bsdf/bsdf_dielectric.cl
   cl/bsdf/energy_dielectric.cl
+  cl/bsdf/gltf/mixture.cl
+  cl/bsdf/gltf/fresnel.cl
+  cl/bsdf/gltf/coat.cl
+  cl/bsdf/gltf/sheen.cl
+  cl/bsdf/gltf/metal.cl
+  cl/bsdf/gltf/spec.cl
+  cl/bsdf/gltf/difftrans.cl
+  cl/bsdf/gltf/diffuse.cl
+  cl/bsdf/gltf/ms.cl
+  cl/bsdf/gltf/glass.cl
   cl/bsdf/bsdf_gltf.cl
   cl/bsdf/bsdf.cl
   cl/bsdf/unlit.cl

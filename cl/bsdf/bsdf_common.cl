@@ -55,13 +55,22 @@ typedef struct {
   float3 f_avg;  // hemispherical average of its Fresnel term
 } ConductorBsdf;
 
+// The members of Bsdf's lobe union, X(type, member): a type's parameters at a shading point
+#define BSDF_LOBE_TYPES(X) X(GltfBsdf, gltf) X(ConductorBsdf, conductor)
+#define BSDF_LOBE_MEMBER(type, member) type member;
+
 // The lobe union's first member spans all of it as float4 words. A compiler may copy a union
 // as the one member it lays the union out by, and skip that member's padding: NVIDIA's
 // OpenCL compiler (driver 580) copied a Bsdf as GltfBsdf, whose `bool thin` (one byte, then
 // three of padding) lies over a conductor's k.z, and so rendered every measured conductor
 // without its blue channel's absorption. Words have no padding, and clang lays a union out by
-// its first member of the largest size and alignment.
-#define BSDF_LOBE_BYTES (sizeof(GltfBsdf) > sizeof(ConductorBsdf) ? sizeof(GltfBsdf) : sizeof(ConductorBsdf))
+// its first member of the largest size and alignment. Their count comes from the largest
+// member: the size of a union of the members alone, which is only measured (sizeof), never
+// an object, so never copied. The device layout test checks it against each member.
+typedef union {
+  BSDF_LOBE_TYPES(BSDF_LOBE_MEMBER)
+} BsdfLobeMembers;
+#define BSDF_LOBE_BYTES sizeof(BsdfLobeMembers)
 #define BSDF_LOBE_WORDS ((BSDF_LOBE_BYTES + 15) / 16)
 
 // The BSDF of one shading point: what every type has (frame, normals, colour), then the
@@ -77,9 +86,8 @@ typedef struct {
   int channel;  // the RGB channel whose wavelength a dispersive material refracts (dispersion.cl); -1: none
 #endif
   union {
-    float4 words[BSDF_LOBE_WORDS];  // see below: the union as a whole, without padding
-    GltfBsdf gltf;
-    ConductorBsdf conductor;
+    float4 words[BSDF_LOBE_WORDS];  // see above: the union as a whole, without padding
+    BSDF_LOBE_TYPES(BSDF_LOBE_MEMBER)
   } lobe;  // by type
 } Bsdf;
 

@@ -4,7 +4,7 @@
 // of a volumetric interface and of a thin sheet, by bsdf_sample weights and by an eval-based
 // estimator, and never above 1 for tinted glass; samples agree with eval; X is reciprocal
 // across the interface as Y = f / n_o^2; white rough glass spheres vanish in a white furnace;
-// and a white Lambert base under a clear coat reflects all the light (bsdf_gltf.cl).
+// and a white Lambert base under a clear coat reflects all the light (cl/bsdf/gltf/coat.cl).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -375,7 +375,7 @@ TEST(EnergyDielectric, EvalIsReciprocalAndConservesEnergy) {
     }
 }
 
-// The clear coat (cl/bsdf/bsdf_gltf.cl): a white Lambert base under a clear coat (factor 1,
+// The clear coat (cl/bsdf/gltf/coat.cl): a white Lambert base under a clear coat (factor 1,
 // ior 1.5) reflects >= 98 % at every angle and coat roughness with compensation (the light
 // trapped under the coat is returned), and under 1 without it at some angle; a white
 // plastic base (its own specular layer) under the coat stays <= 1

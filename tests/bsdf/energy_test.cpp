@@ -360,7 +360,7 @@ TEST(Energy, AnisotropyFeatureLeavesIsotropicLobesAsTheyWere) {
   EXPECT_GT(std::abs(exact[1].mean - approx[1].mean), 4.0 * (exact[1].se + approx[1].se));
 }
 
-// The plastic's layering (cl/bsdf/bsdf_gltf.cl): with the table, the diffuse base gets exactly
+// The plastic's layering (cl/bsdf/gltf/mixture.cl): with the table, the diffuse base gets exactly
 // the light its specular layer does not reflect, so white plastic reflects 1 at every angle
 // and roughness (smooth included), up to the table's accuracy; coloured and tinted plastic
 // reflect at most 1. Without the table (no compensation) nothing exceeds 1 either.

@@ -1,5 +1,5 @@
 // The clearcoat's own normal (KHR_materials_clearcoat clearcoatNormalTexture) and the diffuse
-// transmission (KHR_materials_diffuse_transmission) of the glTF BSDF (cl/bsdf/bsdf_gltf.cl), on
+// transmission (KHR_materials_diffuse_transmission) of the glTF BSDF (cl/bsdf/gltf/), on
 // PoCL and rusticl, through the real dispatch (tests/bsdf/test_gltf_layers.cl): the coat's
 // specular peak follows the coat's normal map while the base's does not (and, as the
 // extension says, a base normal map leaves the coat alone); sampling against the pdf

@@ -1,6 +1,6 @@
 // KHR_materials_iridescence (cl/bsdf/iridescence.cl, and its film mixed into the metal's and
-// the specular layer's Fresnel terms in bsdf_gltf.cl) on PoCL, with a test program of its own
-// (the shared one leaves CD_FEATURE_IRIDESCENCE out): the film's RGB reflectance against an
+// the specular layer's Fresnel terms in cl/bsdf/gltf/fresnel.cl) on PoCL, with a test program
+// of its own (the shared one leaves CD_FEATURE_IRIDESCENCE out): the film's RGB reflectance against an
 // explicit spectral reference (the Airy sum of the film's inter-reflections per wavelength,
 // integrated against an analytic fit of the CIE 1931 colour matching functions, in double
 // precision); its limit as the thickness goes to 0 (the Airy sum at zero phase, the base's

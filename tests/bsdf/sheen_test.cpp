@@ -1,5 +1,5 @@
 // The sheen layer of KHR_materials_sheen (cl/bsdf/sheen.cl, the Charlie lobe of Estevez &
-// Kulla 2017, and its albedo scaling in bsdf_gltf.cl) on PoCL and rusticl: the lobe against
+// Kulla 2017, and its albedo scaling in cl/bsdf/gltf/sheen.cl) on PoCL and rusticl: the lobe against
 // a host evaluation of the formula; the device-computed albedo table against a host
 // quadrature; sampling of sheen materials (bsdf_sample agrees with bsdf_eval / bsdf_pdf, the
 // pdf integrates to 1, chi-square of the sampled directions); a white furnace (albedo <= 1,

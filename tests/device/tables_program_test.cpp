@@ -19,6 +19,7 @@
 #include "device/kernel_sources.hpp"
 #include "device/sheen_albedo.hpp"
 #include "device/tables_program.hpp"
+#include "device/tables_program_passes.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "support/test_support.hpp"
 
@@ -71,6 +72,10 @@ TEST(TablesProgram, RendererProgramHoldsOnlyTheSceneKernelAndTheTablesProgramEve
                                    "energy_ggx_aniso_average_table", "energy_dielectric_albedo_table",
                                    "energy_dielectric_average_table", "energy_dielectric_aniso_table",
                                    "energy_dielectric_aniso_average_table", "sheen_albedo_table"}));
+  // The list of table passes (kTablePasses) runs exactly these kernels, each once
+  std::set<std::string> listed;
+  for (const TablePass& p : kTablePasses) EXPECT_TRUE(listed.insert(p.kernel).second) << p.kernel << " listed twice";
+  EXPECT_EQ(listed, kernel_names(tables.get()));
   EXPECT_FALSE(fs::exists(tables.cache_file())) << "the tables program's binary is not stored";
 }
 

@@ -9,10 +9,15 @@ CD_LIGHTS are exactly their entries, numbered 0, 1, ...; no kernel code compares
 an id or switches on it (the dispatch is generated from the lists); every type has its
 functions with the one signature, and the generated dispatch calls each of them; every
 CD_FEATURE_* macro the kernels use is in CD_SCENE_FEATURES, whose defaults come from the
-list alone. Fails when a union in kernel code (outside cl/shared/device_types.h, whose
-structs hold only 4-byte scalars) does not begin with a float4 or uint4 array that spans it:
-a compiler may copy a union as the member it lays it out by and drop that member's padding
-(NVIDIA's OpenCL compiler lost a conductor's k.z under a bool's padding). Usage: kernel_lint_test.py REPO_ROOT
+list alone. Fails when the glTF mixture's lists (cl/bsdf/gltf/mixture.cl) and its files
+disagree: every GLTF_COMPONENTS entry has its file cl/bsdf/gltf/NAME.cl defining its params,
+at_wo, flags, weight, sample, lobes and eval functions, GLTF_EVAL_ORDER holds each entry once, bsdf_gltf.cl sums
+the terms through it, and cl/bsdf/gltf/ holds no other file than the shared ones. Fails when
+a union in kernel code (outside cl/shared/device_types.h, whose structs hold only 4-byte
+scalars) does not begin with a float4 or uint4 array that spans it (a union only measured by
+sizeof, never an object, excepted): a compiler may copy a union as the member it lays it out
+by and drop that member's padding (NVIDIA's OpenCL compiler lost a conductor's k.z under a
+bool's padding). Usage: kernel_lint_test.py REPO_ROOT
 """
 import glob
 import os
@@ -69,14 +74,33 @@ def violations(sources):
     return found
 
 
+def measured_unions(sources):
+    """Spans (path, start, end) of `typedef union {...} Name;` whose Name the sources use only
+    in sizeof(Name): never an object, so never copied."""
+    code = {p: re.sub(r'//[^\n]*', '', t) for p, t in sources.items()}
+    spans = []
+    for path, text in code.items():
+        for m in re.finditer(r'\btypedef\s+union\s*\w*\s*\{[^}]*\}\s*(\w+)\s*;', text):
+            name = re.escape(m.group(1))
+            uses = sum(len(re.findall(r'\b' + name + r'\b', t)) for t in code.values()) - 1
+            measured = sum(len(re.findall(r'\bsizeof\s*\(\s*' + name + r'\s*\)', t)) for t in code.values())
+            if uses == measured:
+                spans.append((path, m.start(), m.end()))
+    return spans
+
+
 def union_violations(sources):
-    """Unions whose first member is not a padding-free array of 4-wide vectors."""
+    """Unions whose first member is not a padding-free array of 4-wide vectors, but for those
+    only measured (measured_unions)."""
     found = []
+    measured = measured_unions(sources)
     for path, text in sources.items():
         if path.endswith(os.path.join('shared', 'device_types.h')):
             continue
         text = re.sub(r'//[^\n]*', '', text)
         for m in re.finditer(r'\bunion\s*\w*\s*\{\s*([^;]*;)', text):
+            if any(p == path and a <= m.start() < b for p, a, b in measured):
+                continue
             if not re.match(r'(?:float|uint|int)4\s+\w+\s*\[[^\]]+\]\s*;', m.group(1)):
                 found.append(f'{path}: a union begins with "{m.group(1).strip()}", not a float4 array spanning it '
                              f'(a copy may drop the padding of the member it is laid out by)')
@@ -164,6 +188,9 @@ LOBE = {
     'lobes': ('void', ['const Bsdf*', 'float3', 'BsdfLobes*']),
 }
 COMPONENT = {
+    'params': ('bool', ['const SceneData*', '__global const Material*', 'const SurfaceHit*', 'Bsdf*']),
+    'at_wo': ('void', ['const Bsdf*', 'float3', 'GltfAtWo*']),
+    'flags': ('uint', ['const Bsdf*']),
     'weight': ('float', ['const Bsdf*', 'const GltfAtWo*', 'float']),
     'sample': ('int', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float', 'float2', 'BsdfSample*']),
     'lobes': ('void', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float', 'BsdfLobes*']),
@@ -283,6 +310,85 @@ def planted_list_violations():
     return missed
 
 
+# The glTF mixture (cl/bsdf/gltf/mixture.cl): one file per component, cl/bsdf/gltf/NAME.cl,
+# defining its functions; the files beside them that are no component
+GLTF_DIR = os.path.join('cl', 'bsdf', 'gltf')
+GLTF_MIXTURE = os.path.join(GLTF_DIR, 'mixture.cl')
+GLTF_SHARED = {'mixture.cl', 'fresnel.cl'}
+# Each component's term of f and pdf, called in GLTF_EVAL_ORDER rather than GLTF_COMPONENTS' order
+COMPONENT_EVAL = ('void', ['const Bsdf*', 'const GltfAtWo*', 'float3', 'float3', 'GltfEval*'])
+
+
+def component_violations(sources, dispatch_path):
+    """Disagreements between GLTF_COMPONENTS, GLTF_EVAL_ORDER and the component files among
+    sources (path -> text of the program's files)."""
+    found = []
+    text = strip_comments(sources.get(GLTF_MIXTURE, ''))
+    names = [e[1] for e in list_entries(macro_body(text, 'GLTF_COMPONENTS') or '') if len(e) == 3]
+    order = [e[0] for e in list_entries(macro_body(text, 'GLTF_EVAL_ORDER') or '')]
+    if not names:
+        return [f'{GLTF_MIXTURE}: no GLTF_COMPONENTS']
+    if sorted(order) != sorted(names):
+        found.append(f'{GLTF_MIXTURE}: GLTF_EVAL_ORDER ({", ".join(order)}) is not GLTF_COMPONENTS\' entries '
+                     f'({", ".join(names)}) each once')
+    signatures = dict(COMPONENT, eval=COMPONENT_EVAL)
+    for name in names:
+        path = os.path.join(GLTF_DIR, name + '.cl')
+        if path not in sources:
+            found.append(f'GLTF_COMPONENTS entry {name}: no {path} in the program')
+            continue
+        defs = definitions(strip_comments(sources[path]))
+        for suffix, signature in signatures.items():
+            fn = f'gltf_{name}_{suffix}'
+            if fn not in defs:
+                found.append(f'{path}: no {fn}() (each component defines its functions in its own file)')
+            elif defs[fn] != signature:
+                found.append(f'{fn}: {defs[fn][0]} ({", ".join(defs[fn][1])}), not the one signature '
+                             f'{signature[0]} ({", ".join(signature[1])})')
+    for path in sources:
+        if os.path.dirname(path) == GLTF_DIR and os.path.basename(path) not in GLTF_SHARED | {n + '.cl' for n in names}:
+            found.append(f'{path}: a file of cl/bsdf/gltf/ that is no GLTF_COMPONENTS entry')
+    dispatch = strip_comments(sources.get(dispatch_path, ''))
+    callers = generated_callers(dispatch, 'gltf', 'eval')
+    if not any(re.search(r'GLTF_EVAL_ORDER\(\s*' + c + r'\s*\)', dispatch) for c in callers):
+        found.append(f'{dispatch_path}: no sum of gltf_NAME_eval generated from GLTF_EVAL_ORDER')
+    return found
+
+
+def planted_component_violations():
+    """What component_violations misses among planted violations (empty when it finds each)."""
+    mixture = ('#define GLTF_COMPONENTS(X) X(GLTF_A, a, BSDF_GLOSSY) X(GLTF_B, b, BSDF_DIFFUSE)\n'
+               '#define GLTF_EVAL_ORDER(X) X(b) X(a)\n')
+
+    def definition(name, suffix, signature):
+        params = ', '.join(f'{t} p{i}' for i, t in enumerate(signature[1]))
+        return f'{signature[0]} gltf_{name}_{suffix}({params}) {{{"" if signature[0] == "void" else " return 0; "}}}'
+
+    signatures = dict(COMPONENT, eval=COMPONENT_EVAL)
+    component = {n: '\n'.join(definition(n, suffix, sig) for suffix, sig in signatures.items()) for n in 'ab'}
+    dispatch = os.path.join('cl', 'bsdf', 'bsdf_gltf.cl')
+    base = {GLTF_MIXTURE: mixture, os.path.join(GLTF_DIR, 'a.cl'): component['a'],
+            os.path.join(GLTF_DIR, 'b.cl'): component['b'],
+            dispatch: '#define E(name) gltf_##name##_eval(b, g, wo, wi, &acc);\nvoid f() { GLTF_EVAL_ORDER(E) }\n'}
+    cases = [
+        ('a component without its file', {os.path.join(GLTF_DIR, 'b.cl'): None}),
+        ('a component missing from the evaluation order', {GLTF_MIXTURE: mixture.replace(' X(a)', '')}),
+        ('a function in another file', {
+            os.path.join(GLTF_DIR, 'a.cl'): component['a'].split('\nvoid gltf_a_eval')[0],
+            os.path.join(GLTF_DIR, 'b.cl'): component['b'] + '\n' + definition('a', 'eval', COMPONENT_EVAL)}),
+        ('a term of another signature', {
+            os.path.join(GLTF_DIR, 'a.cl'): component['a'].replace('GltfEval* p4', 'float* p4')}),
+        ('a file that is no component', {os.path.join(GLTF_DIR, 'c.cl'): ''}),
+        ('a sum not generated from the list', {dispatch: 'void f() {}\n'}),
+    ]
+    missed = ['the clean sources (it reports one there)'] if component_violations(base, dispatch) else []
+    for what, change in cases:
+        sources = {p: t for p, t in dict(base, **change).items() if t is not None}
+        if not component_violations(sources, dispatch):
+            missed.append(what)
+    return missed
+
+
 def main():
     root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), '..', '..')
     # Every kernel file, found recursively: the renderer's cl/ and the test kernels beside their tests
@@ -307,13 +413,19 @@ def main():
     if not violations(planted):
         print('kernel_lint: the planted violation was not found; the check is broken')
         return 1
+    measured = 'typedef union { A a; B b; } M;\n#define N sizeof(M)\n'
     if not union_violations({'u.cl': 'typedef struct { union { A a; B b; } lobe; } S;'}) or union_violations(
-            {'u.cl': 'typedef struct { union { float4 words[3]; A a; } lobe; } S;'}):
+            {'u.cl': 'typedef struct { union { float4 words[3]; A a; } lobe; } S;'}) or union_violations(
+            {'u.cl': measured}) or not union_violations({'u.cl': measured + 'void f() { M m; }\n'}):
         print('kernel_lint: the union check misses its planted violation or flags a clean union; the check is broken')
         return 1
     missed = planted_list_violations()
     if missed:
         print(f'kernel_lint: the list check misses planted violations ({"; ".join(missed)}); the check is broken')
+        return 1
+    missed = planted_component_violations()
+    if missed:
+        print(f'kernel_lint: the component check misses planted violations ({"; ".join(missed)}); the check is broken')
         return 1
     found = violations(sources) + union_violations(sources)
     program_sources = {p: t for p, t in sources.items() if p in program}
@@ -322,8 +434,9 @@ def main():
     found += list_violations(program_sources, types, {
         'CD_MATERIALS': (types, 'bsdf', LOBE, os.path.join('cl', 'bsdf', 'bsdf.cl'), True),
         'CD_LIGHTS': (types, 'lights', LIGHT, os.path.join('cl', 'lights', 'lights.cl'), True),
-        'GLTF_COMPONENTS': (gltf, 'gltf', COMPONENT, gltf, False),
+        'GLTF_COMPONENTS': (GLTF_MIXTURE, 'gltf', COMPONENT, gltf, False),
     })
+    found += component_violations(program_sources, gltf)
     # Test kernels may tell types apart, but use only the listed features
     test_sources = {p: strip_comments(t) for p, t in sources.items() if p.startswith('tests' + os.sep)}
     macros = {e[1] for e in list_entries(macro_body(sources[os.path.join('cl', 'shared', 'device_types.h')],
