@@ -317,6 +317,24 @@ RenderResult render_with_progress(Renderer& renderer, const RenderArgs& a, const
   return r;
 }
 
+// The automatic exposure (scene/default_light.hpp, image_exposure) metered from the image,
+// said in one line: the exposure the PNG/JPEG outputs get
+void meter_exposure(const Film& film, RenderArgs* a) {
+  if (a->exposure || !a->auto_exposure_share) return;
+  std::vector<float> lum(film.pixels());
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    glm::vec3 v = film.pixel(i);
+    lum[i] = dev::luminance_rgb(v.x, v.y, v.z);
+  }
+  a->exposure = image_exposure(lum, film.width, film.height);
+  if (a->exposure)
+    std::fprintf(stderr,
+                 "note: exposing PNG/JPEG outputs at %.1f stops, metered from the image (log-average luminance to "
+                 "middle grey): the scene's own lights give %.3g times the studio's light on its surfaces "
+                 "(--exposure 0 keeps them as they are; EXR stays linear)\n",
+                 double(*a->exposure), *a->auto_exposure_share);
+}
+
 // The images (and the variance image), each with the report as metadata; each output is
 // written on its own, so one that fails (reported) does not cost the others. False when
 // any failed.
@@ -393,8 +411,8 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   render
       ->add_option(
           "--exposure", a.exposure,
-          "Exposure of PNG/JPEG outputs in stops (default 0, or lower for a scene whose own lights are over 4x the "
-          "studio's); EXR stays linear")
+          "Exposure of PNG/JPEG outputs in stops (default 0, or metered from the image for a scene whose own lights "
+          "are over 4x the studio's); EXR stays linear")
       ->check(finite_number());
   render->add_option("--tonemap", a.tonemap,
                      "Display transform of PNG/JPEG outputs: " + enum_names(kTonemapNames, true));
@@ -442,6 +460,7 @@ int run_render(RenderArgs a) {
   report.has_view = true;
   report.lighting = lighting;
   raise_if_asked("writing");
+  meter_exposure(r.film, &a);
   bool all_written = write_outputs(a, r.film, report);
   print_result(report, r.partial_pass, r.film);
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
