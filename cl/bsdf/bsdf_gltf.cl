@@ -17,8 +17,10 @@
 //            F_d = Schlick(F0 from ior and KHR_materials_specular, f90 = specular)
 //   film:    (CD_FEATURE_IRIDESCENCE) KHR_materials_iridescence mixes a thin film's reflectance
 //            (iridescence.cl) into F_m and F_d: F = mix(F, film over that base, factor), the
-//            dielectric's film scaled by its specular factor (gltf_fresnel). The layering (W,
-//            the albedo weights) and the multiple scattering keep the base's Schlick terms
+//            dielectric's film scaled by its specular factor (gltf_fresnel), and into the
+//            glass's split between reflection and transmission (gltf_glass_eval), for every
+//            base index, 1 included. The layering (W, the albedo weights) and the multiple
+//            scattering keep the base's own Fresnel terms
 //   difftrans: (CD_FEATURE_DIFFUSE_TRANSMISSION) (1 - metallic)(1 - transmission) *
 //            d W(mu_o, |mu_i|) * colour / pi into the other hemisphere
 //            (KHR_materials_diffuse_transmission: the factor d takes that share of the
@@ -468,6 +470,59 @@ float gltf_coat_across(const Bsdf* b, const GltfAtWo* g, float3 wi) {
   return 1.0f - gltf_coat_albedo(&g->coat, b->entering ? clamp(g->coat_o, 0.0f, 1.0f) : gltf_coat_mu(g, wi));
 }
 
+// The glass component's interface (bsdf_dielectric.cl with energy_dielectric.cl's
+// multiple-scattering compensation). Under KHR_materials_iridescence the film's reflectance
+// replaces the Fresnel term of the split between reflection and transmission, as it does
+// the metal's and the plastic's (gltf_fresnel), for every index of the base, 1 included;
+// the compensation lobe stays the bare interface's.
+#if CD_FEATURE_IRIDESCENCE
+DielectricFilm gltf_film(const Bsdf* b) {
+  DielectricFilm film = {b->lobe.gltf.iridescence, b->lobe.gltf.iridescence_ior, b->lobe.gltf.iridescence_thickness};
+  return film;
+}
+#endif
+
+float3 gltf_glass_eval(const Bsdf* b, float3 wo, float3 wi, float* pdf) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+#if CD_FEATURE_IRIDESCENCE
+  if (lobe->iridescence > 0.0f) {
+    float3 f = bsdf_dielectric_film_eval(lobe->ggx, lobe->eta, lobe->thin, b->base_color, gltf_film(b), wo, wi, pdf);
+    DielectricMs ms = energy_dielectric_at(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, energy_at(wo));
+    if (!ms.on) return f;
+    float ms_pdf;
+    f += energy_dielectric_ms(&ms, b->base_color, wi, &ms_pdf);
+    *pdf = (1.0f - ms.q) * *pdf + ms.q * ms_pdf;
+    return f;
+  }
+#endif
+  return energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, pdf);
+}
+
+// A sample of the glass's interface: the compensation lobe with probability q (as
+// energy_dielectric_sample), else the interface
+bool gltf_glass_interface_sample(const Bsdf* b, float3 wo, float uc, float2 u, BsdfSample* bs) {
+  const GltfBsdf* lobe = &b->lobe.gltf;
+#if CD_FEATURE_IRIDESCENCE
+  if (lobe->iridescence > 0.0f) {
+    DielectricMs ms = energy_dielectric_at(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, energy_at(wo));
+    if (ms.on && uc < ms.q) {
+      bs->wi = sample_cosine_hemisphere(u.x, u.y);
+      if (uc / ms.q >= ms.p_refl) bs->wi.z = -bs->wi.z;
+    } else if (!bsdf_dielectric_film_sample(lobe->ggx, lobe->eta, lobe->thin, b->base_color, gltf_film(b), wo,
+                                            ms.on ? fmin((uc - ms.q) / (1.0f - ms.q), 0x1.fffffep-1f) : uc, u, bs)) {
+      return false;
+    }
+    if (!ms.on) return true;
+    bool transmits = bs->wi.z < 0.0f;
+    bs->f = gltf_glass_eval(b, wo, bs->wi, &bs->pdf);
+    bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | BSDF_GLOSSY;
+    bs->eta = transmits && !lobe->thin ? lobe->eta : 1.0f;
+    return bs->pdf > 0.0f;
+  }
+#endif
+  return energy_dielectric_sample(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs);
+}
+
 // Everything but delta components: f(wo, wi) and the mixture pdf of bsdf_gltf_sample, wo.z > 0
 float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, float* pdf) {
   const GltfBsdf* lobe = &b->lobe.gltf;
@@ -515,8 +570,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
 #endif
   if (t > 0.0f) {
     float glass_p;
-    under += (1.0f - m) * t *
-             energy_dielectric_eval(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, wi, &glass_p);
+    under += (1.0f - m) * t * gltf_glass_eval(b, wo, wi, &glass_p);
     *pdf += w[GLTF_GLASS] * glass_p;
   }
 #if CD_FEATURE_SHEEN
@@ -644,8 +698,7 @@ int gltf_ms_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2
 // A delta transmission crosses the coat once, at the angle of the direction outside
 int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, float2 u, BsdfSample* bs) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  if (!energy_dielectric_sample(b->ggx_albedo, lobe->ggx, lobe->eta, lobe->thin, b->base_color, wo, uc, u, bs))
-    return GLTF_SAMPLE_FAILED;
+  if (!gltf_glass_interface_sample(b, wo, uc, u, bs)) return GLTF_SAMPLE_FAILED;
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
   float att = bs->wi.z > 0.0f ? gltf_coat_below(g, bs->wi) : gltf_coat_across(b, g, bs->wi);
 #if CD_FEATURE_SHEEN
@@ -705,6 +758,9 @@ void gltf_glass_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, Bsdf
   const GltfBsdf* lobe = &b->lobe.gltf;
   if (ggx_is_delta(lobe->ggx)) return;
   float r = fresnel_dielectric(wo.z, lobe->eta);
+#if CD_FEATURE_IRIDESCENCE
+  if (lobe->iridescence > 0.0f) r = dielectric_film_share(dielectric_film_fresnel(gltf_film(b), wo.z, lobe->eta, false));
+#endif
   float3 t = -wo;
   if (lobe->thin) {
     r = dielectric_sheet_reflectance(r);
