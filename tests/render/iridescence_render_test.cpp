@@ -52,15 +52,17 @@ TEST_P(IridescentLens, ReflectsBlueOverAnIndexMatchedBase) {
 }
 
 // A clear (white) lens with a volume: each crossing reflects the film's F and transmits 1 - F,
-// so the sphere keeps the furnace's light
+// so the sphere keeps the furnace's light, channel by channel (within the noise of choosing
+// reflection by the channels' mean: weights F / mean(F) and (1 - F) / (1 - mean(F)))
 TEST_P(IridescentLens, ClearLensConservesEnergyInTheFurnace) {
   DeviceEntry device;
   CANDELA_DEVICE_OR_SKIP(GetParam(), device);
   Scene s = load_scene(furnace_sphere(film_lens(1.0, true)), std::string("film-clear-") + GetParam() + ".gltf");
-  Film f = render_film(s, Strategy::Bsdf, 16, 16, 64, 1000, 5, device);
+  Film f = render_film(s, Strategy::Bsdf, 16, 16, 256, 1000, 5, device);
   for (int c = 0; c < 3; ++c) {
     Estimate e = region_mean(f, c, 0, 16, 0, 16);
-    EXPECT_NEAR(e.mean, 1.0, 1e-4) << "channel " << c;
+    EXPECT_LT(e.standard_error, 0.005) << "too noisy to test anything";
+    EXPECT_NEAR(e.mean, 1.0, 4.0 * e.standard_error + 1e-5) << "channel " << c << ", SE " << e.standard_error;
   }
   EXPECT_EQ(f.dropped_samples(), 0u);
 }
