@@ -12,8 +12,9 @@
 // zero optical path gives each RGB channel exactly its DC term: as the thickness goes to 0
 // (with the film's index held) the film tends to the Airy sum at zero phase, which at normal
 // incidence is exactly the base's F0 ((a + b) / (1 + ab) of the two interfaces' amplitudes).
-// Compiled only with CD_FEATURE_IRIDESCENCE; bsdf_gltf.cl calls it from one place
-// (gltf_fresnel).
+// Compiled only with CD_FEATURE_IRIDESCENCE; bsdf_gltf.cl calls it for the metal and the
+// plastic (gltf_fresnel) and, through bsdf_dielectric.cl's dielectric_film_fresnel, for the
+// glass. A base of index 1 (F0 = 0) is no special case: the film alone reflects.
 #if CD_FEATURE_IRIDESCENCE
 
 #define IRIDESCENCE_ORDERS 8

@@ -26,6 +26,7 @@
 #include "compile/scene_compiler.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
+#include "scene/default_light.hpp"
 
 namespace candela {
 namespace {
@@ -205,6 +206,24 @@ RenderResult render_with_progress(Renderer& renderer, const RenderArgs& a, const
   return r;
 }
 
+// The automatic exposure (scene/default_light.hpp, image_exposure) metered from the image,
+// said in one line: the exposure the PNG/JPEG outputs get
+void meter_exposure(const Film& film, RenderArgs* a) {
+  if (a->exposure || !a->auto_exposure_share) return;
+  std::vector<float> lum(film.pixels());
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    glm::vec3 v = film.pixel(i);
+    lum[i] = dev::luminance_rgb(v.x, v.y, v.z);
+  }
+  a->exposure = image_exposure(lum, film.width, film.height);
+  if (a->exposure)
+    std::fprintf(stderr,
+                 "note: exposing PNG/JPEG outputs at %.1f stops, metered from the image (log-average luminance to "
+                 "middle grey): the scene's own lights give %.3g times the studio's light on its surfaces "
+                 "(--exposure 0 keeps them as they are; EXR stays linear)\n",
+                 double(*a->exposure), *a->auto_exposure_share);
+}
+
 // The images (and the variance image), each with the report as metadata; each output is
 // written on its own, so one that fails (reported) does not cost the others. False when
 // any failed.
@@ -305,6 +324,7 @@ int run_render(RenderArgs a) {
   report.has_view = true;
   report.lighting = lighting;
   raise_if_asked("writing");
+  meter_exposure(r.film, &a);
   bool all_written = write_outputs(a, r.film, report);
   print_result(report, r.partial_pass, r.film);
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;

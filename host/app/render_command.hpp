@@ -31,6 +31,9 @@ struct RenderArgs {
   std::string variant;                 // --variant NAME: a KHR_materials_variants variant; empty: the default
   std::string stats;
   std::optional<float> exposure;  // --exposure EV; unset: 0, or the automatic exposure (render_scene.cpp)
+  // Set where the automatic exposure applies (the scene's own lights' share of the studio's
+  // light): PNG/JPEG outputs are exposed from the rendered image (render_command.cpp)
+  std::optional<double> auto_exposure_share;
   std::string tonemap = "neutral";
   std::optional<int> camera;  // --camera N: the scene's camera N (default its first)
   std::string look_from, look_at, up;

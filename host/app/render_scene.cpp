@@ -137,15 +137,11 @@ DefaultLightChoice add_default_light(const RenderArgs& a, Scene* scene) {
   return c;
 }
 
-// Without --exposure, the automatic exposure (scene/default_light.hpp), said in one line
+// Without --exposure, whether the automatic exposure applies (scene/default_light.hpp); its
+// value is metered from the rendered image and said then (render_command.cpp)
 void choose_exposure(const DefaultLightChoice& c, RenderArgs* a) {
   if (a->exposure) return;
-  a->exposure = automatic_exposure(c);
-  if (a->exposure)
-    std::fprintf(stderr,
-                 "note: exposing PNG/JPEG outputs at %.1f stops: the scene's own lights give %.3g times the studio's "
-                 "light on its surfaces (--exposure 0 keeps them as they are; EXR stays linear)\n",
-                 double(*a->exposure), c.own_share);
+  if (automatic_exposure(c)) a->auto_exposure_share = c.own_share;
 }
 
 // --env-strength, --env-rotation

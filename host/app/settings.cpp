@@ -233,11 +233,11 @@ std::vector<RenderSetting> make_render_settings() {
       {"--stats", "FILE.json", "Write render statistics as JSON to this file",
        "Write render statistics ([below](#statistics---stats)).", "", option(&A::stats)},
       {"--exposure", "EV",
-       "Exposure of PNG/JPEG outputs in stops (default 0, or lower for a scene whose own lights are over 4x the "
-       "studio's); EXR stays linear",
+       "Exposure of PNG/JPEG outputs in stops (default 0, or metered from the image for a scene whose own lights "
+       "are over 4x the studio's); EXR stays linear",
        "Exposure of PNG/JPEG outputs in stops, finite; EXR stays linear. Default 0, except for a scene lit by its "
-       "own lights more than 4 times brighter than the studio would light it: then −log2 of that share, announced "
-       "([lights.md](lights.md#automatic-exposure)).",
+       "own lights more than 4 times brighter than the studio would light it: then metered from the rendered image "
+       "(its log-average luminance to middle grey), announced ([lights.md](lights.md#automatic-exposure)).",
        "0", option(&A::exposure, check(finite_number())),
        [](const A& a, S*) {
          if (a.exposure && !std::isfinite(*a.exposure)) throw Error("--exposure must be a finite number of stops");

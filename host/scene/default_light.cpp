@@ -216,4 +216,37 @@ std::optional<float> automatic_exposure(const DefaultLightChoice& c) {
   return float(std::round(-10.0 * std::log2(c.own_share)) / 10.0);
 }
 
+std::optional<float> image_exposure(const std::vector<float>& luminance, int width, int height) {
+  if (width <= 0 || height <= 0 || luminance.size() < size_t(width) * size_t(height)) return std::nullopt;
+  int side = std::max(1, (std::min(width, height) + kMeterZones - 1) / kMeterZones);
+  std::vector<double> zones;
+  for (int by = 0; by < height; by += side)
+    for (int bx = 0; bx < width; bx += side) {
+      double sum = 0.0;
+      size_t n = 0;
+      for (int y = by; y < std::min(by + side, height); ++y)
+        for (int x = bx; x < std::min(bx + side, width); ++x) {
+          float l = luminance[size_t(y) * size_t(width) + size_t(x)];
+          if (!std::isfinite(l)) continue;
+          sum += std::max(double(l), 0.0);
+          ++n;
+        }
+      if (n > 0 && sum > 0.0) zones.push_back(sum / double(n));
+    }
+  if (zones.empty()) return std::nullopt;
+  std::vector<double> sorted = zones;
+  size_t k = std::min(sorted.size() - 1, size_t(0.99 * double(sorted.size())));
+  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+  double floor = 1e-3 * sorted[k], sum = 0.0;
+  size_t n = 0;
+  for (double z : zones)
+    if (z >= floor) {
+      sum += std::log(z);
+      ++n;
+    }
+  double stops = std::log2(kMiddleGrey) - sum / double(n) / std::log(2.0);
+  stops = std::clamp(stops, -kImageExposureRange, kImageExposureRange);
+  return float(std::round(10.0 * stops) / 10.0) + 0.0f;  // + 0: no -0.0
+}
+
 }  // namespace candela

@@ -167,6 +167,14 @@ std::vector<cl_float4> eval(KernelRig& r, const cl::Program& p, const AlbedoTabl
   return flat_eval(r, p, "test_sheen_eval", pairs, r.input(std::vector<dev::Material>{m}), t.ggx, t.sheen, tables);
 }
 
+// m thin-walled, with the base's index of refraction 1 (glass that matches the air; one with
+// a volume would refract nothing: its rough transmission is a delta lobe)
+dev::Material thin_index_matched(dev::Material m) {
+  m.params.gltf.ior = 1.0f;
+  m.flags |= MATERIAL_THIN_WALLED;
+  return m;
+}
+
 const Rgb kGold{0.944, 0.776, 0.373}, kGrey{0.04, 0.04, 0.04}, kBlack{0.0, 0.0, 0.0}, kMixed{0.5, 0.2, 0.8};
 
 // ---- The film ----------------------------------------------------------------------------------
@@ -247,6 +255,37 @@ TEST(Iridescence, FilmStaysInTheUnitRange) {
     }
 }
 
+// A film of index 2 and 300 nm over a base of index 1 (F0 = 0: the base matches the air and
+// reflects nothing) and over one of index 1.5 (F0 = 0.04), at normal and oblique incidence:
+// the device's RGB reflectance against the spectral Airy sum. The reference itself first: at
+// normal incidence over the base of index 1, the film reflects 0.30 at 450 nm, 0.14 at 550 nm
+// and nothing at 600 nm (|r12 + r23 e^(i delta)|^2 / |1 + r12 r23 e^(i delta)|^2, r12 = -r23
+// = -1/3, delta = 4 pi n d / lambda), a blue mirror
+TEST(Iridescence, FilmReflectsOverAnIndexMatchedBase) {
+  Interfaces matched = interfaces(2.0, 0.0, 1.0);
+  EXPECT_NEAR(matched.r12, 1.0 / 9.0, 1e-12);
+  EXPECT_NEAR(matched.r23, 1.0 / 9.0, 1e-12);
+  EXPECT_NEAR(airy(matched, 2.0, 300.0, 450.0), 0.2967, 1e-4);
+  EXPECT_NEAR(airy(matched, 2.0, 300.0, 550.0), 0.1412, 1e-4);
+  EXPECT_NEAR(airy(matched, 2.0, 300.0, 600.0), 0.0, 1e-12);
+  KernelRig& r = kernel_rig("pocl");
+  std::vector<FilmQuery> qs;
+  for (double f0 : {0.0, 0.04})
+    for (double c : {1.0, 0.8, 0.5, 0.25}) qs.push_back({2.0, 300.0, Rgb{f0, f0, f0}, c});
+  std::vector<Rgb> got = device_film(r, qs);
+  for (size_t i = 0; i < qs.size(); ++i) {
+    Rgb want = spectral_film(qs[i].n, qs[i].d, qs[i].f0, qs[i].cos);
+    std::printf("base F0 %.2f, cos %.2f: device %.4f %.4f %.4f, reference %.4f %.4f %.4f\n", qs[i].f0[0], qs[i].cos,
+                got[i][0], got[i][1], got[i][2], want[0], want[1], want[2]);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(got[i][c], want[c], 0.04) << "F0 " << qs[i].f0[0] << ", cos " << qs[i].cos << ", channel " << c;
+  }
+  // Normal incidence over the matched base: a blue mirror, as the reference
+  EXPECT_GT(got[0][2], 0.2);
+  EXPECT_GT(got[0][2], 1.5 * got[0][0]);
+  EXPECT_GT(got[0][2], got[0][1]);
+}
+
 // ---- The BSDF ----------------------------------------------------------------------------------
 
 // Without the albedo table (no multiple scattering) a rough metal's f is its Fresnel term times
@@ -309,6 +348,68 @@ TEST(Iridescence, FresnelIsTheFilmsMix) {
   }
 }
 
+// The exact Fresnel term of a dielectric interface (eta = n_t / n_i), in double
+double fresnel_exact(double c, double eta) {
+  double s2 = (1.0 - c * c) / (eta * eta);
+  if (s2 >= 1.0) return 1.0;
+  double t = std::sqrt(1.0 - s2), rp = (eta * c - t) / (eta * c + t), rs = (c - eta * t) / (c + eta * t);
+  return 0.5 * (rp * rp + rs * rs);
+}
+
+// Smooth glass (transmission 1) under a film of index 2 and 300 nm: the film's reflectance
+// replaces the exact Fresnel term in the split, F = mix(exact, film over F0(ior), factor), for
+// a base of index 1 (the exact term 0) and of index 1.5, thin-walled too (2F / (1 + F) per
+// channel). Every sample is a delta one; a reflection weighs F, a transmission (1 - F) x tint,
+// and reflections are chosen with probability mean(F): energy is conserved channel by channel
+TEST(Iridescence, GlassSplitsByTheFilm) {
+  KernelRig& r = kernel_rig("pocl");
+  const ProgramBuild& p = iridescence_program(r);
+  AlbedoTables t(r, p.program, p.cache_file);
+  struct Case {
+    const char* name;
+    double ior, factor, tint;
+    bool thin;
+  } cases[] = {{"sunglasses: ior 1, factor 1, tint 0.009", 1.0, 1.0, 0.009, false},
+               {"ior 1.5, factor 0.5, tint 0.8", 1.5, 0.5, 0.8, false},
+               {"thin-walled, ior 1, factor 1, tint 0.3", 1.0, 1.0, 0.3, true}};
+  const size_t n = 1 << 14;
+  for (const Case& k : cases)
+    for (double zo : {1.0, 0.7, 0.3}) {
+      SCOPED_TRACE(std::string(k.name) + ", wo.z " + std::to_string(zo));
+      dev::Material m = material(0.0, 0.0, glm::dvec3(k.tint), k.factor, 2.0, 300.0, 1.0);
+      m.params.gltf.ior = float(k.ior);
+      if (k.thin) m.flags |= MATERIAL_THIN_WALLED;
+      glm::dvec3 wo = sphere_direction(zo, 0.3);
+      double f0 = std::pow((k.ior - 1.0) / (k.ior + 1.0), 2.0);
+      Rgb film = device_film(r, {{2.0, 300.0, Rgb{f0, f0, f0}, zo}})[0];
+      Rgb want{};
+      double share = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        double f = (1.0 - k.factor) * fresnel_exact(zo, k.ior) + k.factor * film[c];
+        want[c] = k.thin ? 2.0 * f / (1.0 + f) : f;
+        share += want[c] / 3.0;
+      }
+      if (k.ior == 1.0) EXPECT_GT(want[2], 0.05) << "the film reflects where the bare base would not";
+      std::vector<cl_float4> s = sample(r, p.program, t, m, 0u, wo, n, 11u);
+      size_t reflected = 0;
+      for (size_t i = 0; i < n; ++i) {
+        const cl_float4 &dir = s[3 * i], &f = s[3 * i + 1];
+        ASSERT_EQ(f.s[3], 1.0f) << "a delta sample";
+        bool reflects = dir.s[2] > 0.0f;
+        reflected += reflects;
+        ASSERT_NEAR(dir.s[3], reflects ? share : 1.0 - share, 1e-5);
+        double cos_t = std::fabs(dir.s[2]), eta2 = k.thin ? 1.0 : k.ior * k.ior;
+        for (int c = 0; c < 3; ++c) {
+          double weight = reflects ? f.s[c] * zo : f.s[c] * cos_t * eta2;
+          double expect = reflects ? want[c] : k.tint * (1.0 - want[c]);
+          ASSERT_NEAR(weight, expect, 2e-5 + 2e-4 * expect) << "sample " << i << ", channel " << c;
+        }
+      }
+      double frac = double(reflected) / double(n), se = std::sqrt(share * (1.0 - share) / double(n));
+      EXPECT_NEAR(frac, share, 5.0 * se + 1e-6);
+    }
+}
+
 // bsdf_sample agrees with bsdf_eval and bsdf_pdf, the pdf integrates to 1 less what the GGX
 // lobes send below the horizon, and a chi-square of the sampled directions against the pdf
 TEST(Iridescence, SamplingMatchesThePdf) {
@@ -324,6 +425,8 @@ TEST(Iridescence, SamplingMatchesThePdf) {
       {"half film over half metal r0.5", material(0.5, 0.5, glm::dvec3(0.2, 0.5, 0.8), 0.5, 1.5, 500.0)},
       {"film under a coat r0.4", material(0.0, 0.4, glm::dvec3(0.7), 1.0, 1.3, 300.0, 0.0, 1.0)},
       {"film over rough glass r0.3", material(0.2, 0.3, glm::dvec3(1.0), 1.0, 1.4, 420.0, 1.0)},
+      {"film 2/300 nm over rough thin glass of ior 1 r0.3",
+       thin_index_matched(material(0.0, 0.3, glm::dvec3(0.5), 1.0, 2.0, 300.0, 1.0))},
   };
   std::vector<double> wo_z = {0.8, 0.3, 0.05};
   double alpha = sidak_alpha(1e-3, int(std::size(cases) * wo_z.size()));

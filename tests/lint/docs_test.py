@@ -83,6 +83,9 @@ def problems(files, read, generated=()):
     return out
 
 
+DOCS_LINES, README_LINES, PERFORMANCE_LINES = 3500, 250, 300
+
+
 def main():
     root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), '..', '..')
     files = [os.path.join(root, 'README.md')] + sorted(glob.glob(os.path.join(root, 'docs', '**', '*.md'), recursive=True))
@@ -117,6 +120,17 @@ def main():
                                capture_output=True, text=True)
         if check.returncode != 0:
             found.append('docs/performance.md: ' + (check.stdout + check.stderr).strip())
+    # Sizes: the docs say what a reader needs, once (docs/**/*.md together, README and the
+    # performance page each within its budget)
+    def lines(p):
+        return read(p).count('\n')
+    docs = [f for f in files if not f.endswith('README.md')]
+    for what, n, limit in (('docs/**/*.md together', sum(lines(f) for f in docs), DOCS_LINES),
+                           ('README.md', lines(files[0]), README_LINES),
+                           ('docs/performance.md', lines(os.path.join(root, 'docs', 'performance.md')),
+                            PERFORMANCE_LINES)):
+        if n > limit:
+            found.append(f'{what}: {n} lines, over the budget of {limit}')
     for p in found:
         print(os.path.relpath(p, root) if p.startswith(root) else p)
     print(f'docs_test: {len(files)} documents, {len(found)} problem(s)')

@@ -45,7 +45,7 @@ const std::vector<FurnaceCase>& furnace_cases() {
        1e-6},
       {"smooth_glass", glass(0.0, true), 1e-5},
       // glTF plastic (ior 1.5): the diffuse base gets exactly what the specular layer does not
-      // reflect (cl/bsdf/bsdf_gltf.cl's layering), within the albedo table's accuracy
+      // reflect (cl/bsdf/gltf/mixture.cl's layering), within the albedo table's accuracy
       {"white_plastic_r05", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}}, 3e-3},
       {"white_smooth_plastic", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}}}, 1e-4},
       {"smooth_thin_glass", glass(0.0, false), 1e-5},

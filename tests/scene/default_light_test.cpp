@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <vector>
 
 #include "base/error.hpp"
 #include "gltf/gltf_loader.hpp"
@@ -127,6 +129,43 @@ TEST(DefaultLight, AutomaticExposureBringsBrightOwnLightsToTheStudiosLevel) {
   // Nor when the scene's own environment, or the studio, lights it
   EXPECT_FALSE(automatic_exposure(choose_default_light(floor_under_light(1e6f, 0.1f), DefaultLight::Auto, true, 1.0)));
   EXPECT_FALSE(automatic_exposure(choose_default_light(floor_under_light(1e6f, 0.1f), DefaultLight::On, false, 1.0)));
+}
+
+// The exposure metered from the image: the log-average of its zones' mean luminance (64 x 64
+// pixels: zones of 4 x 4) goes to middle grey (0.18), to 0.1 stop; black zones (a black
+// background) and those under 1/1000 of the 99th percentile are left out, noise within a zone
+// is averaged, a few bright highlights barely move it (they clip), and it is nullopt for a
+// black image
+TEST(DefaultLight, ImageExposureMapsTheZonesLogAverageToMiddleGrey) {
+  const int w = 64, h = 64;
+  auto image = [&](const std::function<float(int, int)>& at) {
+    std::vector<float> v(size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) v[size_t(y) * w + size_t(x)] = at(x, y);
+    return v;
+  };
+  std::vector<float> grey = image([](int, int) { return 0.045f; });  // two stops under middle grey
+  ASSERT_TRUE(image_exposure(grey, w, h));
+  EXPECT_FLOAT_EQ(*image_exposure(grey, w, h), 2.0f);
+  // Three quarters of the frame a black background, a pitch-black shadow, a non-finite pixel
+  std::vector<float> quadrant = image([](int x, int y) { return x < 32 && y < 32 ? 0.045f : 0.0f; });
+  quadrant[size_t(63) * w + 63] = 1e-7f;
+  quadrant[0] = std::nanf("");
+  EXPECT_FLOAT_EQ(*image_exposure(quadrant, w, h), 2.0f);
+  // Noise: one pixel in 16 at 16 x 0.045, the others black, meters as 0.045 does
+  std::vector<float> sparse = image([](int x, int y) { return x % 4 == 1 && y % 4 == 2 ? 16.0f * 0.045f : 0.0f; });
+  EXPECT_FLOAT_EQ(*image_exposure(sparse, w, h), 2.0f);
+  // Zones alternately 4x brighter and 4x darker than 0.72: the log-average is 0.72, -2 stops
+  std::vector<float> checker = image([](int x, int y) { return (x / 4 + y / 4) % 2 ? 0.72f * 4.0f : 0.72f / 4.0f; });
+  EXPECT_FLOAT_EQ(*image_exposure(checker, w, h), -2.0f);
+  // Five emitters seen at radiance 1000 in one zone: under 0.1 stop darker
+  std::vector<float> highlights = grey;
+  for (int k = 0; k < 5; ++k) highlights[size_t(k)] = 1000.0f;
+  EXPECT_GE(*image_exposure(highlights, w, h), 1.9f);
+  EXPECT_FALSE(image_exposure(std::vector<float>(size_t(w) * h, 0.0f), w, h));
+  EXPECT_FALSE(image_exposure({}, 0, 0));
+  // Within [-20, 20] stops
+  EXPECT_FLOAT_EQ(*image_exposure(std::vector<float>(size_t(w) * h, 1e12f), w, h), -20.0f);
 }
 
 // Where the eight corners of b project in the camera's image (x right, y up, in units of

@@ -4,8 +4,10 @@
 //             specular colour and factor enter through spec_f0 and spec_f90 (bsdf_gltf_params)
 //   film:     (CD_FEATURE_IRIDESCENCE) KHR_materials_iridescence mixes a thin film's
 //             reflectance (iridescence.cl) into F_m and F_d: F = mix(F, film over that base,
-//             factor), the dielectric's film scaled by its specular factor. The layering (W,
-//             the albedo weights) and the multiple scattering keep the base's Schlick terms
+//             factor), the dielectric's film scaled by its specular factor; the glass's split
+//             between reflection and transmission takes the film too (glass.cl), for every
+//             base index, 1 included. The layering (W, the albedo weights) and the multiple
+//             scattering keep the base's own Fresnel terms
 
 // The metal's and the plastic's specular Fresnel terms F_m and F_d at cosine cos_h (wo.h);
 // with KHR_materials_iridescence each is mixed with the film over its base, for the bases
