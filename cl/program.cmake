@@ -1,11 +1,12 @@
 # The renderer's OpenCL program: every kernel source in program order (each file may use
-# what the files before it define; shared/device_types.h comes first). A new .cl file is
+# what the files before it define; shared/gltf_params.h and device_types.h come first). A new .cl file is
 # added here, in the folder of its subsystem; a component of the glTF mixture
 # (cl/bsdf/gltf/NAME.cl) between gltf/mixture.cl and bsdf_gltf.cl, after the components it
 # uses. The files up to and including cl/bsdf/energy_dielectric.cl (kLastTablesFile,
 # host/device/kernel_sources.hpp) also make the tables program, which holds every table
 # kernel (energy.cl, sheen.cl, energy_dielectric.cl).
 set(CANDELA_CL_SOURCES
+  cl/shared/gltf_params.h
   cl/shared/device_types.h
   cl/shared/color.h
   cl/shared/light_profiles.h

@@ -16,35 +16,32 @@ typedef struct {
   float eta;   // relative index of refraction across a transmission, else 1
 } BsdfSample;
 
-// Parameters of a MATERIAL_GLTF BSDF at a shading point (bsdf_gltf.cl)
+// Parameters of a MATERIAL_GLTF BSDF at a shading point (bsdf_gltf.cl): the per-hit values of
+// GLTF_PARAMS (cl/shared/gltf_params.h; each compiled in with its feature, loaded by
+// bsdf_gltf_params), then what the base and the components derive from the parameters
+#define GLTF_VALUE_x(name) float name;
+#define GLTF_VALUE_y(name) float name;
+#define GLTF_VALUE_z(name) float name;
+#define GLTF_VALUE_w(name) float name;
+#define GLTF_VALUE_factor(name) float name;
+#define GLTF_VALUE_xyz(name) float3 name;
+#define GLTF_VALUE__(name)
+#define GLTF_VALUE(_, name, n, def, lo, hi, ext, key, slot, load, feature, role) CD_IF(feature)(GLTF_VALUE_##load(name))
 typedef struct {
-  float metallic;
+  GLTF_PARAMS(GLTF_VALUE)
   Ggx ggx;         // specular roughness, ax along frame.t
   float eta;       // relative index across the surface seen from wo: eta_t / eta_i
   float3 spec_f0;  // dielectric reflectance at normal incidence (KHR_materials_ior, _specular)
   float spec_f90;  // dielectric reflectance at grazing incidence (KHR_materials_specular)
-  float transmission;
-  bool thin;   // a thin-walled sheet: transmission does not bend
-  float coat;  // clearcoat weight
+  bool thin;       // a thin-walled sheet: transmission does not bend
   Ggx coat_ggx;
   float3 coat_n;         // the clearcoat layer's normal (world; clearcoatNormalTexture, else the unmapped normal)
   bool coat_own_normal;  // coat_n may differ from frame.n (either layer is normal-mapped)
 #if CD_FEATURE_SHEEN
-  float3 sheen;                        // KHR_materials_sheen colour (0: no sheen layer)
-  float sheen_roughness;               // its roughness r (alpha = r^2)
-  __global const float* sheen_albedo;  // its albedo table (sheen.cl); 0: no albedo scaling
-#endif
-#if CD_FEATURE_DIFFUSE_TRANSMISSION
-  float diffuse_transmission;         // KHR_materials_diffuse_transmission: the diffuse part's share transmitted
-  float3 diffuse_transmission_color;  // its colour
-#endif
-#if CD_FEATURE_DIFFUSE_ROUGHNESS
-  float diffuse_roughness;  // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON; 0: Lambert)
+  __global const float* sheen_albedo;  // the sheen's albedo table (sheen.cl); 0: no albedo scaling
 #endif
 #if CD_FEATURE_IRIDESCENCE
-  float iridescence;      // KHR_materials_iridescence: the film's share of the metal and specular Fresnel (0: none)
-  float iridescence_ior;  // the film's index
-  float iridescence_thickness;  // its thickness (nm)
+  float iridescence_thickness;  // the film's thickness (nm)
 #endif
 } GltfBsdf;
 

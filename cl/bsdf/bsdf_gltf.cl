@@ -3,19 +3,28 @@
 // cl/bsdf/gltf/ composed through their lists (gltf/mixture.cl): the weights at wo, the
 // sum of their terms of f and pdf, their lobes, and the choice of one to sample.
 
-// The material at the hit: factors times textures. The base's parameters, which the metal,
-// spec and glass share; then each component's own (gltf_NAME_params), and the Fresnel
-// terms' modifiers. KHR_materials_specular gives F0 = min(F0(ior) x colour, 1) x specular and
-// F90 = specular. Where no component but the diffuse base is present (each returns whether
-// it is) the BSDF is exactly Lambertian: MATERIAL_DIFFUSE takes the short path.
+// The material at the hit: factors times textures. First the per-hit values of GLTF_PARAMS
+// (their lists' loads), then the base's parameters, which the metal, spec and glass share;
+// then each component's own (gltf_NAME_params), and the Fresnel terms' modifiers.
+// KHR_materials_specular gives F0 = min(F0(ior) x colour, 1) x specular and F90 = specular.
+// Where no component but the diffuse base is present (each returns whether it is) the BSDF
+// is exactly Lambertian: MATERIAL_DIFFUSE takes the short path.
+#define GLTF_LOAD_x(name, slot) lobe->name = g->name * bsdf_texture(sc, m, slot, s).x;
+#define GLTF_LOAD_y(name, slot) lobe->name = g->name * bsdf_texture(sc, m, slot, s).y;
+#define GLTF_LOAD_z(name, slot) lobe->name = g->name * bsdf_texture(sc, m, slot, s).z;
+#define GLTF_LOAD_w(name, slot) lobe->name = g->name * bsdf_texture(sc, m, slot, s).w;
+#define GLTF_LOAD_xyz(name, slot) lobe->name = load3(g->name) * bsdf_texture(sc, m, slot, s).xyz;
+#define GLTF_LOAD_factor(name, slot) lobe->name = g->name;
+#define GLTF_LOAD__(name, slot)
+#define GLTF_LOAD(_, name, n, def, lo, hi, ext, key, slot, load, feature, role) \
+  CD_IF(feature)(GLTF_LOAD_##load(name, slot))
 void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
   __global const GltfMaterial* g = &m->params.gltf;
   GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->metallic = g->metallic * bsdf_texture(sc, m, TEX_METALLIC_ROUGHNESS, s).z;
+  GLTF_PARAMS(GLTF_LOAD)
   lobe->ggx = bsdf_microfacet_at(sc, m, s, g->roughness, g->anisotropy_strength, g->anisotropy_rotation, &b->frame);
-  lobe->transmission = g->transmission * bsdf_texture(sc, m, TEX_TRANSMISSION, s).x;
   lobe->thin = (m->flags & MATERIAL_THIN_WALLED) != 0u;
-  float spec = g->specular_color[3] * bsdf_texture(sc, m, TEX_SPECULAR, s).w;
+  float spec = g->specular * bsdf_texture(sc, m, TEX_SPECULAR, s).w;
   float ior = g->ior;
 #if CD_FEATURE_DISPERSION
   if (b->channel >= 0 && g->dispersion > 0.0f)
@@ -28,9 +37,9 @@ void bsdf_gltf_params(const SceneData* sc, __global const Material* m, const Sur
   // A thin sheet has air on both sides: light meets air -> glass from either face
   lobe->eta = b->entering || lobe->thin ? ior : 1.0f / ior;
   bool present = false;  // a component beyond the Lambertian base at this point
-#define GLTF_PARAMS(id, name, kind) present = gltf_##name##_params(sc, m, s, b) || present;
-  GLTF_COMPONENTS(GLTF_PARAMS)
-#undef GLTF_PARAMS
+#define GLTF_COMPONENT_PARAMS(id, name, kind) present = gltf_##name##_params(sc, m, s, b) || present;
+  GLTF_COMPONENTS(GLTF_COMPONENT_PARAMS)
+#undef GLTF_COMPONENT_PARAMS
   gltf_fresnel_params(sc, m, s, b);
   if (!present) b->type = MATERIAL_DIFFUSE;
 }
@@ -73,7 +82,7 @@ float3 gltf_eval_at(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, floa
   acc.e5_i = 0.0f;
   if (wi.z > 0.0f) {
     // The microfacet terms only where a specular layer exists (not for pure Lambert)
-    acc.glossy = lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->coat > 0.0f;
+    acc.glossy = lobe->metallic > 0.0f || lobe->spec_f90 > 0.0f || lobe->clearcoat > 0.0f;
     if (acc.glossy) acc.d = ggx_reflection_eval(lobe->ggx, wo, wi, &acc.p, &acc.cos_h);
     // E(wi) and E5(wi) of the specular lobe, looked up once for the layering and f_ms
     acc.e5_i = schlick_weight(wi.z);

@@ -68,26 +68,7 @@
 #define MATERIAL_NULL_BOUNDARY 16u  // invisible (index-matched) surface bounding Material.medium
 #define MATERIAL_UNLIT 32u          // KHR_materials_unlit: shows its base colour, ends paths
 
-// Texture slots of a material (Material.textures)
-#define TEX_BASE_COLOR 0
-#define TEX_METALLIC_ROUGHNESS 1  // B metallic, G roughness
-#define TEX_NORMAL 2
-#define TEX_EMISSION 3
-#define TEX_TRANSMISSION 4                 // R
-#define TEX_SPECULAR 5                     // A
-#define TEX_SPECULAR_COLOR 6               // RGB
-#define TEX_CLEARCOAT 7                    // R
-#define TEX_CLEARCOAT_ROUGHNESS 8          // G
-#define TEX_ANISOTROPY 9                   // RG direction in tangent space, B strength
-#define TEX_SHEEN_COLOR 10                 // RGB (sRGB)
-#define TEX_SHEEN_ROUGHNESS 11             // A
-#define TEX_CLEARCOAT_NORMAL 12            // tangent-space normal of the clearcoat layer
-#define TEX_DIFFUSE_TRANSMISSION 13        // A
-#define TEX_DIFFUSE_TRANSMISSION_COLOR 14  // RGB (sRGB)
-#define TEX_IRIDESCENCE 15                 // R
-#define TEX_IRIDESCENCE_THICKNESS 16       // G
-#define TEX_DIFFUSE_ROUGHNESS 17           // R
-#define TEX_SLOTS 18
+// Texture slots of a material (Material.textures): GLTF_TEXTURES (gltf_params.h)
 
 // Light types. CD_LIGHTS: X(id, name, feature), one entry per type, generates every dispatch
 // on Light.type (cl/lights/lights.cl; on the host light_power, light_bounds and the name
@@ -253,20 +234,7 @@ typedef struct {
   float m[6];
 } TextureRef;
 
-// Parameters of a MATERIAL_GLTF material, 112 bytes; factors multiply their texture slots
-typedef struct {
-  float ior;  // KHR_materials_ior (1.5)
-  float metallic, roughness, transmission;
-  float specular_color[4];  // KHR_materials_specular: rgb colour factor, w = specular factor
-  float clearcoat, clearcoat_roughness, anisotropy_strength, anisotropy_rotation;
-  float sheen[4];                 // KHR_materials_sheen: rgb colour factor, w = sheen roughness factor
-  float diffuse_transmission[4];  // KHR_materials_diffuse_transmission: rgb colour factor, w = factor
-  float clearcoat_normal_scale;   // KHR_materials_clearcoat clearcoatNormalTexture.scale
-  float dispersion;               // KHR_materials_dispersion: 20 / Abbe number (0: none)
-  float diffuse_roughness;        // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON)
-  unsigned int pad;
-  float iridescence[4];  // KHR_materials_iridescence: factor, film ior, thickness minimum, maximum (nm)
-} GltfMaterial;
+// Parameters of a MATERIAL_GLTF material: GltfMaterial, generated from GLTF_PARAMS (gltf_params.h)
 
 // Parameters of a MATERIAL_CONDUCTOR material, 48 bytes: complex index eta + i k per channel
 // (w unused), GGX roughness and KHR_materials_anisotropy as in GltfMaterial
@@ -277,14 +245,14 @@ typedef struct {
   unsigned int pad;
 } ConductorMaterial;
 
-// A material type's own parameters (Material.type selects the member), 112 bytes
+// A material type's own parameters (Material.type selects the member), GltfMaterial's size
 typedef union {
   GltfMaterial gltf;
   ConductorMaterial conductor;
 } MaterialParams;
 
-// Material, 736 bytes: what every type has, then its type's parameters. Colours are linear
-// RGB; factors multiply their texture slots.
+// Material: what every type has (48 bytes), then its type's parameters and the texture slots.
+// Colours are linear RGB; factors multiply their texture slots.
 typedef struct {
   unsigned int type;   // MATERIAL_*
   unsigned int flags;  // MATERIAL_DOUBLE_SIDED | ...
@@ -560,18 +528,14 @@ static inline int environment_guide_cells(int n) { return (n + 3) / 4 > 1 ? (n +
     FIELD(BvhTriangle, v2, 32)                                                                                \
   SIZE(Prim, 16) FIELD(Prim, material, 12)                                                                    \
   SIZE(TextureRef, 32) FIELD(TextureRef, texcoord, 4) FIELD(TextureRef, m, 8)                                 \
-  SIZE(GltfMaterial, 112) FIELD(GltfMaterial, metallic, 4) FIELD(GltfMaterial, specular_color, 16)            \
-    FIELD(GltfMaterial, clearcoat, 32) FIELD(GltfMaterial, anisotropy_rotation, 44)                           \
-    FIELD(GltfMaterial, sheen, 48) FIELD(GltfMaterial, diffuse_transmission, 64)                              \
-    FIELD(GltfMaterial, clearcoat_normal_scale, 80) FIELD(GltfMaterial, dispersion, 84)                       \
-    FIELD(GltfMaterial, diffuse_roughness, 88) FIELD(GltfMaterial, pad, 92)                                   \
-    FIELD(GltfMaterial, iridescence, 96)                                                                      \
+  GLTF_MATERIAL_LAYOUT(SIZE, FIELD)                                                                           \
   SIZE(ConductorMaterial, 48) FIELD(ConductorMaterial, k, 16) FIELD(ConductorMaterial, roughness, 32)         \
     FIELD(ConductorMaterial, pad, 44)                                                                         \
-  SIZE(MaterialParams, 112)                                                                                   \
-  SIZE(Material, 736) FIELD(Material, normal_scale, 12) FIELD(Material, base_color, 16)                       \
-    FIELD(Material, emission, 32) FIELD(Material, medium, 44) FIELD(Material, params, 48)                     \
-    FIELD(Material, textures, 160)                                                                            \
+  SIZE(MaterialParams, GLTF_MATERIAL_BYTES)                                                                   \
+  SIZE(Material, 48 + GLTF_MATERIAL_BYTES + 32 * TEX_SLOTS) FIELD(Material, normal_scale, 12)                \
+    FIELD(Material, base_color, 16) FIELD(Material, emission, 32) FIELD(Material, medium, 44)                 \
+    FIELD(Material, params, 48)                                                                               \
+    FIELD(Material, textures, 48 + GLTF_MATERIAL_BYTES)                                                      \
   SIZE(TextureInfo, 16) FIELD(TextureInfo, flags, 12)                                                         \
   SIZE(Texel8, 4) FIELD(Texel8, a, 3)                                                                         \
   SIZE(TexelF, 16)                                                                                            \

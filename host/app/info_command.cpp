@@ -87,24 +87,9 @@ void print_lights(const Scene& s) {
 }
 
 void print_materials(const Scene& s) {
-  const char* kSlots[TEX_SLOTS] = {"base colour",
-                                   "metallic-roughness",
-                                   "normal",
-                                   "emission",
-                                   "transmission",
-                                   "specular",
-                                   "specular colour",
-                                   "clearcoat",
-                                   "clearcoat roughness",
-                                   "anisotropy",
-                                   "sheen colour",
-                                   "sheen roughness",
-                                   "clearcoat normal",
-                                   "diffuse transmission",
-                                   "diffuse transmission colour",
-                                   "iridescence",
-                                   "iridescence thickness",
-                                   "diffuse roughness"};
+#define CD_SLOT_NAME(slot, name, ...) name,
+  const char* kSlots[TEX_SLOTS] = {GLTF_TEXTURES(CD_SLOT_NAME)};
+#undef CD_SLOT_NAME
   size_t n = s.materials.size() - 1;  // the last is the glTF default material
   std::printf("materials: %zu\n", n);
   for (size_t i = 0; i < n; ++i) {
@@ -113,8 +98,9 @@ void print_materials(const Scene& s) {
     for (int k = 0; k < TEX_SLOTS; ++k)
       if (m.texture(k).index != NO_TEXTURE) textures += std::string(textures.empty() ? "" : ", ") + kSlots[k];
     char dispersion[48] = "", diffuse_roughness[48] = "";
-    if (m.has_dispersion()) std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
-    if (m.has_diffuse_roughness())
+    if (m.needs("CD_FEATURE_DISPERSION"))
+      std::snprintf(dispersion, sizeof dispersion, ", dispersion %.3g", m.dispersion);
+    if (m.needs("CD_FEATURE_DIFFUSE_ROUGHNESS"))
       std::snprintf(diffuse_roughness, sizeof diffuse_roughness, ", diffuse roughness %.3g", m.diffuse_roughness);
     std::printf("  %zu: %s %s material, metallic %.3g, roughness %.3g%s%s%s%s%s%s%s\n", i,
                 quoted_or(m.name, "(unnamed)").c_str(), or_unknown(dev::material_type_name(m.type)), m.metallic,

@@ -13,6 +13,14 @@
 
 #include "base/uninit_vector.hpp"
 
+// The glTF material's lists: the TEX_* slots are visible throughout namespace candela
+namespace candela {
+#include "cl/shared/gltf_params.h"
+namespace dev {
+using candela::GltfMaterial;
+}
+}  // namespace candela
+
 namespace candela::dev {
 #include "cl/shared/color.h"
 #include "cl/shared/device_types.h"
@@ -111,6 +119,9 @@ inline SpotCone spot_cone(double inner_cone, double outer_cone) {
 #define CD_FEATURE_NAME(name, macro, fallback, needs) #name,
 constexpr const char* kSceneFeatureNames[] = {CD_SCENE_FEATURES(CD_FEATURE_NAME)};
 #undef CD_FEATURE_NAME
+#define CD_FEATURE_MACRO(name, macro, fallback, needs) #macro,
+constexpr const char* kSceneFeatureMacros[] = {CD_SCENE_FEATURES(CD_FEATURE_MACRO)};
+#undef CD_FEATURE_MACRO
 
 // The name of material or light type `type`; nullptr for an unknown one
 constexpr const char* material_type_name(unsigned type) {

@@ -72,29 +72,17 @@ dev::TextureRef compile_texture_ref(const TextureSlot& r) {
 // The parameters of each material type (CD_MATERIALS), into Material.params
 void compile_material_diffuse(const MaterialDesc&, dev::Material*) {}
 
+// GLTF_PARAMS, each factor as the loader read it
+void copy_factor(float& to, float v) { to = v; }
+void copy_factor(float (&to)[3], const glm::vec3& v) {
+  for (int c = 0; c < 3; ++c) to[c] = v[c];
+}
+
 void compile_material_gltf(const MaterialDesc& m, dev::Material* d) {
   dev::GltfMaterial& g = d->params.gltf;
-  g.ior = m.ior;
-  g.metallic = m.metallic;
-  g.roughness = m.roughness;
-  g.transmission = m.transmission;
-  for (int c = 0; c < 3; ++c) g.specular_color[c] = m.specular_color[c];
-  g.specular_color[3] = m.specular;
-  g.clearcoat = m.clearcoat;
-  g.clearcoat_roughness = m.clearcoat_roughness;
-  g.anisotropy_strength = m.anisotropy_strength;
-  g.anisotropy_rotation = m.anisotropy_rotation;
-  for (int c = 0; c < 3; ++c) g.sheen[c] = m.sheen_color[c];
-  g.sheen[3] = m.sheen_roughness;
-  for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = m.diffuse_transmission_color[c];
-  g.diffuse_transmission[3] = m.diffuse_transmission;
-  g.diffuse_roughness = m.diffuse_roughness;
-  g.clearcoat_normal_scale = m.clearcoat_normal_scale;
-  g.dispersion = m.has_dispersion() ? m.dispersion : 0.0f;  // only a refracting volume disperses
-  g.iridescence[0] = m.iridescence;
-  g.iridescence[1] = m.iridescence_ior;
-  g.iridescence[2] = m.iridescence_thickness_min;
-  g.iridescence[3] = m.iridescence_thickness_max;
+#define CD_COPY_PARAM(_, name, ...) copy_factor(g.name, m.name);
+  GLTF_PARAMS(CD_COPY_PARAM)
+#undef CD_COPY_PARAM
 }
 
 void compile_material_conductor(const MaterialDesc& m, dev::Material* d) {

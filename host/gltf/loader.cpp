@@ -20,17 +20,7 @@ bool supported_extension(const std::string& name) {
   static const std::set<std::string> kSupported = {"KHR_materials_emissive_strength",
                                                    "KHR_texture_transform",
                                                    "KHR_mesh_quantization",
-                                                   "KHR_materials_ior",
-                                                   "KHR_materials_specular",
-                                                   "KHR_materials_transmission",
                                                    "KHR_materials_volume",
-                                                   "KHR_materials_clearcoat",
-                                                   "KHR_materials_anisotropy",
-                                                   "KHR_materials_sheen",
-                                                   "KHR_materials_diffuse_transmission",
-                                                   "KHR_materials_diffuse_roughness",
-                                                   "KHR_materials_dispersion",
-                                                   "KHR_materials_iridescence",
                                                    "KHR_materials_unlit",
                                                    "KHR_lights_punctual",
                                                    "KHR_draco_mesh_compression",
@@ -39,6 +29,11 @@ bool supported_extension(const std::string& name) {
                                                    "EXT_texture_webp",
                                                    "KHR_materials_pbrSpecularGlossiness",
                                                    "KHR_materials_variants"};
+  // and the material extensions whose factors GLTF_PARAMS lists
+#define CD_PARAM_EXTENSION(_, param, n, value, lo, hi, ext, ...) \
+  if (name == #ext && name != "CORE") return true;
+  GLTF_PARAMS(CD_PARAM_EXTENSION)
+#undef CD_PARAM_EXTENSION
   return kSupported.count(name) > 0;
 }
 

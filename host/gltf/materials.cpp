@@ -2,6 +2,7 @@
 // extension, candela's conductor extras, and the medium a closed surface holds.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "base/error.hpp"
 #include "gltf/reader.hpp"
@@ -67,22 +68,31 @@ void read_alpha(const tinygltf::Material& gm, MaterialDesc* m) {
   m->alpha_cutoff = float(gm.alphaCutoff);
 }
 
-void read_ior(const tinygltf::Material& gm, MaterialDesc* m) {
-  m->ior = float(number_or(extension(gm, "KHR_materials_ior"), "ior", -1, 1.5));
+// The factors and textures of the KHR_materials_* extensions listed in GLTF_PARAMS and
+// GLTF_TEXTURES (cl/shared/gltf_params.h), in the lists' order; the CORE ones are read by hand
+bool core(const char* extension) { return std::strcmp(extension, "CORE") == 0; }
+
+void read_factor(const tinygltf::Value& ext, const char* key, float fallback, float* to) {
+  *to = float(number_or(ext, key, -1, fallback));
+}
+void read_factor(const tinygltf::Value& ext, const char* key, float fallback, glm::vec3* to) {
+  for (int c = 0; c < 3; ++c) (*to)[c] = float(number_or(ext, key, c, fallback));
 }
 
-void read_specular(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& spec = extension(gm, "KHR_materials_specular");
-  m->specular = float(number_or(spec, "specularFactor", -1, 1.0));
-  for (int c = 0; c < 3; ++c) m->specular_color[c] = float(number_or(spec, "specularColorFactor", c, 1.0));
-  set_texture_slot(ctx, m, TEX_SPECULAR, spec, "specularTexture", false);
-  set_texture_slot(ctx, m, TEX_SPECULAR_COLOR, spec, "specularColorTexture", true);
-}
-
-void read_transmission(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& tr = extension(gm, "KHR_materials_transmission");
-  m->transmission = float(number_or(tr, "transmissionFactor", -1, 0.0));
-  set_texture_slot(ctx, m, TEX_TRANSMISSION, tr, "transmissionTexture", false);
+void read_extensions(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
+#define CD_READ_PARAM(_, name, n, value, lo, hi, ext, key, ...) \
+  if (!core(#ext)) read_factor(extension(gm, #ext), #key, value, &m->name);
+  GLTF_PARAMS(CD_READ_PARAM)
+#undef CD_READ_PARAM
+#define CD_READ_TEXTURE(slot, name, ext, key, srgb) \
+  if (!core(#ext)) set_texture_slot(ctx, m, slot, extension(gm, #ext), #key, srgb);
+  GLTF_TEXTURES(CD_READ_TEXTURE)
+#undef CD_READ_TEXTURE
+  // The coat's own normal map's scale (normalTextureInfo); without the map the coat has the
+  // unmapped normal, whatever the base's normalTexture
+  const tinygltf::Value& cc = extension(gm, "KHR_materials_clearcoat");
+  if (cc.Has("clearcoatNormalTexture"))
+    m->clearcoat_normal_scale = float(number_or(cc.Get("clearcoatNormalTexture"), "scale", -1, 1.0));
 }
 
 // KHR_materials_volume's thickness: a solid or a thin sheet (its attenuation: read_interior)
@@ -91,70 +101,8 @@ void read_volume(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m
   m->thin_walled = !(number_or(vol, "thicknessFactor", -1, 0.0) > 0.0);
   if (vol.Has("thicknessTexture"))
     ctx.warn.add("KHR_materials_volume thicknessTexture is not used: a path tracer traces the real thickness");
-}
-
-void read_clearcoat(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& cc = extension(gm, "KHR_materials_clearcoat");
-  m->clearcoat = float(number_or(cc, "clearcoatFactor", -1, 0.0));
-  m->clearcoat_roughness = float(number_or(cc, "clearcoatRoughnessFactor", -1, 0.0));
-  set_texture_slot(ctx, m, TEX_CLEARCOAT, cc, "clearcoatTexture", false);
-  set_texture_slot(ctx, m, TEX_CLEARCOAT_ROUGHNESS, cc, "clearcoatRoughnessTexture", false);
-  // The coat's own normal map (normalTextureInfo: texCoord, scale, KHR_texture_transform);
-  // without it the coat has the unmapped normal, whatever the base's normalTexture
-  set_texture_slot(ctx, m, TEX_CLEARCOAT_NORMAL, cc, "clearcoatNormalTexture", false);
-  if (cc.Has("clearcoatNormalTexture"))
-    m->clearcoat_normal_scale = float(number_or(cc.Get("clearcoatNormalTexture"), "scale", -1, 1.0));
-}
-
-void read_anisotropy(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& an = extension(gm, "KHR_materials_anisotropy");
-  m->anisotropy_strength = float(number_or(an, "anisotropyStrength", -1, 0.0));
-  m->anisotropy_rotation = float(number_or(an, "anisotropyRotation", -1, 0.0));
-  set_texture_slot(ctx, m, TEX_ANISOTROPY, an, "anisotropyTexture", false);
-}
-
-// KHR_materials_sheen: colour (sRGB texture RGB) and roughness (texture A)
-void read_sheen(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& sh = extension(gm, "KHR_materials_sheen");
-  for (int c = 0; c < 3; ++c) m->sheen_color[c] = float(number_or(sh, "sheenColorFactor", c, 0.0));
-  m->sheen_roughness = float(number_or(sh, "sheenRoughnessFactor", -1, 0.0));
-  set_texture_slot(ctx, m, TEX_SHEEN_COLOR, sh, "sheenColorTexture", true);
-  set_texture_slot(ctx, m, TEX_SHEEN_ROUGHNESS, sh, "sheenRoughnessTexture", false);
-}
-
-// KHR_materials_dispersion: 20 / Abbe number, acting on the volume's refraction
-void read_dispersion(const tinygltf::Material& gm, MaterialDesc* m) {
-  m->dispersion = float(number_or(extension(gm, "KHR_materials_dispersion"), "dispersion", -1, 0.0));
-}
-
-// KHR_materials_diffuse_transmission: the factor (texture A) and the colour (sRGB texture RGB)
-void read_diffuse_transmission(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& dt = extension(gm, "KHR_materials_diffuse_transmission");
-  m->diffuse_transmission = float(number_or(dt, "diffuseTransmissionFactor", -1, 0.0));
-  for (int c = 0; c < 3; ++c)
-    m->diffuse_transmission_color[c] = float(number_or(dt, "diffuseTransmissionColorFactor", c, 1.0));
-  set_texture_slot(ctx, m, TEX_DIFFUSE_TRANSMISSION, dt, "diffuseTransmissionTexture", false);
-  set_texture_slot(ctx, m, TEX_DIFFUSE_TRANSMISSION_COLOR, dt, "diffuseTransmissionColorTexture", true);
-}
-
-// KHR_materials_iridescence: the film's factor (texture R), index, and thickness from minimum
-// to maximum (texture G; without it the maximum)
-void read_iridescence(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& ir = extension(gm, "KHR_materials_iridescence");
-  m->iridescence = float(number_or(ir, "iridescenceFactor", -1, 0.0));
-  m->iridescence_ior = float(number_or(ir, "iridescenceIor", -1, 1.3));
-  m->iridescence_thickness_min = float(number_or(ir, "iridescenceThicknessMinimum", -1, 100.0));
-  m->iridescence_thickness_max = float(number_or(ir, "iridescenceThicknessMaximum", -1, 400.0));
-  set_texture_slot(ctx, m, TEX_IRIDESCENCE, ir, "iridescenceTexture", false);
-  set_texture_slot(ctx, m, TEX_IRIDESCENCE_THICKNESS, ir, "iridescenceThicknessTexture", false);
-}
-
-// KHR_materials_diffuse_roughness: the diffuse base's roughness (texture R), shaded by the
-// energy-preserving Oren-Nayar lobe (EON) of OpenPBR
-void read_diffuse_roughness(ReadContext& ctx, const tinygltf::Material& gm, MaterialDesc* m) {
-  const tinygltf::Value& dr = extension(gm, "KHR_materials_diffuse_roughness");
-  m->diffuse_roughness = float(number_or(dr, "diffuseRoughnessFactor", -1, 0.0));
-  set_texture_slot(ctx, m, TEX_DIFFUSE_ROUGHNESS, dr, "diffuseRoughnessTexture", false);
+  // KHR_materials_dispersion acts on a volume's refraction only
+  if (!(m->transmission > 0.0f && !m->thin_walled)) m->dispersion = 0.0f;
 }
 
 // KHR_materials_unlit: the base colour (factor, texture, vertex colour) is the radiance seen
@@ -221,36 +169,23 @@ void read_interior(ReadContext& ctx, const tinygltf::Material& gm, const std::st
   ctx.scene.media.push_back(std::move(md));
 }
 
+bool within(float v, float lo, float hi) { return v >= lo && v <= hi; }
+bool within(const glm::vec3& v, float lo, float hi) {
+  return within(v.x, lo, hi) && within(v.y, lo, hi) && within(v.z, lo, hi);
+}
+
 void check_ranges(const std::string& name, MaterialDesc* m) {
-  auto in = [&](float v, float lo, float hi, const char* what) {
-    if (!(v >= lo && v <= hi))
+  auto in = [&](const auto& v, float lo, float hi, const char* what) {
+    if (!within(v, lo, hi))
       throw Error(name + ": " + what + " must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   };
   for (int c = 0; c < 4; ++c) in(m->base_color[c], 0.0f, 1.0f, "baseColorFactor");
-  in(m->metallic, 0.0f, 1.0f, "metallicFactor");
-  in(m->roughness, 0.0f, 1.0f, "roughnessFactor");
-  in(m->transmission, 0.0f, 1.0f, "transmissionFactor");
-  in(m->specular, 0.0f, 1.0f, "specularFactor");
-  in(m->clearcoat, 0.0f, 1.0f, "clearcoatFactor");
-  in(m->clearcoat_roughness, 0.0f, 1.0f, "clearcoatRoughnessFactor");
-  in(m->anisotropy_strength, 0.0f, 1.0f, "anisotropyStrength");
-  in(m->sheen_roughness, 0.0f, 1.0f, "sheenRoughnessFactor");
-  in(m->diffuse_transmission, 0.0f, 1.0f, "diffuseTransmissionFactor");
-  in(m->diffuse_roughness, 0.0f, 1.0f, "diffuseRoughnessFactor");
-  in(m->iridescence, 0.0f, 1.0f, "iridescenceFactor");
-  in(m->iridescence_ior, 1.0f, 10.0f, "iridescenceIor");
-  in(m->iridescence_thickness_min, 0.0f, 1e5f, "iridescenceThicknessMinimum");
-  in(m->iridescence_thickness_max, 0.0f, 1e5f, "iridescenceThicknessMaximum");
-  in(m->ior, 0.0f, 10.0f, "ior");
-  in(m->dispersion, 0.0f, 1e6f, "dispersion");
-  for (int c = 0; c < 3; ++c) {
-    in(m->specular_color[c], 0.0f, 1e6f, "specularColorFactor");
-    in(m->sheen_color[c], 0.0f, 1.0f, "sheenColorFactor");
-    in(m->diffuse_transmission_color[c], 0.0f, 1.0f, "diffuseTransmissionColorFactor");
-    if (m->type == MATERIAL_CONDUCTOR) {
-      in(m->conductor_eta[c], 0.0f, 100.0f, "conductor eta");
-      in(m->conductor_k[c], 0.0f, 100.0f, "conductor k");
-    }
+#define CD_CHECK_PARAM(_, name, n, value, lo, hi, ext, key, ...) in(m->name, lo, hi, #key);
+  GLTF_PARAMS(CD_CHECK_PARAM)
+#undef CD_CHECK_PARAM
+  if (m->type == MATERIAL_CONDUCTOR) {
+    in(m->conductor_eta, 0.0f, 100.0f, "conductor eta");
+    in(m->conductor_k, 0.0f, 100.0f, "conductor k");
   }
   // ior 0 stands for an infinite index (a perfect mirror); keep the kernel's arithmetic finite
   m->ior = m->ior == 0.0f ? 1e4f : std::max(m->ior, 1.0f + 1e-4f);
@@ -275,17 +210,8 @@ MaterialDesc read_material(ReadContext& ctx, int index) {
   read_emission(ctx, gm, name, &m);
   m.double_sided = gm.doubleSided;
   read_alpha(gm, &m);
-  read_ior(gm, &m);
-  read_specular(ctx, gm, &m);
-  read_transmission(ctx, gm, &m);
+  read_extensions(ctx, gm, &m);
   read_volume(ctx, gm, &m);
-  read_clearcoat(ctx, gm, &m);
-  read_anisotropy(ctx, gm, &m);
-  read_sheen(ctx, gm, &m);
-  read_diffuse_transmission(ctx, gm, &m);
-  read_dispersion(gm, &m);
-  read_iridescence(ctx, gm, &m);
-  read_diffuse_roughness(ctx, gm, &m);
   read_unlit(gm, &m);
   read_conductor(gm.extras, name, &m);
   read_interior(ctx, gm, name, &m);

@@ -2,34 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "base/error.hpp"
 
 namespace candela {
 
+namespace {
+
+bool nonzero(float v) { return v != 0.0f; }
+bool nonzero(const glm::vec3& v) { return v != glm::vec3(0.0f); }
+
+enum class GltfRole { LOBE, MODIFIER, PLAIN };
+
+}  // namespace
+
 uint32_t MaterialDesc::kernel_type() const {
-  bool lambertian = metallic == 0.0f && specular == 0.0f && transmission == 0.0f && clearcoat == 0.0f &&
-                    sheen_color == glm::vec3(0.0f) && diffuse_transmission == 0.0f && diffuse_roughness == 0.0f;
+  bool lambertian = true;
+#define CD_LOBE_ZERO(_, name, n, value, lo, hi, ext, key, slot, load, feature, role) \
+  lambertian = lambertian && !(GltfRole::role == GltfRole::LOBE && nonzero(name));
+  GLTF_PARAMS(CD_LOBE_ZERO)
+#undef CD_LOBE_ZERO
   return unlit || (type == MATERIAL_GLTF && lambertian) ? MATERIAL_DIFFUSE : type;
 }
 
-bool MaterialDesc::has_sheen() const {
-  return kernel_type() == MATERIAL_GLTF && std::max({sheen_color.x, sheen_color.y, sheen_color.z}) > 0.0f;
-}
-
-bool MaterialDesc::has_diffuse_transmission() const {
-  return kernel_type() == MATERIAL_GLTF && diffuse_transmission > 0.0f;
-}
-
-bool MaterialDesc::has_diffuse_roughness() const { return kernel_type() == MATERIAL_GLTF && diffuse_roughness > 0.0f; }
-
-bool MaterialDesc::has_dispersion() const {
-  return kernel_type() == MATERIAL_GLTF && dispersion > 0.0f && transmission > 0.0f && !thin_walled;
-}
-bool MaterialDesc::has_iridescence() const { return kernel_type() == MATERIAL_GLTF && iridescence > 0.0f; }
-
-bool MaterialDesc::has_anisotropy() const {
-  return (kernel_type() == MATERIAL_GLTF || kernel_type() == MATERIAL_CONDUCTOR) && anisotropy_strength > 0.0f;
+bool MaterialDesc::needs(const char* macro) const {
+  std::string want = macro;
+  if (kernel_type() == MATERIAL_CONDUCTOR) return want == "CD_FEATURE_ANISOTROPY" && anisotropy_strength > 0.0f;
+  if (kernel_type() != MATERIAL_GLTF) return false;
+  bool needed = false;
+#define CD_PARAM_NEEDS(_, name, n, value, lo, hi, ext, key, slot, load, feature, role) \
+  needed = needed || (GltfRole::role != GltfRole::PLAIN && want == #feature && nonzero(name));
+  GLTF_PARAMS(CD_PARAM_NEEDS)
+#undef CD_PARAM_NEEDS
+  return needed;
 }
 
 bool MaterialDesc::alpha_tested() const {
@@ -94,12 +100,9 @@ SceneFeatures Scene::features() const {
     for (const auto& c : m.colors) f.vertex_colors |= c != glm::vec3(1.0f);
     f.alpha |= materials.at(m.material).alpha_tested();
     f.media |= materials.at(m.material).medium >= 0;
-    f.sheen |= materials.at(m.material).has_sheen();
-    f.diffuse_transmission |= materials.at(m.material).has_diffuse_transmission();
-    f.diffuse_roughness |= materials.at(m.material).has_diffuse_roughness();
-    f.dispersion |= materials.at(m.material).has_dispersion();
-    f.iridescence |= materials.at(m.material).has_iridescence();
-    f.anisotropy |= materials.at(m.material).has_anisotropy();
+    // The features of GLTF_PARAMS a mesh's material needs
+    for (const char* macro : dev::kSceneFeatureMacros)
+      if (materials.at(m.material).needs(macro)) f.*SceneFeatures::flag(macro) = true;
     f.unlit |= materials.at(m.material).unlit;
     // The feature of the BSDF each mesh's material is shaded with (CD_MATERIALS; the
     // loader's default material may go unused)

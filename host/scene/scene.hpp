@@ -57,32 +57,30 @@ struct MediumDesc {
   bool is_grid() const { return !density.empty() || is_nanovdb(); }
 };
 
+// A glTF material factor of n floats: float or glm::vec3 (GLTF_PARAMS)
+template <int n>
+struct GltfFactor {
+  using type = glm::vec<n, float>;
+};
+template <>
+struct GltfFactor<1> {
+  using type = float;
+};
+
 // A material as glTF describes it (defaults: the glTF specification's), or a measured
 // conductor; factors multiply the textures of the same name
 struct MaterialDesc {
   std::string name;  // the glTF material's, if it has one
   uint32_t type = MATERIAL_GLTF;
   glm::vec4 base_color{1.0f};  // linear rgba
-  float metallic = 1.0f, roughness = 1.0f;
-  glm::vec3 emission{0.0f};  // radiance: emissiveFactor x emissive strength
-  float ior = 1.5f;          // KHR_materials_ior
-  float specular = 1.0f;     // KHR_materials_specular
-  glm::vec3 specular_color{1.0f};
-  float transmission = 0.0f;                           // KHR_materials_transmission
-  bool thin_walled = true;                             // no KHR_materials_volume (or thickness 0): a sheet, not a solid
-  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
-  float clearcoat_normal_scale = 1.0f;                 // its clearcoatNormalTexture's scale
-  float anisotropy_strength = 0.0f, anisotropy_rotation = 0.0f;  // KHR_materials_anisotropy
-  glm::vec3 sheen_color{0.0f};                                   // KHR_materials_sheen (0: no sheen)
-  float sheen_roughness = 0.0f;
-  float diffuse_transmission = 0.0f;  // KHR_materials_diffuse_transmission
-  glm::vec3 diffuse_transmission_color{1.0f};
-  float diffuse_roughness = 0.0f;  // KHR_materials_diffuse_roughness: the diffuse base's roughness (EON)
-  float dispersion = 0.0f;         // KHR_materials_dispersion: 20 / Abbe number of a refracting volume (0: none)
-  float iridescence = 0.0f;        // KHR_materials_iridescence: the film's share of the Fresnel term
-  float iridescence_ior = 1.3f;
-  float iridescence_thickness_min = 100.0f, iridescence_thickness_max = 400.0f;  // nm
-  bool unlit = false;  // KHR_materials_unlit: shows base colour x vertex colour, no lighting
+  glm::vec3 emission{0.0f};    // radiance: emissiveFactor x emissive strength
+  // The parameters of cl/shared/gltf_params.h (metallic, roughness, ior, specular, ... with
+  // their glTF defaults); factors multiply the textures of their slots
+#define CD_MATERIAL_PARAM(_, name, n, value, ...) GltfFactor<n>::type name{value};
+  GLTF_PARAMS(CD_MATERIAL_PARAM)
+#undef CD_MATERIAL_PARAM
+  bool thin_walled = true;  // no KHR_materials_volume (or thickness 0): a sheet, not a solid
+  bool unlit = false;       // KHR_materials_unlit: shows base colour x vertex colour, no lighting
   float normal_scale = 1.0f;
   glm::vec3 conductor_eta{0.0f}, conductor_k{0.0f};  // MATERIAL_CONDUCTOR
   bool double_sided = false;
@@ -97,24 +95,14 @@ struct MaterialDesc {
   // MASK or BLEND with an alpha that can make rays pass: traversal must test its hits
   bool alpha_tested() const;
   // The BSDF the kernel shades it with: MATERIAL_DIFFUSE for a glTF material that is exactly
-  // Lambertian whatever its textures (metallic, specular, transmission, clearcoat, diffuse
-  // transmission and diffuse roughness factors and the sheen colour all 0, each of which
-  // multiplies its texture),
-  // else `type`; an unlit
-  // material has no BSDF (MATERIAL_DIFFUSE, never evaluated)
+  // Lambertian whatever its textures (its LOBE factors of GLTF_PARAMS all 0, each of which
+  // multiplies its texture), else `type`; an unlit material has no BSDF (MATERIAL_DIFFUSE,
+  // never evaluated)
   uint32_t kernel_type() const;
-  // A glTF-shaded material with a sheen layer (KHR_materials_sheen)
-  bool has_sheen() const;
-  // A glTF-shaded material with a diffuse transmission (KHR_materials_diffuse_transmission)
-  bool has_diffuse_transmission() const;
-  // A glTF-shaded material with a rough diffuse base (KHR_materials_diffuse_roughness)
-  bool has_diffuse_roughness() const;
-  // A glTF-shaded refracting solid (transmission through a volume) with dispersion > 0
-  bool has_dispersion() const;
-  // A glTF-shaded material with a thin film (KHR_materials_iridescence)
-  bool has_iridescence() const;
-  // A glTF-shaded or conductor material with an anisotropic lobe (KHR_materials_anisotropy)
-  bool has_anisotropy() const;
+  // Whether the kernel needs the feature whose CD_FEATURE_* macro is named `macro` for this
+  // material: a glTF-shaded one with a nonzero LOBE or MODIFIER factor of that feature
+  // (GLTF_PARAMS), or an anisotropic conductor
+  bool needs(const char* macro) const;
 };
 
 struct TextureDesc {

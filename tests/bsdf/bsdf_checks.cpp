@@ -85,7 +85,7 @@ GltfReference::GltfReference(const dev::Material& m)
       metallic(m.params.gltf.metallic),
       transmission(m.params.gltf.transmission),
       ior(m.params.gltf.ior),
-      f90(m.params.gltf.specular_color[3]),
+      f90(m.params.gltf.specular),
       coat(m.params.gltf.clearcoat),
       diffuse_roughness(m.params.gltf.diffuse_roughness),
       thin((m.flags & MATERIAL_THIN_WALLED) != 0u),

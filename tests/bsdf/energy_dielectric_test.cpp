@@ -37,7 +37,8 @@ dev::Material glass(double roughness, bool thin, glm::dvec3 tint = glm::dvec3(1.
   m.type = MATERIAL_GLTF;
   for (int c = 0; c < 3; ++c) m.base_color[c] = float(tint[c]);
   m.base_color[3] = 1.0f;
-  for (int c = 0; c < 4; ++c) m.params.gltf.specular_color[c] = 1.0f;
+  for (int c = 0; c < 3; ++c) m.params.gltf.specular_color[c] = 1.0f;
+  m.params.gltf.specular = 1.0f;
   m.params.gltf.ior = 1.5f;
   m.params.gltf.roughness = float(roughness);
   m.params.gltf.transmission = 1.0f;
@@ -387,11 +388,11 @@ TEST(EnergyClearcoat, WhiteLambertUnderClearCoatReflectsAll) {
     for (double theta : {0.0, 45.0, 75.0, 88.0}) {
       dev::Material lambert = glass(0.5, false);
       lambert.params.gltf.transmission = 0.0f;
-      lambert.params.gltf.specular_color[3] = 0.0f;  // specular 0: a Lambert base
+      lambert.params.gltf.specular = 0.0f;  // specular 0: a Lambert base
       lambert.params.gltf.clearcoat = 1.0f;
       lambert.params.gltf.clearcoat_roughness = float(coat_roughness);
       dev::Material plastic = lambert;
-      plastic.params.gltf.specular_color[3] = 1.0f;
+      plastic.params.gltf.specular = 1.0f;
       Albedo with = albedo(r, lambert, true, true, at_angle(theta), seed++);
       Albedo without = albedo(r, lambert, false, true, at_angle(theta), seed++);
       Albedo over_plastic = albedo(r, plastic, true, true, at_angle(theta), seed++);

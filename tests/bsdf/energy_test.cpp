@@ -53,7 +53,7 @@ dev::Material material(unsigned type, glm::dvec3 base, double roughness) {
   m.base_color[3] = 1.0f;
   if (type == MATERIAL_GLTF) {
     for (int c = 0; c < 3; ++c) m.params.gltf.specular_color[c] = float(base[c]);
-    m.params.gltf.specular_color[3] = 1.0f;
+    m.params.gltf.specular = 1.0f;
     m.params.gltf.ior = 1.5f;
     m.params.gltf.roughness = float(roughness);
   } else {

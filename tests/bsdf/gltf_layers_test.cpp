@@ -47,14 +47,14 @@ dev::Material material(const Layer& l) {
   if (l.coat_normal) m.textures[TEX_CLEARCOAT_NORMAL].index = 0;
   if (l.base_normal) m.textures[TEX_NORMAL].index = 0;
   dev::GltfMaterial& g = m.params.gltf;
-  g.specular_color[3] = float(l.specular);
+  g.specular = float(l.specular);
   g.clearcoat = float(l.coat);
   g.clearcoat_roughness = float(l.coat_roughness);
   g.clearcoat_normal_scale = 1.0f;
-  for (int c = 0; c < 3; ++c) g.sheen[c] = float(l.sheen[c]);
-  g.sheen[3] = 0.5f;
-  for (int c = 0; c < 3; ++c) g.diffuse_transmission[c] = float(l.dt_color[c]);
-  g.diffuse_transmission[3] = float(l.diffuse_transmission);
+  for (int c = 0; c < 3; ++c) g.sheen_color[c] = float(l.sheen[c]);
+  g.sheen_roughness = 0.5f;
+  for (int c = 0; c < 3; ++c) g.diffuse_transmission_color[c] = float(l.dt_color[c]);
+  g.diffuse_transmission = float(l.diffuse_transmission);
   g.diffuse_roughness = float(l.diffuse_roughness);
   return m;
 }

@@ -145,13 +145,13 @@ dev::Material material(double metallic, double roughness, glm::dvec3 base, doubl
                        double transmission = 0.0, double coat = 0.0, double specular = 1.0) {
   dev::Material m = gltf(base, metallic, roughness, transmission);
   dev::GltfMaterial& g = m.params.gltf;
-  g.specular_color[3] = float(specular);
+  g.specular = float(specular);
   g.clearcoat = float(coat);
   g.clearcoat_roughness = 0.3f;
-  g.iridescence[0] = float(film);
-  g.iridescence[1] = float(n);
-  g.iridescence[2] = float(0.25 * d);
-  g.iridescence[3] = float(d);
+  g.iridescence = float(film);
+  g.iridescence_ior = float(n);
+  g.iridescence_thickness_min = float(0.25 * d);
+  g.iridescence_thickness_max = float(d);
   return m;
 }
 

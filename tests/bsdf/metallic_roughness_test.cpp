@@ -22,7 +22,7 @@ LobeFamily metallic_roughness_family() {
   // known exactly), and under the specular layer
   auto rough_diffuse = [=](glm::dvec3 base, double r, double specular) {
     dev::Material m = gltf(base, 0.0, 0.5);
-    m.params.gltf.specular_color[3] = float(specular);
+    m.params.gltf.specular = float(specular);
     m.params.gltf.diffuse_roughness = float(r);
     return m;
   };

@@ -65,11 +65,11 @@ dev::Material material(double metallic, double roughness, glm::dvec3 sheen, doub
                        double specular = 1.0) {
   dev::Material m = gltf(base, metallic, roughness, transmission);
   dev::GltfMaterial& g = m.params.gltf;
-  g.specular_color[3] = float(specular);
+  g.specular = float(specular);
   g.clearcoat = float(coat);
   g.clearcoat_roughness = 0.3f;
-  for (int c = 0; c < 3; ++c) g.sheen[c] = float(sheen[c]);
-  g.sheen[3] = float(sheen_roughness);
+  for (int c = 0; c < 3; ++c) g.sheen_color[c] = float(sheen[c]);
+  g.sheen_roughness = float(sheen_roughness);
   return m;
 }
 

@@ -552,8 +552,8 @@ TEST(GltfLoader, DiffuseTransmissionIsRead) {
   EXPECT_EQ(s.materials[1].kernel_type(), MATERIAL_DIFFUSE);
   CompiledScene c = compile_scene(s);
   const dev::GltfMaterial& g = c.buffers.materials[0].params.gltf;
-  EXPECT_FLOAT_EQ(g.diffuse_transmission[3], 0.4f);
-  EXPECT_FLOAT_EQ(g.diffuse_transmission[1], 0.5f);
+  EXPECT_FLOAT_EQ(g.diffuse_transmission, 0.4f);
+  EXPECT_FLOAT_EQ(g.diffuse_transmission_color[1], 0.5f);
   for (double bad : {-0.1, 1.5}) {
     j["materials"][0]["extensions"]["KHR_materials_diffuse_transmission"]["diffuseTransmissionFactor"] = bad;
     EXPECT_THROW(load_gltf(dir.write("bad.gltf", j.dump())), Error);
@@ -588,7 +588,7 @@ TEST(GltfLoader, IridescenceIsRead) {
   ASSERT_NE(thickness.index, NO_TEXTURE);
   EXPECT_FALSE(s.textures.at(size_t(factor.index)).srgb);
   EXPECT_FALSE(s.textures.at(size_t(thickness.index)).srgb);
-  EXPECT_TRUE(m.has_iridescence());
+  EXPECT_TRUE(m.needs("CD_FEATURE_IRIDESCENCE"));
   EXPECT_TRUE(s.features().iridescence);
   EXPECT_EQ(join(s.warnings).find("KHR_materials_iridescence"), std::string::npos) << join(s.warnings);
   // Defaults: factor 0 (no film), ior 1.3, 100 to 400 nm
@@ -596,13 +596,13 @@ TEST(GltfLoader, IridescenceIsRead) {
   EXPECT_FLOAT_EQ(s.materials[1].iridescence_ior, 1.3f);
   EXPECT_FLOAT_EQ(s.materials[1].iridescence_thickness_min, 100.0f);
   EXPECT_FLOAT_EQ(s.materials[1].iridescence_thickness_max, 400.0f);
-  EXPECT_FALSE(s.materials[1].has_iridescence());
+  EXPECT_FALSE(s.materials[1].needs("CD_FEATURE_IRIDESCENCE"));
   CompiledScene c = compile_scene(s);
   const dev::GltfMaterial& g = c.buffers.materials[0].params.gltf;
-  EXPECT_FLOAT_EQ(g.iridescence[0], 0.7f);
-  EXPECT_FLOAT_EQ(g.iridescence[1], 1.8f);
-  EXPECT_FLOAT_EQ(g.iridescence[2], 200.0f);
-  EXPECT_FLOAT_EQ(g.iridescence[3], 650.0f);
+  EXPECT_FLOAT_EQ(g.iridescence, 0.7f);
+  EXPECT_FLOAT_EQ(g.iridescence_ior, 1.8f);
+  EXPECT_FLOAT_EQ(g.iridescence_thickness_min, 200.0f);
+  EXPECT_FLOAT_EQ(g.iridescence_thickness_max, 650.0f);
   // Without a film the scene's kernel compiles none of it
   j["materials"][0]["extensions"]["KHR_materials_iridescence"]["iridescenceFactor"] = 0.0;
   EXPECT_FALSE(load_gltf(dir.write("none.gltf", j.dump())).features().iridescence);
@@ -633,12 +633,12 @@ TEST(GltfLoader, DiffuseRoughnessIsRead) {
   ASSERT_NE(tex.index, NO_TEXTURE);
   EXPECT_FALSE(s.textures.at(size_t(tex.index)).srgb);
   EXPECT_EQ(m.kernel_type(), MATERIAL_GLTF);
-  EXPECT_TRUE(m.has_diffuse_roughness());
+  EXPECT_TRUE(m.needs("CD_FEATURE_DIFFUSE_ROUGHNESS"));
   EXPECT_TRUE(s.features().diffuse_roughness);
   EXPECT_EQ(join(s.warnings).find("KHR_materials_diffuse_roughness"), std::string::npos) << join(s.warnings);
   EXPECT_FLOAT_EQ(s.materials[1].diffuse_roughness, 0.0f);
   EXPECT_EQ(s.materials[1].kernel_type(), MATERIAL_DIFFUSE);
-  EXPECT_FALSE(s.materials[1].has_diffuse_roughness());
+  EXPECT_FALSE(s.materials[1].needs("CD_FEATURE_DIFFUSE_ROUGHNESS"));
   CompiledScene c = compile_scene(s);
   EXPECT_FLOAT_EQ(c.buffers.materials[0].params.gltf.diffuse_roughness, 0.6f);
   j["materials"][0]["extensions"]["KHR_materials_diffuse_roughness"]["diffuseRoughnessFactor"] = 0.0;

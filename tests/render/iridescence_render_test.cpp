@@ -42,7 +42,8 @@ TEST_P(IridescentLens, ReflectsBlueOverAnIndexMatchedBase) {
   Scene s = load_scene(furnace_sphere(film_lens(0.009, false)), std::string("film-lens-") + GetParam() + ".gltf");
   EXPECT_TRUE(s.features().iridescence);
   Film f = render_film(s, Strategy::Nee, 16, 16, 64, 16, 3, device);
-  Estimate r = region_mean(f, 0, 4, 12, 4, 12), g = region_mean(f, 1, 4, 12, 4, 12), b = region_mean(f, 2, 4, 12, 4, 12);
+  Estimate r = region_mean(f, 0, 4, 12, 4, 12), g = region_mean(f, 1, 4, 12, 4, 12),
+           b = region_mean(f, 2, 4, 12, 4, 12);
   std::printf("sphere's mean under a white background: %.4f %.4f %.4f\n", r.mean, g.mean, b.mean);
   // Without the film the lens passes 0.009^2 of the background: black
   EXPECT_GT(b.mean, 0.15) << "the film reflects";

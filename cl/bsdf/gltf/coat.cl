@@ -17,8 +17,8 @@ float gltf_coat_albedo(const GltfLayer* l, float mu) {
 // The clearcoat: Schlick(0.04, 1) weighted by the coat factor, never normalized
 GltfLayer gltf_coat_layer(const Bsdf* b, float cos_o) {
   const GltfBsdf* lobe = &b->lobe.gltf;
-  GgxEnergy e = energy_ggx_mu(lobe->coat > 0.0f ? b->ggx_albedo : 0, lobe->coat_ggx, cos_o);
-  GltfLayer l = gltf_layer(e, (float3)(0.04f * lobe->coat), lobe->coat, (float3)(0.0f), false);
+  GgxEnergy e = energy_ggx_mu(lobe->clearcoat > 0.0f ? b->ggx_albedo : 0, lobe->coat_ggx, cos_o);
+  GltfLayer l = gltf_layer(e, (float3)(0.04f * lobe->clearcoat), lobe->clearcoat, (float3)(0.0f), false);
   l.a_o = gltf_coat_albedo(&l, cos_o);
   return l;
 }
@@ -31,7 +31,7 @@ GltfLayer gltf_coat_layer(const Bsdf* b, float cos_o) {
 // T_avg by 8-point Gauss-Legendre quadrature on [0, 1/4] and [1/4, 1] (A is steep at grazing);
 // under an anisotropic specular layer also over four azimuths (midpoints in [0, pi / 2]).
 float gltf_coat_base_norm(const Bsdf* b, const GltfLayer* coat, const GltfLayer* spec) {
-  if (b->lobe.gltf.coat <= 0.0f || !spec->normalized || !b->ggx_albedo) return 1.0f;
+  if (b->lobe.gltf.clearcoat <= 0.0f || !spec->normalized || !b->ggx_albedo) return 1.0f;
   const float x[4] = ENERGY_GL_X;
   const float w[4] = ENERGY_GL_W;
 #if CD_FEATURE_ANISOTROPY
@@ -58,7 +58,7 @@ float gltf_coat_base_norm(const Bsdf* b, const GltfLayer* coat, const GltfLayer*
 
 // Clearcoat reflectance Schlick(0.04, 1) weighted by the coat factor, at the coat lobe's wo.h
 float gltf_coat_fresnel(const Bsdf* b, float cos_i) {
-  return b->lobe.gltf.coat * (0.04f + 0.96f * schlick_weight(cos_i));
+  return b->lobe.gltf.clearcoat * (0.04f + 0.96f * schlick_weight(cos_i));
 }
 
 // A direction in the coat's frame, and |w.n_c|: the cosine the coat's albedo is taken at
@@ -118,7 +118,7 @@ void gltf_coat_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, Gltf
   const GltfBsdf* lobe = &b->lobe.gltf;
   acc->f = acc->under * (wi.z > 0.0f ? gltf_coat_below(g, wi) : gltf_coat_across(b, g, wi));
   if (wi.z < 0.0f) acc->f += acc->dtrans * gltf_coat_below(g, wi);
-  if (wi.z > 0.0f && lobe->coat > 0.0f && !ggx_is_delta(lobe->coat_ggx)) {
+  if (wi.z > 0.0f && lobe->clearcoat > 0.0f && !ggx_is_delta(lobe->coat_ggx)) {
     float coat_p, coat_h;
     float3 wi_c = gltf_coat_local(g, wi);
     float coat_d = ggx_reflection_eval(lobe->coat_ggx, gltf_coat_local(g, wo), wi_c, &coat_p, &coat_h);
@@ -133,18 +133,17 @@ void gltf_coat_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, Gltf
 bool gltf_coat_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
   __global const GltfMaterial* g = &m->params.gltf;
   GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->coat = g->clearcoat * bsdf_texture(sc, m, TEX_CLEARCOAT, s).x;
   float coat_rough = g->clearcoat_roughness * bsdf_texture(sc, m, TEX_CLEARCOAT_ROUGHNESS, s).y;
   lobe->coat_ggx = ggx_from_roughness(coat_rough, 0.0f);
   Frame geo = bsdf_geometry_frame(s);
   lobe->coat_n = geo.n;
   lobe->coat_own_normal = false;
-  if (lobe->coat > 0.0f) {
+  if (lobe->clearcoat > 0.0f) {
     bsdf_mapped_normal(sc, m, s, &geo, TEX_CLEARCOAT_NORMAL, g->clearcoat_normal_scale, &lobe->coat_n);
     lobe->coat_own_normal =
         m->textures[TEX_CLEARCOAT_NORMAL].index != NO_TEXTURE || m->textures[TEX_NORMAL].index != NO_TEXTURE;
   }
-  return lobe->coat != 0.0f;
+  return lobe->clearcoat != 0.0f;
 }
 
 // Its frame, where it has a normal of its own, and its layer at wo, which leaves the rest
@@ -160,4 +159,6 @@ void gltf_coat_at_wo(const Bsdf* b, float3 wo, GltfAtWo* g) {
   g->outer = 1.0f - g->coat.a_o;
 }
 
-uint gltf_coat_flags(const Bsdf* b) { return b->lobe.gltf.coat > 0.0f ? gltf_ggx_flags(b->lobe.gltf.coat_ggx) : 0u; }
+uint gltf_coat_flags(const Bsdf* b) {
+  return b->lobe.gltf.clearcoat > 0.0f ? gltf_ggx_flags(b->lobe.gltf.coat_ggx) : 0u;
+}

@@ -48,15 +48,10 @@ void gltf_difftrans_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi,
 #endif
 }
 
-// Its factor and colour
+// Present where its factor (a GLTF_PARAMS value, as its colour) is
 bool gltf_difftrans_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
 #if CD_FEATURE_DIFFUSE_TRANSMISSION
-  __global const GltfMaterial* g = &m->params.gltf;
-  GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->diffuse_transmission = g->diffuse_transmission[3] * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION, s).w;
-  lobe->diffuse_transmission_color =
-      load3(g->diffuse_transmission) * bsdf_texture(sc, m, TEX_DIFFUSE_TRANSMISSION_COLOR, s).xyz;
-  return lobe->diffuse_transmission > 0.0f;
+  return b->lobe.gltf.diffuse_transmission > 0.0f;
 #else
   return false;
 #endif

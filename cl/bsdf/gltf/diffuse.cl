@@ -40,12 +40,12 @@ void gltf_diffuse_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, G
   }
 }
 
-// Its roughness (KHR_materials_diffuse_roughness); the colour is the base colour
+// Its roughness (KHR_materials_diffuse_roughness, a GLTF_PARAMS value) within [0, 1]; the
+// colour is the base colour
 bool gltf_diffuse_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
 #if CD_FEATURE_DIFFUSE_ROUGHNESS
-  __global const GltfMaterial* g = &m->params.gltf;
   GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->diffuse_roughness = clamp(g->diffuse_roughness * bsdf_texture(sc, m, TEX_DIFFUSE_ROUGHNESS, s).x, 0.0f, 1.0f);
+  lobe->diffuse_roughness = clamp(lobe->diffuse_roughness, 0.0f, 1.0f);
   return lobe->diffuse_roughness > 0.0f;
 #else
   return false;

@@ -40,10 +40,8 @@ void gltf_fresnel_params(const SceneData* sc, __global const Material* m, const 
 #if CD_FEATURE_IRIDESCENCE
   __global const GltfMaterial* g = &m->params.gltf;
   GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->iridescence = g->iridescence[0] * bsdf_texture(sc, m, TEX_IRIDESCENCE, s).x;
-  lobe->iridescence_ior = g->iridescence[1];
-  lobe->iridescence_thickness =
-      mix(g->iridescence[2], g->iridescence[3], bsdf_texture(sc, m, TEX_IRIDESCENCE_THICKNESS, s).y);
+  lobe->iridescence_thickness = mix(g->iridescence_thickness_min, g->iridescence_thickness_max,
+                                    bsdf_texture(sc, m, TEX_IRIDESCENCE_THICKNESS, s).y);
   if (!(lobe->iridescence_thickness > 0.0f)) lobe->iridescence = 0.0f;
 #endif
 }

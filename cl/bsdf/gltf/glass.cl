@@ -68,7 +68,7 @@ int gltf_glass_sample(const Bsdf* b, const GltfAtWo* g, float3 wo, float uc, flo
   if (!(bs->flags & BSDF_DELTA)) return GLTF_SAMPLE_DIRECTION;
   float att = bs->wi.z > 0.0f ? gltf_coat_below(g, bs->wi) : gltf_coat_across(b, g, bs->wi);
 #if CD_FEATURE_SHEEN
-  if (max_component(lobe->sheen) > 0.0f)
+  if (max_component(lobe->sheen_color) > 0.0f)
     att *= bs->wi.z > 0.0f || b->entering ? g->sheen_o : gltf_sheen_below(b, gltf_sheen_e(b, -bs->wi.z));
 #endif
   bs->f *= att * (1.0f - lobe->metallic) * lobe->transmission;
@@ -83,7 +83,8 @@ void gltf_glass_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, Bsdf
   if (ggx_is_delta(lobe->ggx)) return;
   float r = fresnel_dielectric(wo.z, lobe->eta);
 #if CD_FEATURE_IRIDESCENCE
-  if (lobe->iridescence > 0.0f) r = dielectric_film_share(dielectric_film_fresnel(gltf_film(b), wo.z, lobe->eta, false));
+  if (lobe->iridescence > 0.0f)
+    r = dielectric_film_share(dielectric_film_fresnel(gltf_film(b), wo.z, lobe->eta, false));
 #endif
   float3 t = -wo;
   if (lobe->thin) {

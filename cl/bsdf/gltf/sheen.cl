@@ -12,7 +12,7 @@ float gltf_sheen_e(const Bsdf* b, float mu) {
 
 // What the sheen leaves to the layers below it where its albedo is e: 1 - max3(colour) min(e, 1)
 float gltf_sheen_below(const Bsdf* b, float e) {
-  float c = max_component(b->lobe.gltf.sheen);
+  float c = max_component(b->lobe.gltf.sheen_color);
   return c > 0.0f ? fmax(1.0f - c * fmin(e, 1.0f), 0.0f) : 1.0f;
 }
 
@@ -22,7 +22,7 @@ float gltf_sheen_below(const Bsdf* b, float e) {
 float3 gltf_sheen_f(const Bsdf* b, float e_o, float3 wo, float3 wi) {
   const GltfBsdf* lobe = &b->lobe.gltf;
   float norm = fmax(1.0f, fmax(e_o, gltf_sheen_e(b, wi.z)));
-  return lobe->sheen * (sheen_eval(sheen_alpha(lobe->sheen_roughness), wo, wi) / norm);
+  return lobe->sheen_color * (sheen_eval(sheen_alpha(lobe->sheen_roughness), wo, wi) / norm);
 }
 #endif
 
@@ -38,7 +38,7 @@ float gltf_sheen_weight(const Bsdf* b, const GltfAtWo* g, float cos_o) {
 #if CD_FEATURE_SHEEN
   const GltfBsdf* lobe = &b->lobe.gltf;
   float e = lobe->sheen_albedo ? fmin(g->sheen_e_o, 1.0f) : 1.0f;
-  return (1.0f - g->coat.a_o) * luminance(lobe->sheen) * fmax(e, 0.01f);
+  return (1.0f - g->coat.a_o) * luminance(lobe->sheen_color) * fmax(e, 0.01f);
 #else
   return 0.0f;
 #endif
@@ -58,7 +58,7 @@ void gltf_sheen_lobes(const Bsdf* b, const GltfAtWo* g, float3 wo, float w, Bsdf
 void gltf_sheen_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, GltfEval* acc) {
 #if CD_FEATURE_SHEEN
   const GltfBsdf* lobe = &b->lobe.gltf;
-  if (max_component(lobe->sheen) > 0.0f) {
+  if (max_component(lobe->sheen_color) > 0.0f) {
     if (wi.z > 0.0f) {
       acc->under = acc->under * fmin(g->sheen_o, gltf_sheen_below(b, gltf_sheen_e(b, wi.z))) +
                    gltf_sheen_f(b, g->sheen_e_o, wo, wi);
@@ -72,15 +72,12 @@ void gltf_sheen_eval(const Bsdf* b, const GltfAtWo* g, float3 wo, float3 wi, Glt
 #endif
 }
 
-// Its colour, roughness and albedo table
+// Its albedo table (its colour and roughness are GLTF_PARAMS values); present where coloured
 bool gltf_sheen_params(const SceneData* sc, __global const Material* m, const SurfaceHit* s, Bsdf* b) {
 #if CD_FEATURE_SHEEN
-  __global const GltfMaterial* g = &m->params.gltf;
   GltfBsdf* lobe = &b->lobe.gltf;
-  lobe->sheen = load3(g->sheen) * bsdf_texture(sc, m, TEX_SHEEN_COLOR, s).xyz;
-  lobe->sheen_roughness = g->sheen[3] * bsdf_texture(sc, m, TEX_SHEEN_ROUGHNESS, s).w;
   lobe->sheen_albedo = sc->sheen_albedo;
-  return max_component(lobe->sheen) > 0.0f;
+  return max_component(lobe->sheen_color) > 0.0f;
 #else
   return false;
 #endif
@@ -97,7 +94,7 @@ void gltf_sheen_at_wo(const Bsdf* b, float3 wo, GltfAtWo* g) {
 
 uint gltf_sheen_flags(const Bsdf* b) {
 #if CD_FEATURE_SHEEN
-  if (max_component(b->lobe.gltf.sheen) > 0.0f) return BSDF_GLOSSY;
+  if (max_component(b->lobe.gltf.sheen_color) > 0.0f) return BSDF_GLOSSY;
 #endif
   return 0u;
 }
