@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+#include "base/error.hpp"
+#include "render/aov.hpp"
 #include "render/renderer.hpp"
 #include "support/gltf_builder.hpp"
 #include "support/scenes.hpp"
@@ -181,6 +183,40 @@ TEST_P(Aov, TransparentBackgroundHasExactAlpha) {
   }
   // The environment still lights the quad: a Lambertian under radiance 1 shows its albedo
   EXPECT_NEAR(lit, kColour.y, 0.03);
+}
+
+// Films of disjoint sample ranges merge their AOVs by samples taken (kept and dropped)
+TEST(AovFilm, MergeWeighsBySamplesTaken) {
+  Film a(1, 1), b(1, 1);
+  a.mean[3] = 3.0f;  // 3 kept, 1 dropped: 4 taken
+  a.m2[3] = 1.0f;
+  b.mean[3] = 12.0f;
+  a.aov.assign(8, 1.0f);
+  b.aov.assign(8, 0.0f);
+  b.aov[7] = 6.0f;
+  Film m = merge_films(a, b);
+  ASSERT_EQ(m.aov.size(), 8u);
+  EXPECT_FLOAT_EQ(m.aov[0], 4.0f / 16.0f);
+  EXPECT_FLOAT_EQ(m.aov[7], (4.0f + 12.0f * 6.0f) / 16.0f);
+  EXPECT_FLOAT_EQ(m.samples_taken(0), 16.0f);
+  b.aov.clear();
+  EXPECT_TRUE(merge_films(a, b).aov.empty());  // only films that both hold them
+}
+
+TEST(AovNames, ListsAndOutputs) {
+  EXPECT_EQ(parse_aov_list("albedo,spp"), aov_bit(candela::Aov::Albedo) | aov_bit(candela::Aov::Spp));
+  EXPECT_EQ(aov_list_text(parse_aov_list("spp,normal,depth")), "normal,depth,spp");
+  EXPECT_EQ(aov_list_text(0), "none");
+  EXPECT_THROW(parse_aov_list("albedo,"), Error);
+  EXPECT_THROW(parse_aov_list("colour"), Error);
+  EXPECT_FALSE(aovs_need_kernel(aov_bit(candela::Aov::Spp)));
+  OutputSpec o = parse_output("dir/n.png:normal");
+  EXPECT_EQ(o.path, "dir/n.png");
+  EXPECT_EQ(o.aov, aov_bit(candela::Aov::Normal));
+  EXPECT_EQ(parse_output("a:b/out.png").path, "a:b/out.png");  // a colon in a folder
+  EXPECT_EQ(parse_output("out.png").aov, 0u);
+  EXPECT_THROW(parse_output("out.png:colour"), Error);
+  EXPECT_THROW(parse_output("out.exr:normal"), Error);  // an EXR holds them all
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, Aov, ::testing::Values("pocl", "rusticl"),
