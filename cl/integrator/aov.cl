@@ -4,7 +4,8 @@
 // lobe (mirrors and smooth glass show what they reflect or transmit):
 //   albedo  the BSDF sample's weight f |cos| / pdf there, whose mean over the samples is the
 //           directional albedo; an escaped ray: the environment's radiance clamped to 1
-//   normal  the world-space shading normal there (normal mapping included); 0 when none
+//   normal  the world-space shading normal there (normal mapping included), on the side the
+//           ray came from; 0 when none
 //   depth   the distance along the camera ray to its first surface; 0 when it escapes
 //   alpha   1 - the throughput (its channels' mean) with which the camera path escapes to the
 //           environment through delta transmissions, alpha-blended surfaces and null
