@@ -41,11 +41,12 @@ RenderSettings aov_settings() {
   return s;
 }
 
-// A quad of kColour in z = 0 facing +z across [x0, x1] x [-10, 10], seen from (0, 0, 3)
-// (yfov 0.5: the view spans |x|, |y| < 3 tan 0.25 there), under a uniform background of 1
-Scene quad_scene(float x0, float x1, const std::string& file) {
+// A quad (default: a Lambertian of kColour) in z = 0 facing +z across [x0, x1] x [-10, 10],
+// seen from (0, 0, 3) (yfov 0.5: the view spans |x|, |y| < 3 tan 0.25 there), under a
+// uniform background of 1
+Scene quad_scene(float x0, float x1, const std::string& file, const json& material = diffuse(kColour)) {
   GltfBuilder g;
-  int m = g.add("materials", diffuse(kColour));
+  int m = g.add("materials", material);
   g.add_node({{"mesh", g.add_mesh({quad_primitive({{x0, -10, 0}, {x1, -10, 0}, {x1, 10, 0}, {x0, 10, 0}}, m)})}});
   g.add_camera(glm::vec3(0.0f, 0.0f, 3.0f), glm::vec3(0.0f), 0.5f);
   g.set_background(glm::vec3(1.0f));
@@ -217,6 +218,28 @@ TEST(AovNames, ListsAndOutputs) {
   EXPECT_EQ(parse_output("out.png").aov, 0u);
   EXPECT_THROW(parse_output("out.png:colour"), Error);
   EXPECT_THROW(parse_output("out.exr:normal"), Error);  // an EXR holds them all
+}
+
+TEST_P(Aov, SmoothGlassIsPartlyTransparent) {
+  // Thin-walled smooth white glass filling the view: a path reflects (alpha 1, the white
+  // background's radiance) or passes straight through to the environment (alpha 0, left
+  // out), so alpha is the glass's reflectance and equals the image's value on average
+  json glass = {{"pbrMetallicRoughness",
+                 {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.0}}},
+                {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}}}};
+  Scene s = quad_scene(-10, 10, file("glass"), glass);
+  RenderSettings settings = aov_settings();
+  settings.transparent = true;
+  Film f = scene_renderer(device_, s, settings).render(0, 64).film;
+  double a = 0.0, r = 0.0;
+  for (size_t i = 0; i < f.pixels(); ++i) {
+    a += alpha(f, i) / double(f.pixels());
+    r += f.pixel(i).y / double(f.pixels());
+    expect_plane_depth(f, i);
+  }
+  EXPECT_GT(a, 0.02);  // about 2F / (1 + F), F = 0.04 at normal incidence
+  EXPECT_LT(a, 0.15);
+  EXPECT_NEAR(r, a, 0.005);
 }
 
 INSTANTIATE_TEST_SUITE_P(Devices, Aov, ::testing::Values("pocl", "rusticl"),
