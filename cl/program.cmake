@@ -54,4 +54,6 @@ set(CANDELA_CL_SOURCES
   cl/media/phase.cl
   cl/media/nanovdb.cl
   cl/media/media.cl
-  cl/integrator/integrator_path.cl)
+  cl/integrator/aov.cl
+  cl/integrator/integrator_path.cl
+  cl/integrator/render_paths.cl)

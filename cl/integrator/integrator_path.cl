@@ -345,9 +345,18 @@ bool path_prev_takes(const SceneData* sc, const PathState* ps, uint index) {
   return path_nee_takes(sc, &ps->lobes, &ps->prev, index, -1.0f);
 }
 
+// With CD_AOV, path_trace also fills the sample's AOVs (aov.cl)
+#if CD_AOV
+#define AOV_PARAM , PathAov* aov
+#define AOV_ARG(a) , a
+#else
+#define AOV_PARAM
+#define AOV_ARG(a)
+#endif
+
 // Radiance along one camera ray; `first`: the camera ray's closest hit when it is known
 // already (traced in a packet), else 0
-float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng) {
+float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rng AOV_PARAM) {
   __global const RenderParams* params = sc->params;
   const uint strategy = params->strategy;
   PathState ps = path_start(sc, camera_ray);
@@ -363,6 +372,9 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
     // Medium step: emission and free flight up to the surface; scattering in the medium
     // (the phase function is never near-specular: auto light-samples there, like nee)
     int event = path_medium_step(sc, &ps, hit.prim < 0 ? INFINITY : hit.t, strategy != STRATEGY_BSDF, rng);
+#if CD_AOV
+    if (event != MEDIUM_PASSED) aov->see_through = false;
+#endif
     if (event == MEDIUM_ABSORBED) break;
     if (event == MEDIUM_SCATTERED) continue;
 #endif
@@ -372,6 +384,12 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
         float3 le = lights_environment_radiance(sc, ps.ray.dir);
         if (!counts_emission && max_component(le) > 0.0f)
           counts_emission = !path_prev_takes(sc, &ps, (uint)params->environment_light);
+#if CD_AOV
+        aov_escape(aov, ps.beta, le);
+#if CD_TRANSPARENT
+        if (aov->see_through) counts_emission = false;
+#endif
+#endif
         if (counts_emission) ps.radiance += ps.beta * le;
       }
       break;
@@ -380,16 +398,25 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
 #if CD_FEATURE_MEDIA
     // A null boundary only changes the medium: the ray goes straight on, and no bounce counts
     if (media_is_null_boundary(sc, s.material)) {
+#if CD_AOV
+      if (ps.depth == 0u) aov->travelled += hit.t;
+#endif
       path_cross_boundary(sc, &ps, &s);
       ps.ray.org = offset_ray_origin(s.p, -s.ng);
       --ps.depth;  // the loop's ++ undoes it
       continue;
     }
 #endif
+#if CD_AOV
+    if (ps.depth == 0u) aov->depth = aov->travelled + hit.t;
+#endif
 #if CD_FEATURE_UNLIT
     // An unlit surface shows its colour to every ray and ends the path (no light sampling finds it)
     if (sc->materials[s.material].flags & MATERIAL_UNLIT) {
       ps.radiance += ps.beta * bsdf_unlit_radiance(sc, &s);
+#if CD_AOV
+      aov_unlit(aov, bsdf_unlit_radiance(sc, &s), s.ns);
+#endif
       break;
     }
 #endif
@@ -446,6 +473,9 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
           ps.beta * path_direct_light(sc, &ctx, &bsdf, wo, chooses ? &lobes : 0, &ps.media,
                                       sc->materials[s.material].medium, x_select, u_select, u_light, rng, &choice);
     }
+#if CD_AOV
+    aov_vertex(aov, &bs, sampled, bsdf.frame.n);
+#endif
     if (!sampled) break;
 
     // Continue the path along the sampled direction
@@ -470,191 +500,3 @@ float3 path_trace(const SceneData* sc, Ray camera_ray, const Hit* first, Rng* rn
   }
   return ps.radiance;
 }
-
-// The pixel (row-major index) of launch index i, 0 <= i < width * height: launches hand out
-// the image in 8x8 tiles, a band of 8 rows at a time from the top and the band's tiles from
-// the left; inside a whole tile the order is the Z-order (Morton 1966, A Computer Oriented
-// Geodetic Data Base and a New Technique in File Sequencing: x in the even bits of the
-// index, y in the odd ones), inside a tile cut by the right or bottom edge it is row-major.
-// Neighbouring work-items (a work-group of 64 launch indices is about one tile) trace
-// neighbouring primary rays. A bijection of [0, width * height) onto the pixels; the
-// sample of a pixel depends on the pixel only, so the order changes no image.
-uint pixel_of_launch_index(uint i, uint width, uint height) {
-  uint band = i / (8u * width), in_band = i - band * 8u * width;
-  uint th = min(8u, height - 8u * band);  // the band's height
-  uint tile = in_band / (8u * th), k = in_band - tile * 8u * th;
-  uint tw = min(8u, width - 8u * tile);  // the tile's width
-  uint lx, ly;
-  if (tw == 8u && th == 8u) {
-    lx = (k & 1u) | ((k >> 1u) & 2u) | ((k >> 2u) & 4u);
-    ly = ((k >> 1u) & 1u) | ((k >> 2u) & 2u) | ((k >> 3u) & 4u);
-  } else {
-    ly = k / tw;
-    lx = k - ly * tw;
-  }
-  return (8u * band + ly) * width + 8u * tile + lx;
-}
-
-// A sample's radiance into the pixel's running mean and sum of squared deviations
-// (Welford): mean.w counts kept samples, m2.w dropped (non-finite) ones
-void film_add(float4* mean, float4* m2, float3 l) {
-  if (!all_finite(l)) {
-    m2->w += 1.0f;
-    return;
-  }
-  float n = mean->w + 1.0f;
-  float3 delta = l - mean->xyz;
-  float3 new_mean = mean->xyz + delta / n;
-  m2->xyz += delta * (l - new_mean);
-  *mean = (float4)(new_mean, n);
-}
-
-// The camera ray through film position (fx, fy), with the lens sample's two numbers drawn
-// next when the camera has a lens
-Ray film_camera_ray(__global const RenderParams* params, float fx, float fy, Rng* rng) {
-  float2 lens = (float2)(0.0f);
-  if (params->camera.lens_radius > 0.0f) {
-    lens.x = rng_next(rng);
-    lens.y = rng_next(rng);
-  }
-  return camera_ray(params, fx, fy, lens);
-}
-
-// The camera ray of a pixel's sample, from its first random numbers
-Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng* rng) {
-  float jx = rng_next(rng), jy = rng_next(rng);
-  float2 film = filter_sample(params->filter, jx, jy);
-  return film_camera_ray(params, (float)px + film.x, (float)py + film.y, rng);
-}
-
-// CD_PACKETS=1 (CPU devices, set by the host): a work-item takes eight consecutive launch
-// indices (a 4x2 block of a tile) and traces their camera rays as one packet
-// (bvh_intersect8), then each path on its own. The same samples, bit for bit, as one
-// work-item per index, but where a camera ray meets two triangles within rounding of one
-// distance (the packet may test them in another order and keep the other).
-#if CD_PACKETS
-// (Loops over the eight lanes have a fixed trip count, and structs reach the arrays from
-// locals: llvmpipe mistranslated a lane loop with a data-dependent bound and a struct
-// returned straight into an array element.)
-
-// The camera rays and random number states of eight pixels' sample `sample`: lane for
-// lane pixel_camera_ray's after rng_init, bit for bit (hashed_seed: rng_hash_seed of the
-// render's seed, for the Sobol sampler). With the Sobol sampler the film
-// positions' numbers (pair 0) are drawn in SIMD lanes (the tent and Gaussian filters then
-// map them lane by lane), and so are a pinhole camera's ray directions (normalized lane by
-// lane: camera_rays8); a lens or an orthographic camera goes lane by lane, and so does the
-// independent sampler.
-void packet_camera_rays(__global const RenderParams* params, const uint pixel[8], uint sample, uint hashed_seed,
-                        Rng rng[8], Ray rays[8]) {
-#if CD_SAMPLER_SOBOL
-  uint sample_reversed = rng_reverse_bits(sample);
-  uint8 pixels = vload8(0, pixel), ux, uy;
-  rng_sobol_pair8(pixels, sample_reversed, hashed_seed, 0u, &ux, &uy);
-  uint y_bits[8];
-  vstore8(uy, 0, y_bits);
-  // Where each sample lands on the film: the box filter's is the uniform jitter itself
-  float8 jx = convert_float8(ux >> 8) * 0x1.0p-24f, jy = convert_float8(uy >> 8) * 0x1.0p-24f;  // rng_uint_to_float
-  float8 fx = convert_float8(pixels % params->width), fy = convert_float8(pixels / params->width);
-  if (params->filter == FILTER_BOX) {
-    fx += jx;
-    fy += jy;
-  } else {
-    float ax[8], ay[8], bx[8], by[8];
-    vstore8(jx, 0, ax);
-    vstore8(jy, 0, ay);
-    vstore8(fx, 0, bx);
-    vstore8(fy, 0, by);
-    for (int l = 0; l < 8; ++l) {
-      float2 film = filter_sample(params->filter, ax[l], ay[l]);
-      bx[l] += film.x;
-      by[l] += film.y;
-    }
-    fx = vload8(0, bx);
-    fy = vload8(0, by);
-  }
-  for (int l = 0; l < 8; ++l) {
-    Rng r = rng_sobol_after_pair0(pixel[l], sample_reversed, hashed_seed, y_bits[l]);
-    rng[l] = r;
-  }
-  if (params->camera.type == CAMERA_PERSPECTIVE && !(params->camera.lens_radius > 0.0f)) {
-    camera_rays8(params, fx, fy, rays);
-    return;
-  }
-  float px[8], py[8];
-  vstore8(fx, 0, px);
-  vstore8(fy, 0, py);
-  for (int l = 0; l < 8; ++l) {
-    Rng r = rng[l];
-    Ray ray = film_camera_ray(params, px[l], py[l], &r);
-    rng[l] = r;
-    rays[l] = ray;
-  }
-#else
-  for (int l = 0; l < 8; ++l) {
-    Rng r = rng_init(pixel[l], sample, params->seed);
-    Ray ray = pixel_camera_ray(params, pixel[l] % params->width, pixel[l] / params->width, &r);
-    rng[l] = r;
-    rays[l] = ray;
-  }
-#endif
-}
-
-__kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                           __global float4* film_mean, __global float4* film_m2) {
-  uint first = params->pixel_begin + 8u * (uint)get_global_id(0);
-  if (first >= params->pixel_end) return;
-  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
-  if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
-  uint pixel[8];
-  float4 mean[8], m2[8];
-  float tmax[8];
-  for (uint l = 0u; l < 8u; ++l) {
-    // A lane past the launch's end repeats the first lane's pixel, finds nothing (tmax 0)
-    // and is never written
-    bool inside = first + l < params->pixel_end;
-    pixel[l] = pixel_of_launch_index(inside ? first + l : first, params->width, params->height);
-    tmax[l] = inside ? INFINITY : 0.0f;
-    mean[l] = film_mean[pixel[l]];
-    m2[l] = film_m2[pixel[l]];
-  }
-  uint hashed_seed = rng_hash_seed(params->seed);
-  for (uint k = 0u; k < params->sample_count; ++k) {
-    Rng rng[8];
-    Ray rays[8];
-    packet_camera_rays(params, pixel, params->sample_begin + k, hashed_seed, rng, rays);
-    Hit hits[8];
-    scene_intersect8(&sc, rays, tmax, hits);
-    for (uint l = 0u; l < 8u; ++l) {
-      if (first + l >= params->pixel_end) continue;
-      Ray ray = rays[l];
-      Hit hit = hits[l];
-      Rng r = rng[l];
-      film_add(&mean[l], &m2[l], path_trace(&sc, ray, &hit, &r));
-    }
-  }
-  for (uint l = 0u; l < 8u; ++l) {
-    if (first + l >= params->pixel_end) continue;
-    film_mean[pixel[l]] = mean[l];
-    film_m2[pixel[l]] = m2[l];
-  }
-}
-#else
-__kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                           __global float4* film_mean, __global float4* film_m2) {
-  uint index = params->pixel_begin + (uint)get_global_id(0);
-  if (index >= params->pixel_end) return;
-  uint pixel = pixel_of_launch_index(index, params->width, params->height);
-  SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
-  if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
-  uint px = pixel % params->width, py = pixel / params->width;
-  float4 mean = film_mean[pixel];
-  float4 m2 = film_m2[pixel];
-  for (uint k = 0u; k < params->sample_count; ++k) {
-    Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
-    Ray ray = pixel_camera_ray(params, px, py, &rng);
-    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng));
-  }
-  film_mean[pixel] = mean;
-  film_m2[pixel] = m2;
-}
-#endif

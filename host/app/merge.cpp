@@ -10,6 +10,7 @@
 #include "app/report.hpp"
 #include "base/atomic_file.hpp"
 #include "base/error.hpp"
+#include "render/aov.hpp"
 #include "render/film.hpp"
 #include "render/image_stats.hpp"
 
@@ -132,9 +133,22 @@ std::vector<std::pair<std::pair<uint64_t, uint64_t>, size_t>> disjoint_ranges(co
   return all;
 }
 
-// Weighted mean per pixel, in double
+// Where an AOV channel goes in Film::aov (render/aov.hpp), -1 for spp.Y (summed), -2: none
+int aov_slot(const std::string& name) {
+  const char* names[] = {"albedo.R", "albedo.G", "albedo.B", "A", "normal.X", "normal.Y", "normal.Z", "depth.Z"};
+  for (int k = 0; k < 8; ++k)
+    if (name == names[k]) return k;
+  return name == "spp.Y" ? -1 : -2;
+}
+
+// Weighted mean per pixel, in double; the AOV channels (the same in every input: --aov must
+// match) alike, and spp.Y summed
 Film merged_film(const std::vector<Input>& in, uint64_t total) {
   Film film(in.front().img.width, in.front().img.height);
+  const std::vector<std::string>& names = in.front().img.extra_names;
+  bool any_aov = false;
+  for (const auto& name : names) any_aov = any_aov || aov_slot(name) >= 0;
+  if (any_aov) film.aov.assign(film.pixels() * 8, 0.0f);
   for (size_t p = 0; p < film.pixels(); ++p) {
     for (int c = 0; c < 3; ++c) {
       double sum = 0.0;
@@ -142,8 +156,32 @@ Film merged_film(const std::vector<Input>& in, uint64_t total) {
       film.mean[4 * p + c] = float(sum / double(total));
     }
     film.mean[4 * p + 3] = float(total);
+    for (size_t k = 0; k < names.size(); ++k) {
+      int slot = aov_slot(names[k]);
+      if (slot == -2) continue;
+      double sum = 0.0;
+      for (const auto& x : in) {
+        size_t at = std::find(x.img.extra_names.begin(), x.img.extra_names.end(), names[k]) - x.img.extra_names.begin();
+        float v = at < x.img.extra_names.size() ? x.img.extra[p * x.img.extra_names.size() + at] : 0.0f;
+        sum += slot < 0 ? double(v) : double(x.spp) * v;
+      }
+      if (slot < 0)
+        film.mean[4 * p + 3] = float(sum);
+      else
+        film.aov[8 * p + size_t(slot)] = float(sum / double(total));
+    }
   }
   return film;
+}
+
+// The inputs' AOVs and transparency, from their metadata (the first's: they must match)
+ImageLayers merged_layers(const std::map<std::string, std::string>& meta) {
+  ImageLayers layers;
+  auto aov = meta.find("aov");
+  if (aov != meta.end() && aov->second != "none") layers.aovs = parse_aov_list(aov->second);
+  auto transparent = meta.find("transparent");
+  layers.transparent = transparent != meta.end() && transparent->second == "on";
+  return layers;
 }
 
 // "B:E,B:E": the sorted ranges, adjacent ones coalesced; *first gets the first index
@@ -216,7 +254,7 @@ int run_merge(const MergeArgs& args) {
   std::string ranges = ranges_text(all, &first_index);
   meta["sample_offset"] = std::to_string(first_index);
   meta["sample_ranges"] = ranges;
-  write_image(args.output, film, meta);
+  write_image(args.output, film, meta, {}, merged_layers(meta));
   std::printf("wrote %s\n", args.output.c_str());
   if (!args.quiet)
     std::printf("merged %zu images: %llu spp, sample indices %s\n", in.size(), (unsigned long long)total,

@@ -39,11 +39,13 @@ MpiSession::~MpiSession() { MPI_Finalize(); }
 Film mpi_gather_films(const MpiSession& s, const Film& film, uint32_t* spp, double* seconds, bool* interrupted,
                       bool* partial) {
   const int n = int(film.mean.size());
-  std::vector<float> mine(2 * size_t(n));
+  const int parts = film.aov.empty() ? 2 : 4;  // mean, m2 and the AOVs' two (every rank alike)
+  std::vector<float> mine(parts * size_t(n));
   std::copy(film.mean.begin(), film.mean.end(), mine.begin());
   std::copy(film.m2.begin(), film.m2.end(), mine.begin() + n);
+  std::copy(film.aov.begin(), film.aov.end(), mine.begin() + 2 * size_t(n));
   std::vector<float> all(s.rank() == 0 ? mine.size() * size_t(s.size()) : 0);
-  MPI_Gather(mine.data(), 2 * n, MPI_FLOAT, all.data(), 2 * n, MPI_FLOAT, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine.data(), parts * n, MPI_FLOAT, all.data(), parts * n, MPI_FLOAT, 0, MPI_COMM_WORLD);
   unsigned long long my_spp = *spp, total_spp = 0;
   MPI_Reduce(&my_spp, &total_spp, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
   double longest = 0.0;
@@ -58,9 +60,10 @@ Film mpi_gather_films(const MpiSession& s, const Film& film, uint32_t* spp, doub
   Film out;
   for (int r = 0; r < s.size(); ++r) {
     Film f(film.width, film.height);
-    const float* src = all.data() + size_t(r) * 2 * n;
+    const float* src = all.data() + size_t(r) * parts * n;
     std::copy(src, src + n, f.mean.begin());
     std::copy(src + n, src + 2 * n, f.m2.begin());
+    if (parts == 4) f.aov.assign(src + 2 * n, src + 4 * size_t(n));
     out = r == 0 ? std::move(f) : merge_films(out, f);
   }
   return out;

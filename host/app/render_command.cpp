@@ -24,6 +24,7 @@
 #include "compile/camera.hpp"
 #include "compile/light_tree.hpp"
 #include "compile/scene_compiler.hpp"
+#include "render/aov.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
 #include "scene/default_light.hpp"
@@ -96,7 +97,7 @@ void check_distinct_paths(const RenderArgs& a) {
     return ec ? fs::absolute(path).lexically_normal().string() : p.string();
   };
   std::vector<std::pair<std::string, std::string>> outputs;  // (key, option and path)
-  for (const auto& out : a.outputs) outputs.push_back({key(out), "-o " + out});
+  for (const auto& out : a.outputs) outputs.push_back({key(parse_output(out).path), "-o " + out});
   if (!a.variance.empty()) outputs.push_back({key(a.variance), "--variance " + a.variance});
   if (!a.stats.empty()) outputs.push_back({key(a.stats), "--stats " + a.stats});
   for (size_t i = 0; i < outputs.size(); ++i)
@@ -134,7 +135,7 @@ RenderSettings check_render_args(const RenderArgs& a) {
   apply_render_settings(a, &settings);  // names of enums, and what they set
   check_camera_options(a);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
-  for (const auto& out : a.outputs) check_output_path(out);
+  for (const auto& out : a.outputs) check_output_path(parse_output(out).path);
   check_variance_path(a);
   check_stats_path(a);
   check_distinct_paths(a);
@@ -239,8 +240,17 @@ bool write_outputs(const RenderArgs& a, const Film& film, const RenderReport& re
       ok = false;
     }
   };
-  for (const auto& out : a.outputs)
-    attempt(out, [&] { write_image(out, film, meta, {a.exposure.value_or(0.0f), parse_tonemap(a.tonemap)}); });
+  ImageLayers layers;
+  layers.aovs = requested_aovs(a);
+  layers.transparent = a.transparent;
+  for (const auto& out : a.outputs) {
+    OutputSpec o = parse_output(out);
+    ImageLayers these = layers;
+    these.single = o.aov;
+    attempt(o.path, [&] {
+      write_image(o.path, film, meta, {a.exposure.value_or(0.0f), parse_tonemap(a.tonemap)}, these);
+    });
+  }
   if (!a.variance.empty()) attempt(a.variance, [&] { write_variance_image(a.variance, film, meta); });
   return ok;
 }
@@ -285,6 +295,12 @@ void print_result(const RenderReport& report, bool partial_pass, const Film& fil
 }
 
 }  // namespace
+
+uint32_t requested_aovs(const RenderArgs& a) {
+  uint32_t set = a.aov.empty() ? 0 : parse_aov_list(a.aov);
+  for (const auto& out : a.outputs) set |= parse_output(out).aov;
+  return set;
+}
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   auto* render = app->add_subcommand("render", "Render a glTF scene");

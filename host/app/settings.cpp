@@ -8,6 +8,7 @@
 #include "app/options.hpp"
 #include "app/report.hpp"
 #include "base/error.hpp"
+#include "render/aov.hpp"
 #include "render/tonemap.hpp"
 #include "scene/default_light.hpp"
 #include "scene/scene.hpp"
@@ -300,6 +301,26 @@ std::vector<RenderSetting> make_render_settings() {
        "where a pixel has fewer than 2 samples), with the image's metadata and `candela:image` = `variance_of_mean` "
        "([accuracy.md](accuracy.md#variance-images)).",
        "", option(&A::variance)},
+      recorded(
+          {"--aov", "LIST",
+           "Also compute these AOVs, a comma list of albedo, normal, depth, alpha, spp: channels of every .exr "
+           "output; -o FILE.png:NAME writes one as an image",
+           "Arbitrary output variables, a comma list of `albedo`, `normal`, `depth`, `alpha`, `spp` "
+           "([below](#aovs-and-a-transparent-background)): channels `albedo.R/G/B`, `normal.X/Y/Z`, `depth.Z`, `A`, "
+           "`spp.Y` of every `.exr` output. `-o FILE.png:NAME` (or `.jpg`) writes one as an image, and adds it.",
+           "", option(&A::aov), [](const A& a, S* s) { s->aov = aovs_need_kernel(requested_aovs(a)); }},
+          [](const A& a, const S&) -> SettingValue { return aov_list_text(requested_aovs(a)); }, "aov", "aov",
+          kMustMatch, "CD_AOV"),
+      recorded(
+          {"--transparent", "",
+           "Alpha 0 where the camera sees the environment (fractionally through smooth glass and alpha blending); "
+           "PNG outputs RGBA, EXR ones with A; the environment still lights the scene",
+           "A transparent background ([below](#aovs-and-a-transparent-background)): the environment that camera "
+           "paths see directly or through smooth glass and blended alpha is left out of the image, and alpha says "
+           "how much of it was; it still lights the scene. PNG outputs are RGBA, EXR ones have `A`.",
+           "", flag(&A::transparent), [](const A& a, S* s) { s->transparent = a.transparent; }},
+          [](const A& a, const S&) -> SettingValue { return a.transparent; }, "transparent", "transparent",
+          kMustMatch, "CD_TRANSPARENT"),
       recorded(
           {"--generic", "",
            "Build the generic kernel with every scene feature compiled in, instead of the one specialized to "

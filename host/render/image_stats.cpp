@@ -46,9 +46,23 @@ RgbImage read_rgb_image(const std::string& path, const std::string& what) {
     if (name.rfind("candela:", 0) == 0) img.metadata[name.substr(8)] = p.get_string();
   }
   in->close();
+  int rgb[3];
+  for (int c = 0; c < 3; ++c) {
+    auto named = std::find(spec.channelnames.begin(), spec.channelnames.end(), std::string(1, "RGB"[c]));
+    rgb[c] = named != spec.channelnames.end() ? int(named - spec.channelnames.begin()) : std::min(c, channels - 1);
+  }
+  std::vector<int> others;
+  for (int k = 0; k < channels; ++k)
+    if (k != rgb[0] && k != rgb[1] && k != rgb[2] && k < int(spec.channelnames.size())) {
+      others.push_back(k);
+      img.extra_names.push_back(spec.channelnames[size_t(k)]);
+    }
   img.rgb.resize(img.pixels() * 3);
-  for (size_t i = 0; i < img.pixels(); ++i)
-    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = all[i * channels + std::min(c, channels - 1)];
+  img.extra.resize(img.pixels() * others.size());
+  for (size_t i = 0; i < img.pixels(); ++i) {
+    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = all[i * channels + rgb[c]];
+    for (size_t k = 0; k < others.size(); ++k) img.extra[i * others.size() + k] = all[i * channels + others[k]];
+  }
   return img;
 }
 

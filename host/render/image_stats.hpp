@@ -20,12 +20,14 @@ namespace candela {
 void write_variance_image(const std::string& path, const Film& film,
                           const std::map<std::string, std::string>& metadata);
 
-// A linear RGB float image read from a file (any format OpenImageIO reads; extra channels
-// beyond the first three are ignored, a grey image is repeated into R, G and B)
+// A linear RGB float image read from a file (any format OpenImageIO reads): channels R, G, B
+// by name, else the first three (a grey image repeated into R, G and B); the others kept apart
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<float> rgb;                       // 3 per pixel, row-major from the top
   std::map<std::string, std::string> metadata;  // candela:KEY attributes, without "candela:"
+  std::vector<std::string> extra_names;         // the channels besides R, G and B (A, albedo.R, ...)
+  std::vector<float> extra;                     // extra_names.size() per pixel
   size_t pixels() const { return size_t(width) * height; }
 };
 

@@ -121,6 +121,8 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
   std::string options = "-cl-std=CL1.2 " + features.build_options();
   options += settings.sampler == Sampler::Sobol ? " -DCD_SAMPLER_SOBOL=1" : " -DCD_SAMPLER_SOBOL=0";
   if (render_packets(device, settings)) options += " -DCD_PACKETS=1";
+  if (settings.aov || settings.transparent) options += " -DCD_AOV=1";
+  if (settings.transparent) options += " -DCD_TRANSPARENT=1";
   return options;
 }
 
@@ -236,7 +238,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   kernel_build_seconds_ = build.seconds;
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
-  const unsigned want_args = dev::kSceneBufferCount + 3;  // + params and the film's two buffers
+  const bool aov = settings.aov || settings.transparent;
+  // + params and the film's two buffers, and the AOVs' one
+  const unsigned want_args = dev::kSceneBufferCount + 3 + (aov ? 1 : 0);
   if (kernel_.getInfo<CL_KERNEL_NUM_ARGS>() != want_args)
     throw Error("render_paths takes " + std::to_string(kernel_.getInfo<CL_KERNEL_NUM_ARGS>()) +
                 " arguments, but the host binds " + std::to_string(want_args) +
@@ -285,6 +289,11 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
     cl_uint arg = 0;
     for (const cl::Buffer& b : scene_buffers_) kernel_.setArg(arg++, b);
     for (const cl::Buffer* b : {&params_, &film_mean_, &film_m2_}) kernel_.setArg(arg++, *b);
+    if (aov) {
+      film_aov_ = cl::Buffer(context_, CL_MEM_READ_WRITE, 2 * film_bytes);
+      queue_.enqueueFillBuffer(film_aov_, 0.0f, 0, 2 * film_bytes);
+      kernel_.setArg(arg++, film_aov_);
+    }
     queue_.finish();
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("allocating the film", e.err()));
@@ -353,6 +362,10 @@ Film DeviceRenderer::film() {
   try {
     queue_.enqueueReadBuffer(film_mean_, CL_TRUE, 0, film.mean.size() * sizeof(float), film.mean.data());
     queue_.enqueueReadBuffer(film_m2_, CL_TRUE, 0, film.m2.size() * sizeof(float), film.m2.data());
+    if (settings_.aov || settings_.transparent) {
+      film.aov.resize(film.pixels() * 8);
+      queue_.enqueueReadBuffer(film_aov_, CL_TRUE, 0, film.aov.size() * sizeof(float), film.aov.data());
+    }
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("reading back the film", e.err()));
   }

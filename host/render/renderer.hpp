@@ -65,6 +65,10 @@ struct RenderSettings {
   CD_KERNEL_SETTINGS(CD_KERNEL_SETTING_MEMBER)
 #undef CD_KERNEL_SETTING_MEMBER
   Sampler sampler = Sampler::Sobol;  // a build option: CD_SAMPLER_SOBOL (render_kernel_options)
+  // Build options (render_kernel_options): the AOVs beside the film (CD_AOV, Film::aov), and
+  // the environment seen through see-through paths left out (CD_TRANSPARENT; needs aov)
+  bool aov = false;
+  bool transparent = false;
   double launch_seconds = 0.2;       // target duration of one launch
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
@@ -209,7 +213,7 @@ class DeviceRenderer {
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
   std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
-  cl::Buffer params_, film_mean_, film_m2_;
+  cl::Buffer params_, film_mean_, film_m2_, film_aov_;
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
   size_t pixels_per_item_ = 1;  // 8 with packets (render_packets)

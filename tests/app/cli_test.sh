@@ -264,6 +264,24 @@ if "$bin" render "$scene" -o "$tmp/m.exr" --variance "$tmp/v.exr" --spp 4 --widt
 else
   fail "--variance writes the variance image (generic kernel)"; cat "$tmp/err"
 fi
+# ---- AOVs and the transparent background (tests/render/aov_test.cpp checks their values) ----
+expect_error "unknown AOV" "unknown AOV 'foo'" -- "$bin" render "$scene" -o "$tmp/x.exr" --aov albedo,foo --device pocl
+expect_error "unknown AOV output" "unknown AOV 'foo'" -- "$bin" render "$scene" -o "$tmp/x.png:foo" --device pocl
+expect_error "AOV output of an EXR" "FILE:NAME is for .png" -- "$bin" render "$scene" -o "$tmp/x.exr:normal" --device pocl
+aov_render() {  # OUT OFFSET: a shard with AOVs, a normal image and a transparent PNG
+  "$bin" render "$scene" -o "$1" -o "$tmp/n.png:normal" -o "$tmp/t.png" --aov albedo,depth,spp --transparent --spp 2 \
+    --sample-offset "$2" --width 16 --height 16 --device pocl -q >/dev/null 2>"$tmp/err"
+}
+channels='channel list: R, G, B, A, albedo.R, albedo.G, albedo.B, depth.Z, normal.X, normal.Y, normal.Z, spp.Y'
+if aov_render "$tmp/a0.exr" 0 && aov_render "$tmp/a1.exr" 2 &&
+  "$bin" merge "$tmp/a0.exr" "$tmp/a1.exr" -o "$tmp/a01.exr" -q >/dev/null 2>>"$tmp/err" &&
+  { ! command -v oiiotool >/dev/null || { oiiotool --info -v "$tmp/a0.exr" | grep -q "$channels" &&
+    oiiotool --info -v "$tmp/a01.exr" | grep -q "$channels" && oiiotool --info "$tmp/t.png" | grep -q '4 channel' &&
+    oiiotool --info "$tmp/n.png" | grep -q '3 channel'; }; }; then
+  pass "--aov and --transparent: EXR channels, PNG RGBA, one AOV as PNG, merge keeps them"
+else
+  fail "--aov and --transparent: EXR channels, PNG RGBA, one AOV as PNG, merge keeps them"; cat "$tmp/err"
+fi
 # The generic kernel renders the Cornell box (no optional feature) to the same image
 if command -v oiiotool >/dev/null; then
   if "$bin" render "$scene" -o "$tmp/spec.exr" --spp 4 --width 16 --height 16 --device pocl -q >/dev/null 2>&1 &&

@@ -1,4 +1,4 @@
-// render_paths' launch order (pixel_of_launch_index in cl/integrator/integrator_path.cl),
+// render_paths' launch order (pixel_of_launch_index in cl/integrator/render_paths.cl),
 // as the kernel computes it on PoCL:
 //  - it equals the order written out here by enumeration (bands of 8 rows from the top,
 //    8x8 tiles from the left, Z-order inside a whole tile, row-major inside a cut one), and
