@@ -1,5 +1,5 @@
-// `candela info SCENE`: what a scene holds, as candela reads it: size, extensions, cameras,
-// lights, materials, and the warnings of what it leaves out.
+// `candela info SCENE`: what a scene holds, as candela reads it: size, extensions, animations,
+// cameras, lights, materials, and the warnings of what it leaves out.
 #include <cstdio>
 #include <string>
 
@@ -40,6 +40,18 @@ void print_variants(const Scene& s) {
   if (s.variants.empty()) return;
   std::printf("material variants (KHR_materials_variants; render --variant NAME): %zu\n", s.variants.size());
   for (const std::string& v : s.variants) std::printf("  '%s'\n", v.c_str());
+}
+
+void print_animations(const Scene& s) {
+  if (s.animations.empty()) return;
+  std::printf("animations: %zu (render --anim-time T poses all of them together at T seconds; --animation N|NAME "
+              "one)\n",
+              s.animations.size());
+  for (size_t i = 0; i < s.animations.size(); ++i) {
+    const AnimationDesc& a = s.animations[i];
+    std::printf("  %zu: %s, %.4g to %.4g s, %zu channel%s: %s\n", i, quoted_or(a.name, "(unnamed)").c_str(), a.start,
+                a.end, a.channels, a.channels == 1 ? "" : "s", a.targets.empty() ? "none" : a.targets.c_str());
+  }
 }
 
 void print_cameras(const Scene& s) {
@@ -145,6 +157,7 @@ int run_info_command(const InfoArgs& args) {
   print_geometry(s);
   print_extensions(s);
   print_variants(s);
+  print_animations(s);
   print_cameras(s);
   print_lights(s);
   print_materials(s);

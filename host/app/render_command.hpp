@@ -29,6 +29,8 @@ struct RenderArgs {
   std::string default_light = "auto";  // --default-light auto|on|off (--no-default-light: off)
   std::string light_units;             // --light-units photometric|radiometric; empty: the scene's
   std::string variant;                 // --variant NAME: a KHR_materials_variants variant; empty: the default
+  std::string animation;                // --animation N|NAME: the animation posed; empty: all of them
+  std::optional<double> anim_time;      // --anim-time SECONDS: the moment posed; unset: the rest pose
   std::string stats;
   std::optional<float> exposure;  // --exposure EV; unset: 0, or the automatic exposure (render_scene.cpp)
   // Set where the automatic exposure applies (the scene's own lights' share of the studio's

@@ -180,6 +180,8 @@ Scene load_render_scene(RenderArgs* args) {
   options.allow_outside_paths = a.allow_outside_paths;
   if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
   options.variant = a.variant;
+  options.animation = a.animation;
+  options.anim_time = a.anim_time;
   Scene scene = load_gltf(a.scene, options);
   if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "auto" : scene.strategy;
   apply_background_options(a, &scene);

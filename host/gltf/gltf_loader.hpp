@@ -13,6 +13,10 @@ struct LoadOptions {
   std::optional<LightUnits> light_units;  // else the scene extras' candela.light_units, else photometric
   std::string variant;                    // a KHR_materials_variants name; empty: the default materials
   bool allow_outside_paths = false;       // files outside the scene's folder (SceneFolder)
+  // Animations: the pose at anim_time seconds (unset: the rest pose, animations ignored) of
+  // the animation `animation` names (an index or a name; empty: all of them together)
+  std::optional<double> anim_time;
+  std::string animation;
 };
 
 // Whether the loader implements glTF extension `name` (others are named in a warning)

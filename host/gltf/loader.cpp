@@ -1,7 +1,9 @@
 // The glTF loader's entry points: the file or bytes through tinygltf, compressed geometry
-// decoded (EXT_meshopt_compression, KHR_draco_mesh_compression), then each reader in turn
+// decoded (EXT_meshopt_compression, KHR_draco_mesh_compression), posed by its animations at
+// the time asked (animation.cpp), then each reader in turn
 // (materials, then the node trees with their meshes, cameras and lights, then the
 // environment map the extras name).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -38,7 +40,8 @@ bool supported_extension(const std::string& name) {
                                                    "EXT_mesh_gpu_instancing",
                                                    "EXT_texture_webp",
                                                    "KHR_materials_pbrSpecularGlossiness",
-                                                   "KHR_materials_variants"};
+                                                   "KHR_materials_variants",
+                                                   "KHR_animation_pointer"};
   return kSupported.count(name) > 0;
 }
 
@@ -51,8 +54,25 @@ void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
     if (!supported_extension(ext))
       warn->add("the scene requires glTF extension " + ext +
                 ", which candela does not support: the image may be wrong");
-  if (!model.animations.empty())
-    warn->add("animations are ignored: the scene renders as posed by its node transforms and default morph weights");
+}
+
+// The scene's animations listed and, at LoadOptions::anim_time, the document posed by the
+// chosen ones; without a time, the rest pose
+void apply_animations(tinygltf::Model* model, const LoadOptions& options, Scene* scene, Warnings* warn) {
+  scene->animations = describe_animations(*model, warn);
+  if (!options.anim_time) {
+    if (!options.animation.empty()) throw Error("--animation needs --anim-time (the moment to render)");
+    if (!model->animations.empty())
+      warn->add(
+          "animations are ignored (render --anim-time poses them): the scene renders as posed by its node "
+          "transforms and default morph weights");
+    return;
+  }
+  if (!(std::isfinite(*options.anim_time) && *options.anim_time >= 0.0))
+    throw Error("--anim-time must be a finite, non-negative number of seconds");
+  std::vector<int> chosen = chosen_animations(*model, options.animation);
+  if (chosen.empty()) warn->add("the scene has no animations: --anim-time changes nothing");
+  pose_animations(model, chosen, *options.anim_time, warn);
 }
 
 // tinygltf file access that finds no file: glTF from memory without a base folder
@@ -145,6 +165,7 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   warn_model_wide(model, &warnings);
   decode_meshopt_views(&model);
   decode_draco_primitives(&model, &warnings);
+  apply_animations(&model, options, &scene, &warnings);
   scene.variants = variant_names(model);
   ReadContext ctx{model, scene, warnings, folder, image_errors, options};
   ctx.variant = chosen_variant(model, options.variant);

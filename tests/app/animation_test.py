@@ -1,0 +1,191 @@
+#!/usr/bin/python3
+"""Animations through the command line: --anim-time and --animation on real renders.
+
+- An emissive square seen by an orthographic camera (4 scene units across 64 pixels: 16
+  pixels a unit), moved by a LINEAR translation from x = -1 at t = 0 to x = +1 at t = 2: its
+  silhouette's centroid at --anim-time 0.5 and 1.5 lies 16 pixels apart (and at -8 and +8
+  from the centre); after the last key (t = 5) it stays at the end value; without
+  --anim-time it is at the rest pose (x = 0). The metadata record the pose.
+- Bad input (unknown animation, negative or non-finite time, --animation alone) is one
+  `candela: error:` line and exit 1.
+- With the sample assets (../shared/gltf-samples): `candela info` lists Fox's three
+  animations with their durations, and SimpleSkin and AnimatedMorphSphere posed at a time
+  differ from their rest pose seen by the same camera.
+Usage: animation_test.py path/to/candela repo_root
+"""
+import base64
+import json
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import OpenImageIO as oiio
+
+failures = []
+
+
+def check(ok, what):
+    print(('ok    ' if ok else 'FAIL  ') + what)
+    if not ok:
+        failures.append(what)
+
+
+def run(args):
+    return subprocess.run(args, capture_output=True, text=True)
+
+
+def sliding_square(path):
+    """A unit-half-size emissive square in z = 0 at node 0, an animation 'slide' moving it
+    along x, and an orthographic camera (xmag = ymag = 2) at z = 5 looking down -z."""
+    pos = [(-0.5, -0.5, 0), (0.5, -0.5, 0), (0.5, 0.5, 0), (-0.5, 0.5, 0)]
+    idx = [0, 1, 2, 0, 2, 3]
+    times = [0.0, 2.0]
+    moves = [(-1.0, 0, 0), (1.0, 0, 0)]
+    blobs = [b"".join(struct.pack("<3f", *p) for p in pos), b"".join(struct.pack("<H", i) for i in idx) + b"\0\0",
+             b"".join(struct.pack("<f", t) for t in times), b"".join(struct.pack("<3f", *m) for m in moves)]
+    views, offset = [], 0
+    for b in blobs:
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
+        offset += len(b)
+    data = b"".join(blobs)
+    doc = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.1, "zfar": 10}}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
+                       "emissiveFactor": [1, 1, 1]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [2]},
+            {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+        ],
+        "animations": [{"name": "slide", "samplers": [{"input": 2, "output": 3}],
+                        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}],
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    }
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def render(candela, scene, out, *options):
+    r = run([candela, 'render', scene, '-o', out, '-q', '--device', 'pocl', '--spp', '4', *options])
+    if r.returncode != 0:
+        print(r.stderr)
+    return r
+
+
+def pixels(path):
+    return oiio.ImageBuf(path).get_pixels(oiio.FLOAT)[:, :, :3]
+
+
+def centroid_x(image):
+    lum = image.mean(axis=2)
+    w = lum / lum.sum()
+    return float((w.sum(axis=0) * (np.arange(lum.shape[1]) + 0.5)).sum())
+
+
+def metadata(path):
+    spec = oiio.ImageInput.open(path).spec()
+    return {a.name.split(':', 1)[1]: a.value for a in spec.extra_attribs if a.name.startswith('candela:')}
+
+
+def check_translation(candela, tmp):
+    scene = os.path.join(tmp, 'slide.gltf')
+    sliding_square(scene)
+    common = ['--width', '64', '--height', '64', '--background', '0,0,0', '--default-light', 'off', '--max-depth', '1']
+    x = {}
+    for name, opts in (('rest', []), ('t0.5', ['--anim-time', '0.5']), ('t1.5', ['--anim-time', '1.5', '--animation',
+                                                                                  'slide']),
+                       ('t5', ['--anim-time', '5', '--animation', '0'])):
+        out = os.path.join(tmp, name + '.exr')
+        r = render(candela, scene, out, *common, *opts)
+        check(r.returncode == 0, f'renders the sliding square {" ".join(opts) or "at rest"}')
+        if r.returncode != 0:
+            return
+        x[name] = centroid_x(pixels(out)) - 32.0
+        if name == 't1.5':
+            meta = metadata(out)
+            check(meta.get('anim_time') == '1.5' and meta.get('animation') == 'slide',
+                  f'the metadata record the pose: anim_time {meta.get("anim_time")}, animation {meta.get("animation")}')
+        if name == 'rest':
+            meta = metadata(out)
+            check(meta.get('anim_time') == 'none', f'the rest pose is recorded as anim_time none ({meta.get("anim_time")})')
+    print('  centroid x offsets (pixels):', {k: round(v, 3) for k, v in x.items()})
+    check(abs(x['rest']) < 0.2, f'at rest the square is centred ({x["rest"]:.3f} px)')
+    check(abs(x['t0.5'] + 8) < 0.2, f'at t = 0.5 it is 0.5 units (8 px) left of centre ({x["t0.5"]:.3f} px)')
+    check(abs(x['t1.5'] - 8) < 0.2, f'at t = 1.5 it is 8 px right of centre ({x["t1.5"]:.3f} px)')
+    check(abs(x['t1.5'] - x['t0.5'] - 16) < 0.2, f'between them it moved 1 unit, 16 px ({x["t1.5"] - x["t0.5"]:.3f})')
+    check(abs(x['t5'] - 16) < 0.2, f'after the last key it stays at x = +1, 16 px ({x["t5"]:.3f} px)')
+    return scene
+
+
+def check_errors(candela, scene, tmp):
+    out = os.path.join(tmp, 'bad.png')
+    for opts in (['--anim-time', '-1'], ['--anim-time', 'nan'], ['--anim-time', 'inf'],
+                 ['--anim-time', '1', '--animation', 'walk'], ['--anim-time', '1', '--animation', '3'],
+                 ['--animation', 'slide']):
+        r = run([candela, 'render', scene, '-o', out, '-q', '--device', 'pocl', '--spp', '1', *opts])
+        lines = r.stderr.strip().splitlines()
+        check(r.returncode == 1 and len(lines) == 1 and lines[0].startswith('candela: error:'),
+              f'{" ".join(opts)}: one error line, exit 1 ({r.returncode}: {r.stderr.strip()})')
+
+
+def check_samples(candela, tmp):
+    sys.path.insert(0, os.path.join(sys.argv[2], 'scripts'))
+    import candela_tools
+    samples = candela_tools.samples_folder()
+    if not os.path.isdir(samples):
+        print('skip  the sample assets (not found)')
+        return
+    fox = os.path.join(samples, 'Fox', 'Fox.gltf')
+    info = run([candela, 'info', fox]).stdout
+    for line in ("animations: 3", "0: 'Survey', 0 to 3.417 s, 21 channels", "1: 'Walk', 0 to 0.7083 s",
+                 "2: 'Run', 0 to 1.158 s", "rotation of 20 nodes, translation of 1 node"):
+        check(line in info, f'candela info Fox.gltf lists {line!r}')
+    view = ['--width', '96', '--height', '96']
+    for name, path, t, camera in (
+            ('SimpleSkin', os.path.join(samples, 'SimpleSkin', 'SimpleSkin.gltf'), '1.5',
+             ['--look-from', '0,1,4', '--look-at', '0,1,0']),
+            ('AnimatedMorphSphere', os.path.join(samples, 'AnimatedMorphSphere', 'glTF', 'AnimatedMorphSphere.gltf'),
+             '2', ['--look-from', '0,0,4', '--look-at', '0,0,0'])):
+        if not os.path.exists(path):
+            print(f'skip  {name} (not found)')
+            continue
+        rest, posed = os.path.join(tmp, name + '-rest.exr'), os.path.join(tmp, name + '-posed.exr')
+        ok = render(candela, path, rest, *view, *camera).returncode == 0
+        ok = ok and render(candela, path, posed, *view, *camera, '--anim-time', t).returncode == 0
+        check(ok, f'{name} renders at rest and at --anim-time {t}')
+        if not ok:
+            continue
+        a, b = pixels(rest), pixels(posed)
+        changed = float((np.abs(a - b).max(axis=2) > 0.05 * max(a.max(), 1e-6)).mean())
+        check(changed > 0.03, f'{name} posed at {t} s differs from its rest pose ({changed:.1%} of the pixels)')
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    candela = os.path.abspath(sys.argv[1])
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = check_translation(candela, tmp)
+        if scene:
+            check_errors(candela, scene, tmp)
+        check_samples(candela, tmp)
+    if failures:
+        print(f'{len(failures)} failed')
+        sys.exit(1)
+    print('all passed')
+
+
+if __name__ == '__main__':
+    main()
