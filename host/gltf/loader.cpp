@@ -145,21 +145,32 @@ tinygltf::Model parse_model(const std::string& data, const SceneFolder& folder, 
   return model;
 }
 
-// Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
-// External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
-Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
-                      const LoadOptions& options) {
-  SceneFolder folder{base_dir, options.allow_outside_paths};
-  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
-  if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
+// The document tinygltf parsed, with what parsing found: the images left empty and why,
+// tinygltf's warnings
+struct ParsedDocument {
+  SceneFolder folder;
+  tinygltf::Model model;
   std::map<int, std::string> image_errors;  // filled by load_checked_image
   std::string warn;
-  tinygltf::Model model = parse_model(data, folder, name, &image_errors, &warn);
+};
+
+// Parses glTF JSON or GLB bytes; `name` labels error messages. External URIs resolve
+// against `base_dir`; with an empty one, only data: URIs load.
+ParsedDocument parse_document(const std::string& data, const std::string& base_dir, const std::string& name,
+                              const LoadOptions& options) {
+  ParsedDocument doc{SceneFolder{base_dir, options.allow_outside_paths}, {}, {}, {}};
+  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
+  if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
+  doc.model = parse_model(data, doc.folder, name, &doc.image_errors, &doc.warn);
+  trim_end(&doc.warn, "\n");
+  return doc;
+}
+
+// The scene of a parsed document (its model consumed: compressed geometry decoded into it,
+// posed by its animations)
+Scene build_scene(tinygltf::Model model, const ParsedDocument& doc, const LoadOptions& options) {
   Scene scene;
-  if (!warn.empty()) {
-    trim_end(&warn, "\n");
-    scene.warnings.push_back("glTF loader: " + warn);
-  }
+  if (!doc.warn.empty()) scene.warnings.push_back("glTF loader: " + doc.warn);
   Warnings warnings(&scene.warnings);
   scene.extensions_used = model.extensionsUsed;
   warn_model_wide(model, &warnings);
@@ -167,7 +178,7 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   decode_draco_primitives(&model, &warnings);
   apply_animations(&model, options, &scene, &warnings);
   scene.variants = variant_names(model);
-  ReadContext ctx{model, scene, warnings, folder, image_errors, options};
+  ReadContext ctx{model, scene, warnings, doc.folder, doc.image_errors, options};
   ctx.variant = chosen_variant(model, options.variant);
   if (options.light_units) scene.light_units = *options.light_units;
   read_materials(ctx);
@@ -177,6 +188,18 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   return scene;
 }
 
+Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
+                      const LoadOptions& options) {
+  ParsedDocument doc = parse_document(data, base_dir, name, options);
+  tinygltf::Model model = std::move(doc.model);
+  return build_scene(std::move(model), doc, options);
+}
+
+std::string folder_of(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  return dir.empty() ? "." : dir;
+}
+
 }  // namespace
 }  // namespace gltf
 
@@ -184,12 +207,29 @@ bool supported_gltf_extension(const std::string& name) { return gltf::supported_
 
 Scene load_gltf(const std::string& path, const LoadOptions& options) {
   std::string data = read_regular_file(path, "scene file", gltf::kMaxFileBytes);
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path, options);
+  return gltf::load_gltf_bytes(data, gltf::folder_of(path), path, options);
 }
 
 Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir, const LoadOptions& options) {
   return gltf::load_gltf_bytes(data, base_dir, "(from memory)", options);
+}
+
+struct GltfDocument::Parsed {
+  gltf::ParsedDocument doc;
+  LoadOptions options;
+};
+
+GltfDocument::GltfDocument(const std::string& path, const LoadOptions& options) {
+  std::string data = read_regular_file(path, "scene file", gltf::kMaxFileBytes);
+  parsed_ = std::make_unique<Parsed>(Parsed{gltf::parse_document(data, gltf::folder_of(path), path, options), options});
+}
+
+GltfDocument::~GltfDocument() = default;
+
+Scene GltfDocument::scene(std::optional<double> anim_time) const {
+  LoadOptions options = parsed_->options;
+  options.anim_time = anim_time;
+  return gltf::build_scene(parsed_->doc.model, parsed_->doc, options);  // a copy of the model
 }
 
 }  // namespace candela

@@ -8,6 +8,11 @@
   --anim-time it is at the rest pose (x = 0). The metadata record the pose.
 - Bad input (unknown animation, negative or non-finite time, --animation alone) is one
   `candela: error:` line and exit 1.
+- A sequence (--frames 0:48:24 at 24 fps) of the square: three files named by the '#' run,
+  the square at -16, 0 and +16 pixels, the kernel compiled once (a fresh kernel cache: one
+  build announced, the later frames' stats kernel_from_cache), a progress line per frame;
+  --skip-existing renders only a missing frame and one an interruption left short; a
+  sequence whose output has no '#' is one error before anything renders.
 - With the sample assets (../shared/gltf-samples): `candela info` lists Fox's three
   animations with their durations, and SimpleSkin and AnimatedMorphSphere posed at a time
   differ from their rest pose seen by the same camera.
@@ -140,6 +145,72 @@ def check_errors(candela, scene, tmp):
               f'{" ".join(opts)}: one error line, exit 1 ({r.returncode}: {r.stderr.strip()})')
 
 
+def check_sequence(candela, scene, tmp):
+    common = ['--width', '64', '--height', '64', '--background', '0,0,0', '--default-light', 'off', '--max-depth', '1',
+              '--device', 'pocl', '--spp', '4']
+    env = dict(os.environ, CANDELA_CACHE_DIR=os.path.join(tmp, 'fresh-cache'))
+    seq = os.path.join(tmp, 'seq')
+    os.mkdir(seq)
+    args = [candela, 'render', scene, '-o', os.path.join(seq, 'f_###.exr'), '--stats', os.path.join(seq, 's_###.json'),
+            '--frames', '0:48:24', '--fps', '24', *common]
+    r = subprocess.run(args, capture_output=True, text=True, env=env)
+    check(r.returncode == 0, f'a three-frame sequence renders ({r.stderr.strip()[-300:]})')
+    names = sorted(os.listdir(seq))
+    want = ['f_000.exr', 'f_024.exr', 'f_048.exr', 's_000.json', 's_024.json', 's_048.json']
+    check(names == want, f'its files take the frame numbers: {names}')
+    if r.returncode != 0 or names != want:
+        return
+    builds = r.stderr.count('compiling the render kernel')
+    check(builds == 1, f'the kernel is compiled once for the sequence ({builds} builds announced)')
+    cached = [json.load(open(os.path.join(seq, f's_{f:03d}.json')))['kernel_from_cache'] for f in (0, 24, 48)]
+    check(cached == [False, True, True], f'the later frames take the kernel built for the first ({cached})')
+    progress = [line for line in r.stderr.splitlines() if line.startswith('frame ')]
+    check(len(progress) == 3 and progress[1] == 'frame 24 (2 of 3) at 1 s', f'a progress line per frame: {progress}')
+    x = [centroid_x(pixels(os.path.join(seq, f'f_{f:03d}.exr'))) - 32.0 for f in (0, 24, 48)]
+    check(all(abs(a - b) < 0.2 for a, b in zip(x, (-16, 0, 16))),
+          f'frame f poses the square at f / 24 s: x = {[round(v, 3) for v in x]} px (want -16, 0, 16)')
+    times = [metadata(os.path.join(seq, f'f_{f:03d}.exr')).get('anim_time') for f in (0, 24, 48)]
+    check(times == ['0', '1', '2'], f'each frame records its moment: anim_time {times}')
+
+    # Resuming: a missing frame and one an interruption left short are rendered, the others kept
+    os.remove(os.path.join(seq, 'f_024.exr'))
+    kept = os.path.getmtime(os.path.join(seq, 'f_000.exr'))
+    r = subprocess.run(args + ['--skip-existing'], capture_output=True, text=True, env=env)
+    check(r.returncode == 0 and '1 frame rendered (2 skipped' in r.stderr and
+          os.path.exists(os.path.join(seq, 'f_024.exr')) and os.path.getmtime(os.path.join(seq, 'f_000.exr')) == kept,
+          f'--skip-existing renders only the missing frame ({r.stderr.strip()[-200:]})')
+    # 64 samples in launches of one sample: the interruption comes after the first pass
+    short = [candela, 'render', scene, '-o', os.path.join(seq, 'f_###.exr'), '--frames', '48:72:24',
+             *common[:-1], '64']
+    env_stop = dict(env, CANDELA_RAISE_AT='later-pass:INT', CANDELA_LAUNCH_SECONDS='0.0001')
+    r = subprocess.run(short, capture_output=True, text=True, env=env_stop)
+    stopped = metadata(os.path.join(seq, 'f_048.exr')).get('spp')
+    check(r.returncode == 130 and not os.path.exists(os.path.join(seq, 'f_072.exr')) and stopped not in (None, '64'),
+          f'Ctrl-C writes the frame in progress ({stopped} spp) and stops the sequence (exit {r.returncode})')
+    r = subprocess.run(short + ['--skip-existing'], capture_output=True, text=True, env=env)
+    check(r.returncode == 0 and '2 frames rendered (0 skipped' in r.stderr and
+          metadata(os.path.join(seq, 'f_048.exr')).get('spp') == '64',
+          f'--skip-existing renders the interrupted frame again ({r.stderr.strip()[-200:]})')
+
+    # '#' patterns: a run shorter than the number keeps it whole
+    r = run([candela, 'render', scene, '-o', os.path.join(seq, 'one_#.exr'), '--frames', '9:10', *common])
+    check(r.returncode == 0 and os.path.exists(os.path.join(seq, 'one_9.exr')) and
+          os.path.exists(os.path.join(seq, 'one_10.exr')), 'a single # takes 9 and 10')
+    for opts in (['-o', os.path.join(seq, 'plain.exr')],
+                 ['-o', os.path.join(seq, 'p_#.exr'), '--stats', os.path.join(seq, 'plain.json')]):
+        r = run([candela, 'render', scene, *opts, '--frames', '0:2', *common])
+        lines = r.stderr.strip().splitlines()
+        check(r.returncode == 1 and len(lines) == 1 and 'needs a run of #' in lines[0] and
+              not os.path.exists(os.path.join(seq, 'p_0.exr')) and not os.path.exists(os.path.join(seq, 'plain.exr')),
+              f'a sequence writing a file without #: one error before rendering ({r.stderr.strip()})')
+    for opts in (['--frames', '3:1'], ['--frames', '0:4:0'], ['--frames', '1'], ['--frames', '0:2', '--anim-time', '1'],
+                 ['--fps', '0', '--frames', '0:2'], ['--skip-existing']):
+        r = run([candela, 'render', scene, '-o', os.path.join(seq, 'e_#.exr'), *opts, *common])
+        lines = r.stderr.strip().splitlines()
+        check(r.returncode == 1 and len(lines) == 1 and lines[0].startswith('candela: error:'),
+              f'{" ".join(opts)}: one error line, exit 1 ({r.stderr.strip()})')
+
+
 def check_samples(candela, tmp):
     sys.path.insert(0, os.path.join(sys.argv[2], 'scripts'))
     import candela_tools
@@ -180,6 +251,7 @@ def main():
         scene = check_translation(candela, tmp)
         if scene:
             check_errors(candela, scene, tmp)
+            check_sequence(candela, scene, tmp)
         check_samples(candela, tmp)
     if failures:
         print(f'{len(failures)} failed')
