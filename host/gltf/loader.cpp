@@ -64,7 +64,7 @@ void apply_animations(tinygltf::Model* model, const LoadOptions& options, Scene*
     if (!options.animation.empty()) throw Error("--animation needs --anim-time (the moment to render)");
     if (!model->animations.empty())
       warn->add(
-          "animations are ignored (render --anim-time poses them): the scene renders as posed by its node "
+          "animations are ignored (render --anim-time or --frames poses them): the scene renders as posed by its node "
           "transforms and default morph weights");
     return;
   }
