@@ -1,7 +1,8 @@
 // glTF animations: each sampler's keys read and sampled at a time as the specification
 // defines (3.11), and the document posed at that time before the loader reads it: node
 // translation, rotation, scale and morph weights, and through KHR_animation_pointer the same
-// node properties plus material factors, light colour, intensity, range and cone angles and
+// node properties plus material factors, the numbers of a material's extensions (and of its
+// textures' KHR_texture_transform), light colour, intensity, range and cone angles and
 // camera lenses. Whatever reads the document (skins, morph targets, cameras, lights) then
 // sees the pose.
 #include "gltf/animation.hpp"
@@ -164,14 +165,72 @@ int index_at(const std::vector<std::string>& parts, size_t i, size_t n) {
   return v < n ? int(v) : -1;
 }
 
-// Where a pointer's value goes in the document: a list of numbers or one number
+// Where a pointer's value goes in the document: a list of numbers, one number, or a number
+// or list of numbers inside an extension object (`extensions`, at `keys`: the extension's
+// name, then the members down to the property)
 struct Slot {
   std::vector<double>* list = nullptr;
   double* number = nullptr;
-  size_t width = 0;  // how many numbers it takes
+  size_t width = 0;  // how many numbers it takes; 0 inside an extension where it is not given
   bool rotation = false;
   bool matrix_node = false;  // a node given by a matrix, which no channel may animate
+  tinygltf::ExtensionMap* extensions = nullptr;
+  std::vector<std::string> keys = {};
 };
+
+// The Value at keys[i...] under `v` (nullptr when absent or not an object on the way)
+const tinygltf::Value* value_at(const tinygltf::Value& v, const std::vector<std::string>& keys, size_t i) {
+  if (i == keys.size()) return &v;
+  if (!v.IsObject() || !v.Has(keys[i])) return nullptr;
+  return value_at(v.Get(keys[i]), keys, i + 1);
+}
+
+// `v` with the number (one value) or list at keys[i...] replaced by `values`
+tinygltf::Value with_value(const tinygltf::Value& v, const std::vector<std::string>& keys, size_t i,
+                           const std::vector<float>& values) {
+  if (i == keys.size()) {
+    if (values.size() == 1 && !v.IsArray()) return tinygltf::Value(double(values[0]));
+    tinygltf::Value::Array list;
+    for (float x : values) list.emplace_back(double(x));
+    return tinygltf::Value(std::move(list));
+  }
+  tinygltf::Value::Object object = v.IsObject() ? v.Get<tinygltf::Value::Object>() : tinygltf::Value::Object();
+  object[keys[i]] = with_value(object.count(keys[i]) ? object[keys[i]] : tinygltf::Value(), keys, i + 1, values);
+  return tinygltf::Value(std::move(object));
+}
+
+// A property inside an extension the document has (parts[from] its name): a number, or a
+// list of numbers, that is there, or a member the extension's object leaves at its default
+Slot extension_slot(tinygltf::ExtensionMap& extensions, const std::vector<std::string>& parts, size_t from) {
+  if (parts.size() < from + 2) return {};
+  auto ext = extensions.find(parts[from]);
+  if (ext == extensions.end() || !ext->second.IsObject()) return {};
+  std::vector<std::string> inside(parts.begin() + ptrdiff_t(from) + 1, parts.end());
+  std::vector<std::string> parent(inside.begin(), inside.end() - 1);
+  const tinygltf::Value* container = value_at(ext->second, parent, 0);
+  if (!container || !container->IsObject()) return {};
+  const tinygltf::Value* v = value_at(ext->second, inside, 0);
+  size_t width = 0;
+  if (v && v->IsNumber()) width = 1;
+  if (v && v->IsArray()) {
+    for (size_t k = 0; k < v->ArrayLen(); ++k)
+      if (!v->Get(int(k)).IsNumber()) return {};
+    width = v->ArrayLen();
+  }
+  if ((v && width == 0) || inside.back() == "index" || inside.back() == "texCoord")
+    return {};  // a string, an object, an index: not animatable
+  Slot slot;
+  slot.extensions = &extensions;
+  slot.keys.assign(parts.begin() + ptrdiff_t(from), parts.end());
+  slot.width = width;
+  return slot;
+}
+
+// A textureInfo's KHR_texture_transform (or another extension of it): /.../xTexture/extensions/...
+Slot texture_info_slot(tinygltf::ExtensionMap& extensions, const std::vector<std::string>& p, size_t at) {
+  if (p.size() <= at + 1 || p[at] != "extensions") return {};
+  return extension_slot(extensions, p, at + 1);
+}
 
 // The morph target count of a mesh (its first primitive's)
 size_t morph_targets(const tinygltf::Model& model, int mesh) {
@@ -205,6 +264,13 @@ Slot material_slot(tinygltf::Model& model, const std::vector<std::string>& p) {
   if (rest == "/alphaCutoff") return {nullptr, &mat.alphaCutoff, 1};
   if (rest == "/normalTexture/scale") return {nullptr, &mat.normalTexture.scale, 1};
   if (rest == "/occlusionTexture/strength") return {nullptr, &mat.occlusionTexture.strength, 1};
+  if (p.size() > 2 && p[2] == "extensions") return extension_slot(mat.extensions, p, 3);
+  if (p.size() > 4 && p[2] == "pbrMetallicRoughness" && p[3] == "baseColorTexture")
+    return texture_info_slot(mat.pbrMetallicRoughness.baseColorTexture.extensions, p, 4);
+  if (p.size() > 4 && p[2] == "pbrMetallicRoughness" && p[3] == "metallicRoughnessTexture")
+    return texture_info_slot(mat.pbrMetallicRoughness.metallicRoughnessTexture.extensions, p, 4);
+  if (p.size() > 3 && p[2] == "normalTexture") return texture_info_slot(mat.normalTexture.extensions, p, 3);
+  if (p.size() > 3 && p[2] == "emissiveTexture") return texture_info_slot(mat.emissiveTexture.extensions, p, 3);
   return {};
 }
 
@@ -279,7 +345,7 @@ void pose_animations(tinygltf::Model* model, const std::vector<int>& animations,
       std::string pointer = channel_pointer(anim.channels[ch], where, warn);
       if (pointer.empty()) continue;
       Slot slot = pointer_slot(*model, pointer);
-      if (!slot.list && !slot.number) {
+      if (!slot.list && !slot.number && !slot.extensions) {
         warn->add("animation of " + pointer + " is not supported and is ignored");
         continue;
       }
@@ -288,14 +354,18 @@ void pose_animations(tinygltf::Model* model, const std::vector<int>& animations,
         continue;
       }
       AnimationCurve curve = read_curve(*model, anim, anim.channels[ch].sampler, where);
-      if (curve.width != slot.width)
+      if (slot.width != 0 && curve.width != slot.width)
         throw Error(where + ": " + pointer + " takes " + std::to_string(slot.width) + " values a key, its output has " +
                     std::to_string(curve.width));
       std::vector<float> v = sample_curve(curve, t, slot.rotation);
-      if (slot.number)
+      if (slot.number) {
         *slot.number = v[0];
-      else
+      } else if (slot.list) {
         slot.list->assign(v.begin(), v.end());
+      } else {
+        tinygltf::Value& ext = (*slot.extensions)[slot.keys[0]];
+        ext = with_value(ext, slot.keys, 1, v);
+      }
     }
   }
 }

@@ -312,6 +312,46 @@ TEST(AnimationPose, AnimationPointerTargetsNodesAndMaterials) {
   EXPECT_EQ(left_out, 1u);
 }
 
+// Pointers into a material's extensions and its textures' KHR_texture_transform
+TEST(AnimationPose, AnimationPointerTargetsExtensionNumbers) {
+  GltfBuilder g;
+  g.add("images", {{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAACW9GRnMAAAAAAAAAAADa"
+                           "KrbOAAAADElEQVQImWP4//8/AAX+Av5Y8msOAAAAAElFTkSuQmCC"}});
+  g.add("textures", {{"source", 0}});
+  json material = {{"emissiveFactor", {1, 1, 1}}};
+  material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = 2.0;
+  json& base = material["pbrMetallicRoughness"]["baseColorTexture"];
+  base["index"] = 0;
+  base["extensions"]["KHR_texture_transform"]["offset"] = {0, 0};
+  g.add("materials", material);
+  g.add_mesh({quad_primitive({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, 0)});
+  g.add_node({{"mesh", 0}});
+  g.doc["extensionsUsed"] = {"KHR_animation_pointer", "KHR_materials_emissive_strength", "KHR_texture_transform"};
+  int in = g.add_floats({0, 1}, "SCALAR");
+  int strength = g.add_floats({2, 6}, "SCALAR"), offset = g.add_floats({0, 0, 1, -2}, "VEC2");
+  int index = g.add_floats({0, 1}, "SCALAR");
+  auto pointer = [](const std::string& p) {
+    return json{{"path", "pointer"}, {"extensions", {{"KHR_animation_pointer", {{"pointer", p}}}}}};
+  };
+  const std::string tex = "/materials/0/pbrMetallicRoughness/baseColorTexture";
+  g.add("animations",
+        {{"samplers", {{{"input", in}, {"output", strength}},
+                       {{"input", in}, {"output", offset}},
+                       {{"input", in}, {"output", index}}}},
+         {"channels",
+          {{{"sampler", 0}, {"target", pointer("/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength")}},
+           {{"sampler", 1}, {"target", pointer(tex + "/extensions/KHR_texture_transform/offset")}},
+           {{"sampler", 2}, {"target", pointer(tex + "/index")}}}}});
+  Scene s = load(g.document(), 0.25);
+  EXPECT_NEAR(s.materials[0].emission.x, 3.0f, 1e-5);  // strength 2 -> 6, a quarter of the way
+  const TextureSlot& slot = s.materials[0].texture(TEX_BASE_COLOR);
+  ASSERT_NE(slot.index, NO_TEXTURE);
+  glm::vec2 uv = glm::vec2(slot.transform * glm::vec3(0.0f, 0.0f, 1.0f));
+  EXPECT_NEAR(uv.x, 0.25f, 1e-6);
+  EXPECT_NEAR(uv.y, -0.5f, 1e-6);
+  EXPECT_TRUE(has_warning(s, tex + "/index is not supported"));  // an index is no animatable number
+}
+
 // The glTF validator's files with animations (malformed ones among them), posed: each loads
 // or is rejected with a message, nothing else
 TEST(AnimationPose, ValidatorCorpusPosesOrFailsWithError) {
