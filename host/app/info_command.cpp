@@ -4,6 +4,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/options.hpp"
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "scene/default_light.hpp"
@@ -146,14 +147,24 @@ CLI::App* add_info_command(CLI::App* app, InfoArgs* args) {
   info->add_option("scene", args->scene, "Scene file (.gltf or .glb)")->required();
   info->add_flag("--allow-outside-paths", args->allow_outside_paths,
                  "Let the scene read files outside its folder (absolute paths, .., links out)");
+  info->add_option("--anim-time", args->anim_time,
+                   "The scene posed by its animations at this moment in seconds, as render --anim-time poses it")
+      ->check(finite_number());
+  info->add_option("--animation", args->animation, "The animation --anim-time poses, by index or name (default: all)")
+      ->needs("--anim-time");
   return info;
 }
 
 int run_info_command(const InfoArgs& args) {
   LoadOptions options;
   options.allow_outside_paths = args.allow_outside_paths;
+  options.anim_time = args.anim_time;
+  options.animation = args.animation;
   Scene s = load_gltf(args.scene, options);
   std::printf("scene: %s\n", args.scene.c_str());
+  if (args.anim_time)
+    std::printf("posed at %.6g s by %s\n", *args.anim_time,
+                args.animation.empty() ? "all its animations" : ("animation " + args.animation).c_str());
   print_geometry(s);
   print_extensions(s);
   print_variants(s);

@@ -125,6 +125,9 @@ def check_translation(candela, tmp):
         if name == 'rest':
             meta = metadata(out)
             check(meta.get('anim_time') == 'none', f'the rest pose is recorded as anim_time none ({meta.get("anim_time")})')
+    info = run([candela, 'info', scene, '--anim-time', '1.5']).stdout
+    check('posed at 1.5 s by all its animations' in info and 'bounds (0, -0.5, 0) to (1, 0.5, 0)' in info,
+          'candela info --anim-time 1.5 gives the posed bounds, x from 0 to 1')
     print('  centroid x offsets (pixels):', {k: round(v, 3) for k, v in x.items()})
     check(abs(x['rest']) < 0.2, f'at rest the square is centred ({x["rest"]:.3f} px)')
     check(abs(x['t0.5'] + 8) < 0.2, f'at t = 0.5 it is 0.5 units (8 px) left of centre ({x["t0.5"]:.3f} px)')
