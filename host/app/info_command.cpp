@@ -45,9 +45,10 @@ void print_variants(const Scene& s) {
 
 void print_animations(const Scene& s) {
   if (s.animations.empty()) return;
-  std::printf("animations: %zu (render --anim-time T poses all of them together at T seconds; --animation N|NAME "
-              "one)\n",
-              s.animations.size());
+  std::printf(
+      "animations: %zu (render --anim-time T poses all of them together at T seconds; --animation N|NAME "
+      "one)\n",
+      s.animations.size());
   for (size_t i = 0; i < s.animations.size(); ++i) {
     const AnimationDesc& a = s.animations[i];
     std::printf("  %zu: %s, %.4g to %.4g s, %zu channel%s: %s\n", i, quoted_or(a.name, "(unnamed)").c_str(), a.start,

@@ -371,7 +371,8 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
     for (const std::string& out : a.outputs) done = done && frame_written(out, spp);
     if (done) {
       ++skipped;
-      if (!a.quiet) std::fprintf(stderr, "frame %ld (%zu of %zu): written already, skipped\n", frames[i], i + 1, frames.size());
+      if (!a.quiet)
+        std::fprintf(stderr, "frame %ld (%zu of %zu): written already, skipped\n", frames[i], i + 1, frames.size());
       continue;
     }
     if (!a.quiet)
@@ -392,7 +393,8 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
     ++rendered;
     if (a.exposure) exposure = a.exposure;
     if (status != 0) {
-      if (!a.quiet) std::fprintf(stderr, "stopped at frame %ld: %zu of %zu frames rendered\n", frames[i], rendered, frames.size());
+      if (!a.quiet)
+        std::fprintf(stderr, "stopped at frame %ld: %zu of %zu frames rendered\n", frames[i], rendered, frames.size());
       return status;
     }
   }

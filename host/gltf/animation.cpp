@@ -125,7 +125,8 @@ AnimationCurve read_curve(const tinygltf::Model& model, const tinygltf::Animatio
   size_t elements = c.times.size() * (c.interpolation == Interpolation::CubicSpline ? 3 : 1);
   c.width = c.values.size() / elements;
   if (c.width == 0 || c.values.size() != elements * c.width)
-    throw Error(where + ": its output holds " + std::to_string(c.values.size()) + " values, not a whole number per key");
+    throw Error(where + ": its output holds " + std::to_string(c.values.size()) +
+                " values, not a whole number per key");
   for (float v : c.values)
     if (!std::isfinite(v)) throw Error(where + ": its output values must be finite");
   return c;

@@ -209,7 +209,7 @@ struct Bounds {
 struct AnimationDesc {
   std::string name;
   size_t channels = 0;
-  std::string targets;           // what its channels animate: "rotation of 22 nodes, translation of 1 node"
+  std::string targets;            // what its channels animate: "rotation of 22 nodes, translation of 1 node"
   double start = 0.0, end = 0.0;  // the range of its key times, seconds
 };
 

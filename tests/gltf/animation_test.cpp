@@ -6,10 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <functional>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 
 #include "base/error.hpp"
 #include "gltf/animation.hpp"
@@ -77,8 +77,7 @@ TEST(AnimationSampler, LinearInterpolatesEachComponent) {
 // p(s) = (2s³ − 3s² + 1) v0 + (s³ − 2s² + s) td b0 + (−2s³ + 3s²) v1 + (s³ − s²) td a1
 TEST(AnimationSampler, CubicSplineScalesTheTangentsByTheKeyInterval) {
   // Keys (in-tangent, value, out-tangent) at uneven times 0, 2, 5
-  AnimationCurve c =
-      curve(Interpolation::CubicSpline, {0, 2, 5}, {0, 1, 3, /**/ -1, 4, 1, /**/ 2, 5, 0}, 1);
+  AnimationCurve c = curve(Interpolation::CubicSpline, {0, 2, 5}, {0, 1, 3, /**/ -1, 4, 1, /**/ 2, 5, 0}, 1);
   // t = 0.5: td = 2, s = 1/4: 0.84375·1 + 0.140625·2·3 + 0.15625·4 − 0.046875·2·(−1)
   EXPECT_NEAR(at(c, 0.5), 2.40625, 1e-6);
   // t = 3.5: td = 3, s = 1/2: 0.5·4 + 0.125·3·1 + 0.5·5 − 0.125·3·2
@@ -210,10 +209,12 @@ TEST(AnimationPose, RotationAndScaleComposeAsTRS) {
   int in = g.add_floats({0, 1}, "SCALAR");
   int rot = g.add_floats({0, 0, 0, 1, 0, 0, h, h}, "VEC4");  // to 90 degrees about z
   int scale = g.add_floats({1, 1, 1, 3, 3, 3}, "VEC3");
-  g.add("animations", {{"samplers", {{{"input", in}, {"output", rot}, {"interpolation", "STEP"}},
-                                     {{"input", in}, {"output", scale}}}},
-                       {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}},
-                                     {{"sampler", 1}, {"target", {{"node", 0}, {"path", "scale"}}}}}}});
+  g.add(
+      "animations",
+      {{"samplers", {{{"input", in}, {"output", rot}, {"interpolation", "STEP"}}, {{"input", in}, {"output", scale}}}},
+       {"channels",
+        {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}},
+         {{"sampler", 1}, {"target", {{"node", 0}, {"path", "scale"}}}}}}});
   // t = 1: scale 3, then 90 degrees about z, then the node's own translation (0, 5, 0) kept:
   // the centre (2, 0, 0) goes to (0, 6, 0) + (0, 5, 0)
   glm::vec3 c = centre(load(g.document(), 1.0));
@@ -258,8 +259,9 @@ TEST(AnimationPose, CamerasAndLightsMoveWithTheirNodes) {
   int in = g.add_floats({0, 1}, "SCALAR");
   int cam_path = g.add_floats({0, 0, 5, 4, 0, 5}, "VEC3"), light_path = g.add_floats({0, 3, 0, 0, 7, 0}, "VEC3");
   g.add("animations", {{"samplers", {{{"input", in}, {"output", cam_path}}, {{"input", in}, {"output", light_path}}}},
-                       {"channels", {{{"sampler", 0}, {"target", {{"node", cam}, {"path", "translation"}}}},
-                                     {{"sampler", 1}, {"target", {{"node", light}, {"path", "translation"}}}}}}});
+                       {"channels",
+                        {{{"sampler", 0}, {"target", {{"node", cam}, {"path", "translation"}}}},
+                         {{"sampler", 1}, {"target", {{"node", light}, {"path", "translation"}}}}}}});
   Scene s = load(g.document(), 0.25);
   ASSERT_TRUE(s.camera);
   EXPECT_NEAR(s.camera->position.x, 1.0f, 1e-6);
@@ -291,14 +293,17 @@ TEST(AnimationPose, AnimationPointerTargetsNodesAndMaterials) {
   auto pointer = [](const std::string& p) {
     return json{{"path", "pointer"}, {"extensions", {{"KHR_animation_pointer", {{"pointer", p}}}}}};
   };
-  g.add("animations", {{"samplers", {{{"input", in}, {"output", move}},
-                                     {{"input", in}, {"output", colour}},
-                                     {{"input", in}, {"output", other}}}},
-                       {"channels", {{{"sampler", 0}, {"target", pointer("/nodes/0/translation")}},
-                                     {{"sampler", 1}, {"target", pointer("/materials/0/pbrMetallicRoughness/"
-                                                                         "baseColorFactor")}},
-                                     {{"sampler", 2}, {"target", pointer("/materials/0/extensions/"
-                                                                         "KHR_materials_ior/ior")}}}}});
+  g.add("animations",
+        {{"samplers",
+          {{{"input", in}, {"output", move}}, {{"input", in}, {"output", colour}}, {{"input", in}, {"output", other}}}},
+         {"channels",
+          {{{"sampler", 0}, {"target", pointer("/nodes/0/translation")}},
+           {{"sampler", 1},
+            {"target", pointer("/materials/0/pbrMetallicRoughness/"
+                               "baseColorFactor")}},
+           {{"sampler", 2},
+            {"target", pointer("/materials/0/extensions/"
+                               "KHR_materials_ior/ior")}}}}});
   Scene rest = load(g.document(), std::nullopt);
   ASSERT_EQ(rest.animations.size(), 1u);
   EXPECT_EQ(rest.animations[0].targets, "3 KHR_animation_pointer properties");
@@ -315,8 +320,9 @@ TEST(AnimationPose, AnimationPointerTargetsNodesAndMaterials) {
 // Pointers into a material's extensions and its textures' KHR_texture_transform
 TEST(AnimationPose, AnimationPointerTargetsExtensionNumbers) {
   GltfBuilder g;
-  g.add("images", {{"uri", "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAACW9GRnMAAAAAAAAAAADa"
-                           "KrbOAAAADElEQVQImWP4//8/AAX+Av5Y8msOAAAAAElFTkSuQmCC"}});
+  g.add("images", {{"uri",
+                    "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAACW9GRnMAAAAAAAAAAADa"
+                    "KrbOAAAADElEQVQImWP4//8/AAX+Av5Y8msOAAAAAElFTkSuQmCC"}});
   g.add("textures", {{"source", 0}});
   json material = {{"emissiveFactor", {1, 1, 1}}};
   material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = 2.0;
@@ -335,11 +341,13 @@ TEST(AnimationPose, AnimationPointerTargetsExtensionNumbers) {
   };
   const std::string tex = "/materials/0/pbrMetallicRoughness/baseColorTexture";
   g.add("animations",
-        {{"samplers", {{{"input", in}, {"output", strength}},
-                       {{"input", in}, {"output", offset}},
-                       {{"input", in}, {"output", index}}}},
+        {{"samplers",
+          {{{"input", in}, {"output", strength}},
+           {{"input", in}, {"output", offset}},
+           {{"input", in}, {"output", index}}}},
          {"channels",
-          {{{"sampler", 0}, {"target", pointer("/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength")}},
+          {{{"sampler", 0},
+            {"target", pointer("/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength")}},
            {{"sampler", 1}, {"target", pointer(tex + "/extensions/KHR_texture_transform/offset")}},
            {{"sampler", 2}, {"target", pointer(tex + "/index")}}}}});
   Scene s = load(g.document(), 0.25);
