@@ -14,8 +14,9 @@
   --skip-existing renders only a missing frame and one an interruption left short; a
   sequence whose output has no '#' is one error before anything renders.
 - With the sample assets (../shared/gltf-samples): `candela info` lists Fox's three
-  animations with their durations, and SimpleSkin and AnimatedMorphSphere posed at a time
-  differ from their rest pose seen by the same camera.
+  animations with their durations; SimpleSkin at +90 and -90 degrees of its joint (1 s, 4 s,
+  and +-22.5 between keys) gives mirror-image silhouettes; SimpleSkin and AnimatedMorphSphere
+  posed at a time differ from their rest pose seen by the same camera.
 Usage: animation_test.py path/to/candela repo_root
 """
 import base64
@@ -226,6 +227,7 @@ def check_samples(candela, tmp):
     for line in ("animations: 3", "0: 'Survey', 0 to 3.417 s, 21 channels", "1: 'Walk', 0 to 0.7083 s",
                  "2: 'Run', 0 to 1.158 s", "rotation of 20 nodes, translation of 1 node"):
         check(line in info, f'candela info Fox.gltf lists {line!r}')
+    check_skin_mirror(candela, tmp, samples)
     view = ['--width', '96', '--height', '96']
     for name, path, t, camera in (
             ('SimpleSkin', os.path.join(samples, 'SimpleSkin', 'SimpleSkin.gltf'), '1.5',
@@ -244,6 +246,35 @@ def check_samples(candela, tmp):
         a, b = pixels(rest), pixels(posed)
         changed = float((np.abs(a - b).max(axis=2) > 0.05 * max(a.max(), 1e-6)).mean())
         check(changed > 0.03, f'{name} posed at {t} s differs from its rest pose ({changed:.1%} of the pixels)')
+
+
+def check_skin_mirror(candela, tmp, samples):
+    """SimpleSkin's joint turns +90 degrees about z at t = 1 s and -90 at t = 4 s (LINEAR keys),
+    +22.5 at 0.25 s and -22.5 at 3.25 s (halfway between keys); the mesh is symmetric about
+    x = 0. Seen from +z through that axis, each pair's silhouettes are mirror images
+    (intersection over union at least 0.98), and far from equal unmirrored."""
+    path = os.path.join(samples, 'SimpleSkin', 'SimpleSkin.gltf')
+    if not os.path.exists(path):
+        print('skip  SimpleSkin (not found)')
+        return
+    sil = {}
+    for t in ('1', '4', '0.25', '3.25'):
+        out = os.path.join(tmp, f'skin-{t}.exr')
+        # --max-depth 0: the white background where the camera ray misses, black on the mesh
+        r = render(candela, path, out, '--anim-time', t, '--width', '96', '--height', '96', '--max-depth', '0',
+                   '--background', '1,1,1', '--default-light', 'off', '--look-from', '0,1,4', '--look-at', '0,1,0')
+        if r.returncode != 0:
+            check(False, f'SimpleSkin renders at {t} s')
+            return
+        sil[t] = pixels(out).mean(axis=2) < 0.5
+
+    def iou(a, b):
+        return float((a & b).sum()) / max(float((a | b).sum()), 1.0)
+
+    for a, b in (('1', '4'), ('0.25', '3.25')):
+        mirrored, plain = iou(sil[a], sil[b][:, ::-1]), iou(sil[a], sil[b])
+        check(mirrored >= 0.98 and plain < 0.9,
+              f'SimpleSkin at {a} s is the mirror image of {b} s (IoU {mirrored:.3f}; unmirrored {plain:.3f})')
 
 
 def main():
