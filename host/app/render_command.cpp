@@ -381,9 +381,11 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
     a.exposure = exposure;
     enter_phase(kPreparing);
     Scene scene = load_render_scene(&a, &document);
-    // Without a scene camera, the first frame's framing holds for all (no camera following the motion)
-    if (!scene.camera && framed) scene.camera = framed;
-    if (!scene.camera && !framed) {
+    // A file without a camera: the first frame's camera (framed, or placed by the options)
+    // holds for all, not framing each pose anew
+    if (scene.cameras.empty() && framed) {
+      scene.camera = framed;
+    } else if (scene.cameras.empty()) {
       int w = 0, h = 0;
       resolve_image_size(a, scene, &w, &h);
       framed = resolve_camera(scene, float(w) / float(h));

@@ -228,6 +228,12 @@ def check_samples(candela, tmp):
                  "2: 'Run', 0 to 1.158 s", "rotation of 20 nodes, translation of 1 node"):
         check(line in info, f'candela info Fox.gltf lists {line!r}')
     check_skin_mirror(candela, tmp, samples)
+    # A file without a camera: the sequence keeps the first frame's framing
+    stats = os.path.join(tmp, 'fox_##.json')
+    r = run([candela, 'render', fox, '-o', os.path.join(tmp, 'fox_##.png'), '--stats', stats, '--frames', '0:21:21',
+             '--animation', 'Survey', '--device', 'pocl', '--spp', '2', '--width', '48', '-q'])
+    cams = [json.load(open(stats.replace('##', f))).get('camera') for f in ('00', '21')] if r.returncode == 0 else []
+    check(len(cams) == 2 and cams[0] == cams[1], 'a sequence of a file without a camera keeps its first framing')
     view = ['--width', '96', '--height', '96']
     for name, path, t, camera in (
             ('SimpleSkin', os.path.join(samples, 'SimpleSkin', 'SimpleSkin.gltf'), '1.5',
