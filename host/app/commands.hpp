@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "app/compare.hpp"
@@ -26,6 +27,8 @@ int run_compare_command(CLI::App* cmd, CompareCommand* c);
 struct InfoArgs {
   std::string scene;
   bool allow_outside_paths = false;
+  std::optional<double> anim_time;  // --anim-time: the scene as posed then (geometry, cameras, lights)
+  std::string animation;            // --animation N|NAME
 };
 CLI::App* add_info_command(CLI::App* app, InfoArgs* args);
 int run_info_command(const InfoArgs& args);

@@ -1,9 +1,10 @@
-// `candela info SCENE`: what a scene holds, as candela reads it: size, extensions, cameras,
-// lights, materials, and the warnings of what it leaves out.
+// `candela info SCENE`: what a scene holds, as candela reads it: size, extensions, animations,
+// cameras, lights, materials, and the warnings of what it leaves out.
 #include <cstdio>
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/options.hpp"
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "scene/default_light.hpp"
@@ -40,6 +41,19 @@ void print_variants(const Scene& s) {
   if (s.variants.empty()) return;
   std::printf("material variants (KHR_materials_variants; render --variant NAME): %zu\n", s.variants.size());
   for (const std::string& v : s.variants) std::printf("  '%s'\n", v.c_str());
+}
+
+void print_animations(const Scene& s) {
+  if (s.animations.empty()) return;
+  std::printf(
+      "animations: %zu (render --anim-time T poses all of them together at T seconds; --animation N|NAME "
+      "one)\n",
+      s.animations.size());
+  for (size_t i = 0; i < s.animations.size(); ++i) {
+    const AnimationDesc& a = s.animations[i];
+    std::printf("  %zu: %s, %.4g to %.4g s, %zu channel%s: %s\n", i, quoted_or(a.name, "(unnamed)").c_str(), a.start,
+                a.end, a.channels, a.channels == 1 ? "" : "s", a.targets.empty() ? "none" : a.targets.c_str());
+  }
 }
 
 void print_cameras(const Scene& s) {
@@ -120,17 +134,28 @@ CLI::App* add_info_command(CLI::App* app, InfoArgs* args) {
   info->add_option("scene", args->scene, "Scene file (.gltf or .glb)")->required();
   info->add_flag("--allow-outside-paths", args->allow_outside_paths,
                  "Let the scene read files outside its folder (absolute paths, .., links out)");
+  info->add_option("--anim-time", args->anim_time,
+                   "The scene posed by its animations at this moment in seconds, as render --anim-time poses it")
+      ->check(finite_number());
+  info->add_option("--animation", args->animation, "The animation --anim-time poses, by index or name (default: all)")
+      ->needs("--anim-time");
   return info;
 }
 
 int run_info_command(const InfoArgs& args) {
   LoadOptions options;
   options.allow_outside_paths = args.allow_outside_paths;
+  options.anim_time = args.anim_time;
+  options.animation = args.animation;
   Scene s = load_gltf(args.scene, options);
   std::printf("scene: %s\n", args.scene.c_str());
+  if (args.anim_time)
+    std::printf("posed at %.6g s by %s\n", *args.anim_time,
+                args.animation.empty() ? "all its animations" : ("animation " + args.animation).c_str());
   print_geometry(s);
   print_extensions(s);
   print_variants(s);
+  print_animations(s);
   print_cameras(s);
   print_lights(s);
   print_materials(s);

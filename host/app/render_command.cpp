@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -18,12 +19,14 @@
 #include "app/render_devices.hpp"
 #include "app/render_scene.hpp"
 #include "app/report.hpp"
+#include "app/sequence.hpp"
 #include "app/settings.hpp"
 #include "base/atomic_file.hpp"
 #include "base/file_access.hpp"
 #include "compile/camera.hpp"
 #include "compile/light_tree.hpp"
 #include "compile/scene_compiler.hpp"
+#include "gltf/gltf_loader.hpp"
 #include "render/aov.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
@@ -115,6 +118,24 @@ void check_stats_path(const RenderArgs& a) {
   if (!a.stats.empty()) check_writable_path(a.stats);
 }
 
+// --frames: every file written takes the frame number from a run of '#'
+void check_sequence_args(const RenderArgs& a) {
+  if (a.frames.empty()) {
+    if (a.skip_existing) throw Error("--skip-existing applies to a sequence (--frames)");
+    return;
+  }
+  parse_frames(a.frames);
+  if (a.mpi) throw Error("--frames does not run under --mpi");
+  std::vector<std::pair<std::string, std::string>> files;
+  for (const auto& out : a.outputs) files.push_back({"-o", out});
+  if (!a.variance.empty()) files.push_back({"--variance", a.variance});
+  if (!a.stats.empty()) files.push_back({"--stats", a.stats});
+  for (const auto& [option, path] : files)
+    if (!has_frame_pattern(path))
+      throw Error("--frames writes one file a frame: " + option + " " + path +
+                  " needs a run of # in its name for the frame number (fox_####.png)");
+}
+
 // What can be checked before the scene loads: option names and output paths
 RenderSettings check_render_args(const RenderArgs& a) {
   RenderSettings settings = a.settings;
@@ -139,6 +160,7 @@ RenderSettings check_render_args(const RenderArgs& a) {
   check_variance_path(a);
   check_stats_path(a);
   check_distinct_paths(a);
+  check_sequence_args(a);
   return settings;
 }
 
@@ -308,28 +330,23 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
   return render;
 }
 
-int run_render(RenderArgs a) {
-  catch_signals();
-  RenderSettings settings = check_render_args(a);
-  check_regular_file(a.scene, "scene file");  // a missing scene is named before any device
-  std::vector<DeviceEntry> devices = select_render_devices(a.device);
-  // The tables every scene binds are computed (cold cache) while a long load goes on
-  KernelPrebuild prebuild;
-  for (const DeviceEntry& d : devices) prebuild.start_tables(d, settings);
-  raise_if_asked("loading");
-  Scene scene = load_render_scene(&a);
-  prebuild.loaded();
+namespace {
+
+// The render of a loaded scene, its outputs written: the exit status
+int render_scene(RenderArgs& a, RenderSettings settings, Scene& scene, const std::vector<DeviceEntry>& devices,
+                 KernelPrebuild& prebuild) {
   complete_settings(a, scene, &settings);
   uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
   check_sample_offset(a, spp);
   uint32_t first_sample = mpi_shard(&a, &spp);
-  if (!a.quiet && devices.size() == 1) std::fprintf(stderr, "device: %s\n", joined_descriptions(devices).c_str());
+  if (!a.quiet && !a.repeat && devices.size() == 1)
+    std::fprintf(stderr, "device: %s\n", joined_descriptions(devices).c_str());
   std::string camera = camera_fingerprint(scene, settings.width, settings.height);
   dev::Camera view = compile_camera(scene, settings.width, settings.height);
   std::string lighting = lighting_fingerprint(scene);
   raise_if_asked("kernel-build");
   Renderer renderer = make_renderer(a, &scene, settings, devices, prebuild);
-  if (!a.quiet) print_render_summary(renderer, devices);
+  if (!a.quiet && !a.repeat) print_render_summary(renderer, devices);
   RenderResult r = render_with_progress(renderer, a, settings, first_sample, spp);
   enter_phase(kWriting);
   if (!mpi_combine(&r)) return exit_status(r);
@@ -346,6 +363,81 @@ int run_render(RenderArgs a) {
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
   if (!all_written) return 1;
   return exit_status(r);
+}
+
+// --frames: the document read once; each frame posed, compiled and rendered into the outputs
+// its number names. The first frame's metered exposure holds for the others (no flicker).
+int render_sequence(const RenderArgs& args, const RenderSettings& settings, const std::vector<DeviceEntry>& devices,
+                    KernelPrebuild& first_prebuild) {
+  GltfDocument document(args.scene, render_load_options(args));
+  first_prebuild.loaded();
+  std::vector<long> frames = parse_frames(args.frames);
+  auto start = std::chrono::steady_clock::now();
+  size_t rendered = 0, skipped = 0;
+  std::optional<float> exposure = args.exposure;
+  std::optional<CameraDesc> framed;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    RenderArgs a = args;
+    a.anim_time = double(frames[i]) / args.fps;
+    for (std::string& out : a.outputs) out = frame_path(out, frames[i]);
+    if (!a.variance.empty()) a.variance = frame_path(a.variance, frames[i]);
+    if (!a.stats.empty()) a.stats = frame_path(a.stats, frames[i]);
+    uint32_t spp = a.time > 0 ? 0 : (a.spp ? a.spp : 64);
+    bool done = a.skip_existing;
+    for (const std::string& out : a.outputs) done = done && frame_written(out, spp);
+    if (done) {
+      ++skipped;
+      if (!a.quiet)
+        std::fprintf(stderr, "frame %ld (%zu of %zu): written already, skipped\n", frames[i], i + 1, frames.size());
+      continue;
+    }
+    if (!a.quiet)
+      std::fprintf(stderr, "frame %ld (%zu of %zu) at %.6g s\n", frames[i], i + 1, frames.size(), *a.anim_time);
+    a.repeat = rendered > 0;
+    a.exposure = exposure;
+    enter_phase(kPreparing);
+    Scene scene = load_render_scene(&a, &document);
+    // A file without a camera: the first frame's camera (framed, or placed by the options)
+    // holds for all, not framing each pose anew
+    if (scene.cameras.empty() && framed) {
+      scene.camera = framed;
+    } else if (scene.cameras.empty()) {
+      int w = 0, h = 0;
+      resolve_image_size(a, scene, &w, &h);
+      framed = resolve_camera(scene, float(w) / float(h));
+    }
+    KernelPrebuild later_prebuild;
+    int status = render_scene(a, settings, scene, devices, rendered == 0 ? first_prebuild : later_prebuild);
+    ++rendered;
+    if (a.exposure) exposure = a.exposure;
+    if (status != 0) {
+      if (!a.quiet)
+        std::fprintf(stderr, "stopped at frame %ld: %zu of %zu frames rendered\n", frames[i], rendered, frames.size());
+      return status;
+    }
+  }
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!args.quiet)
+    std::fprintf(stderr, "%zu frame%s rendered (%zu skipped, written already) in %.2f s\n", rendered,
+                 rendered == 1 ? "" : "s", skipped, seconds);
+  return 0;
+}
+
+}  // namespace
+
+int run_render(RenderArgs a) {
+  catch_signals();
+  RenderSettings settings = check_render_args(a);
+  check_regular_file(a.scene, "scene file");  // a missing scene is named before any device
+  std::vector<DeviceEntry> devices = select_render_devices(a.device);
+  // The tables every scene binds are computed (cold cache) while a long load goes on
+  KernelPrebuild prebuild;
+  for (const DeviceEntry& d : devices) prebuild.start_tables(d, settings);
+  raise_if_asked("loading");
+  if (!a.frames.empty()) return render_sequence(a, settings, devices, prebuild);
+  Scene scene = load_render_scene(&a);
+  prebuild.loaded();
+  return render_scene(a, settings, scene, devices, prebuild);
 }
 
 int run_render_command(const RenderArgs& args) {

@@ -29,6 +29,12 @@ struct RenderArgs {
   std::string default_light = "auto";  // --default-light auto|on|off (--no-default-light: off)
   std::string light_units;             // --light-units photometric|radiometric; empty: the scene's
   std::string variant;                 // --variant NAME: a KHR_materials_variants variant; empty: the default
+  std::string animation;               // --animation N|NAME: the animation posed; empty: all of them
+  std::optional<double> anim_time;     // --anim-time SECONDS: the moment posed; unset: the rest pose
+  std::string frames;                  // --frames A:B[:STEP]: a sequence, frame f at f / fps seconds
+  double fps = 24.0;                   // --fps R
+  bool skip_existing = false;          // --skip-existing: frames whose outputs all exist are not rendered
+  bool repeat = false;                 // a later frame of a sequence: the scene's notes were said for the first
   std::string stats;
   std::optional<float> exposure;  // --exposure EV; unset: 0, or the automatic exposure (render_scene.cpp)
   // Set where the automatic exposure applies (the scene's own lights' share of the studio's

@@ -123,7 +123,9 @@ DefaultLightChoice add_default_light(const RenderArgs& a, Scene* scene) {
   bool given = scene->lighting_given || scene->environment.has_value();
   EnvironmentDesc studio = builtin_environment();
   DefaultLightChoice c = choose_default_light(*scene, mode, given, environment_mean_luminance(studio.image));
-  if (c.use_environment) {
+  if (a.repeat) {  // a later frame: said for the first
+    if (c.use_environment) scene->environment = std::move(studio);
+  } else if (c.use_environment) {
     bool own_light = scene->has_light();
     scene->environment = std::move(studio);
     std::fprintf(stderr, "note: lighting the scene with the built-in studio environment: %s (--default-light off %s)\n",
@@ -174,21 +176,28 @@ void warn_unreachable_lights(const RenderArgs& a, const Scene& scene) {
 
 }  // namespace
 
-Scene load_render_scene(RenderArgs* args) {
-  RenderArgs& a = *args;
+LoadOptions render_load_options(const RenderArgs& a) {
   LoadOptions options;
   options.allow_outside_paths = a.allow_outside_paths;
   if (!a.light_units.empty()) options.light_units = parse_enum(kLightUnitNames, "--light-units", a.light_units);
   options.variant = a.variant;
-  Scene scene = load_gltf(a.scene, options);
+  options.animation = a.animation;
+  options.anim_time = a.anim_time;
+  return options;
+}
+
+Scene load_render_scene(RenderArgs* args, const GltfDocument* document) {
+  RenderArgs& a = *args;
+  Scene scene = document ? document->scene(a.anim_time) : load_gltf(a.scene, render_load_options(a));
   if (a.strategy.empty()) a.strategy = scene.strategy.empty() ? "auto" : scene.strategy;
   apply_background_options(a, &scene);
   apply_camera_options(a, &scene);
-  for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (!a.repeat)
+    for (const auto& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   choose_exposure(add_default_light(a, &scene), &a);
   apply_environment_options(a, &scene);
   warn_unreachable_lights(a, scene);
-  if (!scene.camera) {
+  if (!scene.camera && !a.repeat) {
     size_t backdrops = 0;
     framing_bounds(scene, &backdrops);
     std::string left_out = backdrops == 0 ? std::string()

@@ -231,6 +231,53 @@ std::vector<RenderSetting> make_render_settings() {
        "variant's material ([scene-format.md](scene-format.md#gltf-support)); default: the default materials. "
        "`candela info` lists the variants; an unknown name is an error that lists them.",
        "", option(&A::variant)},
+      recorded(
+          {"--animation", "NAME",
+           "The animation --anim-time poses, by index or name (candela info lists them; default: all of them "
+           "together)",
+           "The animation `--anim-time` poses, by index or name (`candela info` lists them); default: all of them "
+           "together, as viewers play them ([scene-format.md](scene-format.md#gltf-support)). An unknown one is an "
+           "error that lists them; it needs `--anim-time` or `--frames`.",
+           "", option(&A::animation),
+           [](const A& a, S*) {
+             if (!a.animation.empty() && !a.anim_time && a.frames.empty())
+               throw Error("--animation needs --anim-time or --frames (the moment to render)");
+           }},
+          [](const A& a, const S&) -> SettingValue {
+            return !a.animation.empty() ? a.animation : a.anim_time ? "all" : "none";
+          },
+          "animation", "animation", kMustMatch),
+      recorded(
+          {"--anim-time", "SECONDS",
+           "Pose the scene's animations at this moment, in seconds (default: the rest pose, animations ignored)",
+           "Pose the scene's animations at this moment, seconds ≥ 0: node transforms, skins, morph weights, "
+           "cameras and lights, as the glTF specification samples them (before the first key and after the last, "
+           "the end values). Default: the rest pose, the animations ignored.",
+           "", option(&A::anim_time, check(finite_number())),
+           [](const A& a, S*) {
+             if (a.anim_time && !(std::isfinite(*a.anim_time) && *a.anim_time >= 0.0))
+               throw Error("--anim-time must be a finite number of seconds, at least 0");
+           }},
+          [](const A& a, const S&) -> SettingValue {
+            if (!a.anim_time) return std::string("none");
+            char text[32];
+            std::snprintf(text, sizeof text, "%.9g", *a.anim_time);
+            return std::string(text);
+          },
+          "anim_time", "anim_time", kMustMatch),
+      {"--frames", "A:B[:STEP]",
+       "Render the frames A to B (every STEP-th) of the animations, frame f at f / --fps seconds, into outputs "
+       "whose run of # takes the frame number (-o fox_####.png)",
+       "", "", option(&A::frames, [](CLI::Option* o) { o->excludes("--anim-time"); })},
+      {"--fps", "R", "Frames per second of --frames (default 24)", "", "24", option(&A::fps, check(positive_number()))},
+      {"--skip-existing", "", "With --frames: leave out the frames whose outputs all exist (to resume a sequence)",
+       "A sequence: frames A, A + STEP, ... up to B, frame f posed at f / R seconds (R default 24). Every output "
+       "(and `--variance`, `--stats`) needs a run of `#` in its file name for the zero-padded frame number "
+       "(`-o fox_####.png`: `fox_0007.png`). The scene is read once, the kernel built once; each frame poses, "
+       "compiles (BVH, lights) and renders the scene with the same `--seed`, the first frame's automatic camera "
+       "and exposure. A progress line per frame; Ctrl-C writes the frame in progress and stops; "
+       "`--skip-existing` leaves out frames written whole (resuming). Excludes `--anim-time` and `--mpi`.",
+       "", flag(&A::skip_existing)},
       {"--stats", "FILE.json", "Write render statistics as JSON to this file",
        "Write render statistics ([below](#statistics---stats)).", "", option(&A::stats)},
       {"--exposure", "EV",

@@ -120,6 +120,25 @@ bool fill_meshopt_placeholders(json& j, bool binary) {
   return changed;
 }
 
+// KHR_animation_pointer's channels name no node, which tinygltf 2.7 requires (it drops the
+// channel): each such target gets node -1 (none), its pointer staying in its extensions
+bool add_pointer_target_nodes(json& j) {
+  const json* animations = member(j, "animations");
+  if (!animations || !animations->is_array()) return false;
+  bool changed = false;
+  for (json& anim : j["animations"]) {
+    const json* channels = member(anim, "channels");
+    if (!channels || !channels->is_array()) continue;
+    for (json& ch : anim["channels"]) {
+      const json* target = member(ch, "target");
+      if (!target || !target->is_object() || member(*target, "node")) continue;
+      ch["target"]["node"] = -1;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
 // An unsigned integer member, or `fallback` when it is missing or not one
 uint64_t unsigned_or(const json& j, const char* key, uint64_t fallback) {
   const json* v = member(j, key);
@@ -193,7 +212,8 @@ bool patch_document(const std::string& data, size_t json_begin, size_t json_size
   bool draco = text.find("KHR_draco_mesh_compression") != std::string_view::npos;
   bool meshopt = text.find("EXT_meshopt_compression") != std::string_view::npos;
   bool images = text.find("\"images\"") != std::string_view::npos;
-  if (!lights && !draco && !meshopt && !images) return false;
+  bool pointers = text.find("KHR_animation_pointer") != std::string_view::npos;
+  if (!lights && !draco && !meshopt && !images && !pointers) return false;
   json j = json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return false;
   if (images) check_image_views(j, name);
@@ -202,6 +222,7 @@ bool patch_document(const std::string& data, size_t json_begin, size_t json_size
   if (draco) changed |= drop_draco_indices(j);
   if (meshopt) changed |= fill_meshopt_placeholders(j, binary);
   if (images) changed |= replace_undecodable_images(j, bad_images);
+  if (pointers) changed |= add_pointer_target_nodes(j);
   if (!changed) return false;
   std::string patched = j.dump();
   if (!binary) {

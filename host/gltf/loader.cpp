@@ -1,7 +1,9 @@
 // The glTF loader's entry points: the file or bytes through tinygltf, compressed geometry
-// decoded (EXT_meshopt_compression, KHR_draco_mesh_compression), then each reader in turn
+// decoded (EXT_meshopt_compression, KHR_draco_mesh_compression), posed by its animations at
+// the time asked (animation.cpp), then each reader in turn
 // (materials, then the node trees with their meshes, cameras and lights, then the
 // environment map the extras name).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -28,7 +30,8 @@ bool supported_extension(const std::string& name) {
                                                    "EXT_mesh_gpu_instancing",
                                                    "EXT_texture_webp",
                                                    "KHR_materials_pbrSpecularGlossiness",
-                                                   "KHR_materials_variants"};
+                                                   "KHR_materials_variants",
+                                                   "KHR_animation_pointer"};
   // and the material extensions whose factors GLTF_PARAMS lists
 #define CD_PARAM_EXTENSION(_, param, n, value, lo, hi, ext, ...) \
   if (name == #ext && name != "CORE") return true;
@@ -46,8 +49,25 @@ void warn_model_wide(const tinygltf::Model& model, Warnings* warn) {
     if (!supported_extension(ext))
       warn->add("the scene requires glTF extension " + ext +
                 ", which candela does not support: the image may be wrong");
-  if (!model.animations.empty())
-    warn->add("animations are ignored: the scene renders as posed by its node transforms and default morph weights");
+}
+
+// The scene's animations listed and, at LoadOptions::anim_time, the document posed by the
+// chosen ones; without a time, the rest pose
+void apply_animations(tinygltf::Model* model, const LoadOptions& options, Scene* scene, Warnings* warn) {
+  scene->animations = describe_animations(*model, warn);
+  if (!options.anim_time) {
+    if (!options.animation.empty()) throw Error("--animation needs --anim-time (the moment to render)");
+    if (!model->animations.empty())
+      warn->add(
+          "animations are ignored (render --anim-time or --frames poses them): the scene renders as posed by its node "
+          "transforms and default morph weights");
+    return;
+  }
+  if (!(std::isfinite(*options.anim_time) && *options.anim_time >= 0.0))
+    throw Error("--anim-time must be a finite, non-negative number of seconds");
+  std::vector<int> chosen = chosen_animations(*model, options.animation);
+  if (chosen.empty()) warn->add("the scene has no animations: --anim-time changes nothing");
+  pose_animations(model, chosen, *options.anim_time, warn);
 }
 
 // tinygltf file access that finds no file: glTF from memory without a base folder
@@ -120,28 +140,40 @@ tinygltf::Model parse_model(const std::string& data, const SceneFolder& folder, 
   return model;
 }
 
-// Parses glTF JSON or GLB bytes and builds the scene; `name` labels error messages.
-// External URIs resolve against `base_dir`; with an empty one, only data: URIs load.
-Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
-                      const LoadOptions& options) {
-  SceneFolder folder{base_dir, options.allow_outside_paths};
-  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
-  if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
+// The document tinygltf parsed, with what parsing found: the images left empty and why,
+// tinygltf's warnings
+struct ParsedDocument {
+  SceneFolder folder;
+  tinygltf::Model model;
   std::map<int, std::string> image_errors;  // filled by load_checked_image
   std::string warn;
-  tinygltf::Model model = parse_model(data, folder, name, &image_errors, &warn);
+};
+
+// Parses glTF JSON or GLB bytes; `name` labels error messages. External URIs resolve
+// against `base_dir`; with an empty one, only data: URIs load.
+ParsedDocument parse_document(const std::string& data, const std::string& base_dir, const std::string& name,
+                              const LoadOptions& options) {
+  ParsedDocument doc{SceneFolder{base_dir, options.allow_outside_paths}, {}, {}, {}};
+  if (data.empty()) throw Error("cannot load glTF scene " + name + ": the file is empty");
+  if (data.size() > kMaxFileBytes) throw Error("cannot load glTF scene " + name + ": larger than 4 GiB");
+  doc.model = parse_model(data, doc.folder, name, &doc.image_errors, &doc.warn);
+  trim_end(&doc.warn, "\n");
+  return doc;
+}
+
+// The scene of a parsed document (its model consumed: compressed geometry decoded into it,
+// posed by its animations)
+Scene build_scene(tinygltf::Model model, const ParsedDocument& doc, const LoadOptions& options) {
   Scene scene;
-  if (!warn.empty()) {
-    trim_end(&warn, "\n");
-    scene.warnings.push_back("glTF loader: " + warn);
-  }
+  if (!doc.warn.empty()) scene.warnings.push_back("glTF loader: " + doc.warn);
   Warnings warnings(&scene.warnings);
   scene.extensions_used = model.extensionsUsed;
   warn_model_wide(model, &warnings);
   decode_meshopt_views(&model);
   decode_draco_primitives(&model, &warnings);
+  apply_animations(&model, options, &scene, &warnings);
   scene.variants = variant_names(model);
-  ReadContext ctx{model, scene, warnings, folder, image_errors, options};
+  ReadContext ctx{model, scene, warnings, doc.folder, doc.image_errors, options};
   ctx.variant = chosen_variant(model, options.variant);
   if (options.light_units) scene.light_units = *options.light_units;
   read_materials(ctx);
@@ -151,6 +183,18 @@ Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, cons
   return scene;
 }
 
+Scene load_gltf_bytes(const std::string& data, const std::string& base_dir, const std::string& name,
+                      const LoadOptions& options) {
+  ParsedDocument doc = parse_document(data, base_dir, name, options);
+  tinygltf::Model model = std::move(doc.model);
+  return build_scene(std::move(model), doc, options);
+}
+
+std::string folder_of(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  return dir.empty() ? "." : dir;
+}
+
 }  // namespace
 }  // namespace gltf
 
@@ -158,12 +202,29 @@ bool supported_gltf_extension(const std::string& name) { return gltf::supported_
 
 Scene load_gltf(const std::string& path, const LoadOptions& options) {
   std::string data = read_regular_file(path, "scene file", gltf::kMaxFileBytes);
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  return gltf::load_gltf_bytes(data, dir.empty() ? "." : dir, path, options);
+  return gltf::load_gltf_bytes(data, gltf::folder_of(path), path, options);
 }
 
 Scene load_gltf_from_memory(const std::string& data, const std::string& base_dir, const LoadOptions& options) {
   return gltf::load_gltf_bytes(data, base_dir, "(from memory)", options);
+}
+
+struct GltfDocument::Parsed {
+  gltf::ParsedDocument doc;
+  LoadOptions options;
+};
+
+GltfDocument::GltfDocument(const std::string& path, const LoadOptions& options) {
+  std::string data = read_regular_file(path, "scene file", gltf::kMaxFileBytes);
+  parsed_ = std::make_unique<Parsed>(Parsed{gltf::parse_document(data, gltf::folder_of(path), path, options), options});
+}
+
+GltfDocument::~GltfDocument() = default;
+
+Scene GltfDocument::scene(std::optional<double> anim_time) const {
+  LoadOptions options = parsed_->options;
+  options.anim_time = anim_time;
+  return gltf::build_scene(parsed_->doc.model, parsed_->doc, options);  // a copy of the model
 }
 
 }  // namespace candela

@@ -132,6 +132,14 @@ bool read_specular_glossiness(ReadContext& ctx, const tinygltf::Material& gm, Ma
 // lights.cpp: the node's KHR_lights_punctual light, placed in the world
 void read_node_light(ReadContext& ctx, int node_index, const tinygltf::Value& ext, const glm::mat4& world);
 
+// animation.cpp: the animations LoadOptions::animation names (an index or a name; empty: all),
+// Error naming the file's for an unknown one; the document posed at time t (seconds) by them,
+// in order (a later channel wins), one warning for each property it leaves out; and the
+// animations as Scene::animations lists them (a malformed one warned about)
+std::vector<int> chosen_animations(const tinygltf::Model& model, const std::string& selection);
+void pose_animations(tinygltf::Model* model, const std::vector<int>& animations, double t, Warnings* warn);
+std::vector<AnimationDesc> describe_animations(const tinygltf::Model& model, Warnings* warn);
+
 // extras.cpp: the scene's extras.candela (environment, strategy, medium, background), and
 // the environment map file it names, read once the document is
 void read_scene_extras(ReadContext& ctx, const tinygltf::Value& extras);

@@ -193,6 +193,14 @@ struct Bounds {
   float radius() const { return 0.5f * glm::length(hi - lo); }
 };
 
+// A glTF animation as `candela info` lists it (the loader poses them: LoadOptions::anim_time)
+struct AnimationDesc {
+  std::string name;
+  size_t channels = 0;
+  std::string targets;            // what its channels animate: "rotation of 22 nodes, translation of 1 node"
+  double start = 0.0, end = 0.0;  // the range of its key times, seconds
+};
+
 struct Scene {
   std::vector<MeshDesc> meshes;
   std::vector<MaterialDesc> materials;
@@ -210,6 +218,7 @@ struct Scene {
   std::vector<std::string> warnings;         // each unsupported feature named once
   std::vector<std::string> extensions_used;  // the file's extensionsUsed
   std::vector<std::string> variants;         // KHR_materials_variants names (LoadOptions::variant picks one)
+  std::vector<AnimationDesc> animations;     // the file's animations, in order
 
   size_t triangles() const;
   Bounds bounds() const;
