@@ -324,7 +324,7 @@ CLI::App* add_render_command(CLI::App* app, RenderArgs* args) {
 int run_render(RenderArgs a) {
   catch_signals();
   RenderSettings settings = check_render_args(a);
-  if (!a.denoise.empty()) load_denoiser();  // a missing library is named before the render
+  if (!a.denoise.empty()) load_denoiser();    // a missing library is named before the render
   check_regular_file(a.scene, "scene file");  // a missing scene is named before any device
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   // The tables every scene binds are computed (cold cache) while a long load goes on

@@ -152,12 +152,18 @@ struct Session {
 
 const char* device_name(int type) {
   switch (type) {
-    case 1: return "CPU";
-    case 2: return "SYCL";
-    case 3: return "CUDA";
-    case 4: return "HIP";
-    case 5: return "Metal";
-    default: return "?";
+    case 1:
+      return "CPU";
+    case 2:
+      return "SYCL";
+    case 3:
+      return "CUDA";
+    case 4:
+      return "HIP";
+    case 5:
+      return "Metal";
+    default:
+      return "?";
   }
 }
 
@@ -186,9 +192,13 @@ DenoiseResult denoise_film(const Film& film, DenoiseQuality quality, bool prefer
   Buffer color_buf = s.buffer(color), albedo_buf = s.buffer(albedo), normal_buf = s.buffer(normal);
   Buffer output_buf = s.buffer(std::vector<float>(3 * n, 0.0f));
   check(oidn, s.device, "copies to the device");
-  auto image = [&](Filter f, const char* name, Buffer b) { oidn.set_filter_image(f, name, b, kFormatFloat3, w, h, 0, 0, 0); };
+  auto image = [&](Filter f, const char* name, Buffer b) {
+    oidn.set_filter_image(f, name, b, kFormatFloat3, w, h, 0, 0, 0);
+  };
   // The guides, each filtered in place on its own, then the beauty with cleanAux
+  const bool guided = !film.aov.empty();
   for (Buffer guide : {albedo_buf, normal_buf}) {
+    if (!guided) break;
     Filter f = s.filter();
     image(f, guide == albedo_buf ? "albedo" : "normal", guide);
     image(f, "output", guide);
@@ -199,11 +209,13 @@ DenoiseResult denoise_film(const Film& film, DenoiseQuality quality, bool prefer
   }
   Filter beauty = s.filter();
   image(beauty, "color", color_buf);
-  image(beauty, "albedo", albedo_buf);
-  image(beauty, "normal", normal_buf);
+  if (guided) {
+    image(beauty, "albedo", albedo_buf);
+    image(beauty, "normal", normal_buf);
+  }
   image(beauty, "output", output_buf);
   oidn.set_filter_bool(beauty, "hdr", true);
-  oidn.set_filter_bool(beauty, "cleanAux", true);
+  oidn.set_filter_bool(beauty, "cleanAux", guided);
   oidn.set_filter_int(beauty, "quality", int(quality));
   oidn.commit_filter(beauty);
   oidn.execute_filter(beauty);

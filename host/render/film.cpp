@@ -90,8 +90,8 @@ void write_image(const std::string& path, const Film& film, const std::map<std::
   float scale = std::exp2(display.exposure);
   const bool denoised = !film.denoised.empty();
   for (size_t i = 0; i < film.pixels(); ++i) {
-    glm::vec3 v = denoised ? glm::vec3(film.denoised[3 * i], film.denoised[3 * i + 1], film.denoised[3 * i + 2])
-                           : film.pixel(i);
+    glm::vec3 v =
+        denoised ? glm::vec3(film.denoised[3 * i], film.denoised[3 * i + 1], film.denoised[3 * i + 2]) : film.pixel(i);
     if (rgba && film_alpha(film, i) > 0.0f) v /= film_alpha(film, i);
     if (!exr) v = tonemap_apply(display.tonemap, v * scale);
     for (int c = 0; c < 3; ++c) rgb[3 * i + c] = exr ? v[c] : linear_to_srgb(v[c]);
