@@ -325,15 +325,16 @@ std::vector<RenderSetting> make_render_settings() {
       recorded(
           {"--denoise", "[=fast|balanced|high]",
            "Denoise the image with Open Image Denoise (scripts/setup.sh installs it), guided by the albedo and "
-           "normal AOVs; QUALITY fast, balanced or high (the default); EXR outputs keep the unbiased image as "
+           "normal AOVs; QUALITY fast, balanced (the default) or high; EXR outputs keep the unbiased image as "
            "noisy.R/G/B",
-           "Denoise with Intel Open Image Denoise ([below](#denoising)) at this quality (`--denoise` alone: "
-           "`high`), guided by the albedo and normal AOVs, which it adds. PNG/JPEG outputs show the denoised "
-           "image; EXR ones hold it as RGB and the unbiased estimate as `noisy.R/G/B`.",
+           "Denoise with Intel Open Image Denoise's `RT` filter ([below](#denoising)) at this quality (`--denoise` "
+           "alone: `balanced`), guided by the albedo and normal AOVs (which it adds), each filtered first (`cleanAux`); "
+           "interrupted renders too. PNG/JPEG outputs show the denoised image; EXR ones hold it as RGB and the "
+           "unbiased estimate as `noisy.R/G/B`, which `merge` and `compare` read.",
            "",
            [](CLI::App* render, RenderArgs& a, const RenderSetting& s) {
-             CLI::Option* o = render->add_flag(s.flags, a.denoise, s.help);  // bare: "true", taken as high
-             o->transform([](std::string v) { return v == "true" ? std::string("high") : v; }, "", "");
+             CLI::Option* o = render->add_flag(s.flags, a.denoise, s.help);  // bare: "true", taken as balanced
+             o->transform([](std::string v) { return v == "true" ? std::string("balanced") : v; }, "", "");
              return o->option_text("[=QUALITY]");
            },
            [](const A& a, S*) {
