@@ -257,14 +257,21 @@ bool write_outputs(const RenderArgs& a, const Film& film, const RenderReport& re
 }
 
 // The film's denoised RGB (render/denoise.hpp), on OIDN's choice of device when candela
-// renders on a GPU, else on the CPU; its time on stderr
-void denoise(const RenderArgs& a, const std::vector<DeviceEntry>& devices, Film* film) {
+// renders on a GPU, else on the CPU; its time on stderr. False (reported) when OIDN fails:
+// the outputs are then written undenoised, so the render is not lost.
+bool denoise(const RenderArgs& a, const std::vector<DeviceEntry>& devices, Film* film) {
   bool gpu = std::any_of(devices.begin(), devices.end(), [](const DeviceEntry& d) { return d.type == "gpu"; });
-  DenoiseResult d = denoise_film(*film, parse_enum(kDenoiseQualityNames, "--denoise", a.denoise), gpu);
-  film->denoised = std::move(d.rgb);
-  if (!a.quiet)
-    std::fprintf(stderr, "denoised in %.2fs (Open Image Denoise, %s quality, %s)\n", d.seconds, a.denoise.c_str(),
-                 d.device.c_str());
+  try {
+    DenoiseResult d = denoise_film(*film, parse_enum(kDenoiseQualityNames, "--denoise", a.denoise), gpu);
+    film->denoised = std::move(d.rgb);
+    if (!a.quiet)
+      std::fprintf(stderr, "denoised in %.2fs (Open Image Denoise, %s quality, %s)\n", d.seconds, a.denoise.c_str(),
+                   d.device.c_str());
+    return true;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "candela: error: %s; the outputs are written undenoised\n", e.what());
+    return false;
+  }
 }
 
 bool write_stats_reporting(const RenderReport& report, const std::string& path) {
@@ -355,8 +362,8 @@ int run_render(RenderArgs a) {
   report.lighting = lighting;
   raise_if_asked("writing");
   meter_exposure(r.film, &a);
-  if (!a.denoise.empty()) denoise(a, devices, &r.film);
-  bool all_written = write_outputs(a, r.film, report);
+  bool denoised = a.denoise.empty() || denoise(a, devices, &r.film);
+  bool all_written = write_outputs(a, r.film, report) && denoised;
   print_result(report, r.partial_pass, r.film);
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
   if (!all_written) return 1;
