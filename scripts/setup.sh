@@ -1,5 +1,5 @@
 # Shared set-up for scripts/demo, scripts/test and scripts/bench/bench.sh (sourced, not run):
-# installs missing Debian packages, then configures and builds Release into build/
+# installs missing Debian packages and Open Image Denoise, then configures and builds Release into build/
 # (scripts/fuzz sets CANDELA_SKIP_BUILD=1: it builds build-fuzz/ with clang instead).
 set -euo pipefail
 
@@ -11,7 +11,7 @@ CANDELA_PACKAGES=(
   libtinygltf-dev nlohmann-json3-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
   googletest libgtest-dev clang-format
-  python3-numpy python3-openimageio python3-matplotlib python3-pil
+  python3-numpy python3-openimageio python3-matplotlib python3-pil python3-pip
 )
 # A script sourcing this may add packages (scripts/fuzz: clang and libFuzzer)
 read -r -a _candela_extra <<<"${CANDELA_EXTRA_PACKAGES:-}"
@@ -40,5 +40,40 @@ candela_build() {
   cmake --build "$CANDELA_ROOT/build" -j "$jobs" "${targets[@]}"
 }
 
+# Intel Open Image Denoise for `render --denoise`: the official libraries of the PyPI wheel
+# pyoidn, unpacked into build/oidn/lib (where candela looks beside its executable). Skipped
+# when there, or with CANDELA_SKIP_OIDN=1; without PyPI (or pip) one notice, and the rest goes on.
+CANDELA_OIDN_WHEEL="pyoidn>=2.5,<2.6"
+candela_install_oidn() {
+  local dest="$CANDELA_ROOT/build/oidn"
+  [ "${CANDELA_SKIP_OIDN:-0}" = 1 ] && return 0
+  [ -e "$dest/lib/libOpenImageDenoise.so.2" ] && return 0
+  local tmp
+  tmp=$(mktemp -d)
+  echo "candela: fetching Open Image Denoise (the PyPI wheel $CANDELA_OIDN_WHEEL, about 90 MB) for --denoise" >&2
+  if python3 -m pip download -q --no-deps --only-binary=:all: -d "$tmp" "$CANDELA_OIDN_WHEEL" >/dev/null 2>&1 &&
+    python3 - "$tmp" "$dest" <<'PY'
+import glob, os, sys, zipfile
+tmp, dest = sys.argv[1], sys.argv[2]
+with zipfile.ZipFile(glob.glob(os.path.join(tmp, 'pyoidn-*.whl'))[0]) as wheel:
+    os.makedirs(os.path.join(dest, 'lib.part'), exist_ok=True)
+    for item in wheel.infolist():
+        name = item.filename[len('pyoidn/oidn/lib/'):]
+        if item.filename.startswith('pyoidn/oidn/lib/') and name and '/' not in name:
+            target = os.path.join(dest, 'lib.part', name)
+            with wheel.open(item) as src, open(target, 'wb') as out:
+                out.write(src.read())
+os.replace(os.path.join(dest, 'lib.part'), os.path.join(dest, 'lib'))
+PY
+  then
+    echo "candela: Open Image Denoise is in $dest/lib" >&2
+  else
+    rm -rf "$dest/lib.part"
+    echo "candela: note: could not fetch Open Image Denoise from PyPI (offline, or no pip): render --denoise is unavailable; the rest works" >&2
+  fi
+  rm -rf "$tmp"
+}
+
 candela_install_packages
+candela_install_oidn
 [ "${CANDELA_SKIP_BUILD:-0}" = 1 ] || candela_build

@@ -223,6 +223,7 @@ std::map<std::string, std::string> merged_metadata(const std::vector<Input>& in,
   meta["device"] = device_text;
   meta["merged_from"] = std::to_string(in.size());
   meta.erase("partial_pass");
+  meta["denoise"] = "off";  // merged from the inputs' unbiased estimates, not denoised
   for (const auto& x : in)
     if (partial(x.img)) meta["partial_pass"] = "1";
   return meta;

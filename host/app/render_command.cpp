@@ -28,6 +28,7 @@
 #include "compile/scene_compiler.hpp"
 #include "gltf/gltf_loader.hpp"
 #include "render/aov.hpp"
+#include "render/denoise.hpp"
 #include "render/image_stats.hpp"
 #include "render/tonemap.hpp"
 #include "scene/default_light.hpp"
@@ -277,6 +278,24 @@ bool write_outputs(const RenderArgs& a, const Film& film, const RenderReport& re
   return ok;
 }
 
+// The film's denoised RGB (render/denoise.hpp), on OIDN's choice of device when candela
+// renders on a GPU, else on the CPU; its time on stderr. False (reported) when OIDN fails:
+// the outputs are then written undenoised, so the render is not lost.
+bool denoise(const RenderArgs& a, const std::vector<DeviceEntry>& devices, Film* film) {
+  bool gpu = std::any_of(devices.begin(), devices.end(), [](const DeviceEntry& d) { return d.type == "gpu"; });
+  try {
+    DenoiseResult d = denoise_film(*film, parse_enum(kDenoiseQualityNames, "--denoise", a.denoise), gpu);
+    film->denoised = std::move(d.rgb);
+    if (!a.quiet)
+      std::fprintf(stderr, "denoised in %.2fs (Open Image Denoise, %s quality, %s)\n", d.seconds, a.denoise.c_str(),
+                   d.device.c_str());
+    return true;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "candela: error: %s; the outputs are written undenoised\n", e.what());
+    return false;
+  }
+}
+
 bool write_stats_reporting(const RenderReport& report, const std::string& path) {
   try {
     write_stats(report, path);
@@ -321,6 +340,7 @@ void print_result(const RenderReport& report, bool partial_pass, const Film& fil
 uint32_t requested_aovs(const RenderArgs& a) {
   uint32_t set = a.aov.empty() ? 0 : parse_aov_list(a.aov);
   for (const auto& out : a.outputs) set |= parse_output(out).aov;
+  if (!a.denoise.empty()) set |= aov_bit(Aov::Albedo) | aov_bit(Aov::Normal);
   return set;
 }
 
@@ -358,7 +378,8 @@ int render_scene(RenderArgs& a, RenderSettings settings, Scene& scene, const std
   report.lighting = lighting;
   raise_if_asked("writing");
   meter_exposure(r.film, &a);
-  bool all_written = write_outputs(a, r.film, report);
+  bool denoised = a.denoise.empty() || denoise(a, devices, &r.film);
+  bool all_written = write_outputs(a, r.film, report) && denoised;
   print_result(report, r.partial_pass, r.film);
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
   if (!all_written) return 1;
@@ -428,6 +449,7 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
 int run_render(RenderArgs a) {
   catch_signals();
   RenderSettings settings = check_render_args(a);
+  if (!a.denoise.empty()) load_denoiser();    // a missing library is named before the render
   check_regular_file(a.scene, "scene file");  // a missing scene is named before any device
   std::vector<DeviceEntry> devices = select_render_devices(a.device);
   // The tables every scene binds are computed (cold cache) while a long load goes on

@@ -49,6 +49,7 @@ struct RenderArgs {
   std::string variance;              // --variance: variance-of-the-mean image (render/image_stats.hpp)
   std::string aov;                   // --aov LIST (render/aov.hpp); outputs FILE.png:NAME add theirs
   bool transparent = false;          // --transparent: alpha 0 where the camera sees the environment
+  std::string denoise;               // --denoise[=QUALITY] (render/denoise.hpp); empty: off
   bool generic = false;              // --generic: the kernel with every scene feature compiled in
   uint32_t sample_offset = 0;        // --sample-offset: first sample index (shards, candela merge)
   bool mpi = false;                  // --mpi: spread the samples over the ranks of an MPI job
@@ -63,7 +64,8 @@ struct RenderArgs {
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args);
 
-// The AOVs a render computes: --aov's and those that outputs FILE.png:NAME name (render/aov.hpp)
+// The AOVs a render computes: --aov's, those that outputs FILE.png:NAME name (render/aov.hpp),
+// and with --denoise its guides, albedo and normal
 uint32_t requested_aovs(const RenderArgs& args);
 
 // Renders, writes the outputs and returns the exit code (130: interrupted)

@@ -9,6 +9,7 @@
 #include "app/report.hpp"
 #include "base/error.hpp"
 #include "render/aov.hpp"
+#include "render/denoise.hpp"
 #include "render/tonemap.hpp"
 #include "scene/default_light.hpp"
 #include "scene/scene.hpp"
@@ -369,6 +370,26 @@ std::vector<RenderSetting> make_render_settings() {
           [](const A& a, const S&) -> SettingValue { return a.transparent; }, "transparent", "transparent",
           kMustMatch, "CD_TRANSPARENT"),
       recorded(
+          {"--denoise", "[=fast|balanced|high]",
+           "Denoise the image with Open Image Denoise (scripts/setup.sh installs it), guided by the albedo and "
+           "normal AOVs; QUALITY fast, balanced (the default) or high; EXR outputs keep the unbiased image as "
+           "noisy.R/G/B",
+           "Denoise with Intel Open Image Denoise's `RT` filter ([below](#denoising)) at this quality (`--denoise` "
+           "alone: `balanced`), guided by the albedo and normal AOVs (which it adds), each filtered first (`cleanAux`); "
+           "interrupted renders too. PNG/JPEG outputs show the denoised image; EXR ones hold it as RGB and the "
+           "unbiased estimate as `noisy.R/G/B`, which `merge` and `compare` read.",
+           "",
+           [](CLI::App* render, RenderArgs& a, const RenderSetting& s) {
+             CLI::Option* o = render->add_flag(s.flags, a.denoise, s.help);  // bare: "true", taken as balanced
+             o->transform([](std::string v) { return v == "true" ? std::string("balanced") : v; }, "", "");
+             return o->option_text("[=QUALITY]");
+           },
+           [](const A& a, S*) {
+             if (!a.denoise.empty()) parse_enum(kDenoiseQualityNames, "--denoise", a.denoise);
+           }},
+          [](const A& a, const S&) -> SettingValue { return a.denoise.empty() ? "off" : a.denoise; }, "denoise",
+          "denoise", false),
+      recorded(
           {"--generic", "",
            "Build the generic kernel with every scene feature compiled in, instead of the one specialized to "
            "the scene (to measure what specialization gains)",
@@ -403,7 +424,7 @@ std::string docs_name(const RenderSetting& s) {
   for (size_t at = name.find(','); at != std::string::npos; at = name.find(',', at + 2)) name.replace(at, 1, ", ");
   std::string value;
   for (char c : s.value_name) value += c == '|' ? std::string("\\|") : std::string(1, c);
-  return "`" + name + (name.empty() || value.empty() ? "" : " ") + value + "`";
+  return "`" + name + (name.empty() || value.empty() || value[0] == '[' ? "" : " ") + value + "`";
 }
 
 std::string options_markdown() {

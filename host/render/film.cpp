@@ -88,8 +88,10 @@ void write_image(const std::string& path, const Film& film, const std::map<std::
   bool rgba = layers.transparent && lower_extension(path) == ".png";
   std::vector<float> rgb(film.pixels() * 3);
   float scale = std::exp2(display.exposure);
+  const bool denoised = !film.denoised.empty();
   for (size_t i = 0; i < film.pixels(); ++i) {
-    glm::vec3 v = film.pixel(i);
+    glm::vec3 v =
+        denoised ? glm::vec3(film.denoised[3 * i], film.denoised[3 * i + 1], film.denoised[3 * i + 2]) : film.pixel(i);
     if (rgba && film_alpha(film, i) > 0.0f) v /= film_alpha(film, i);
     if (!exr) v = tonemap_apply(display.tonemap, v * scale);
     for (int c = 0; c < 3; ++c) rgb[3 * i + c] = exr ? v[c] : linear_to_srgb(v[c]);
@@ -98,6 +100,16 @@ void write_image(const std::string& path, const Film& film, const std::map<std::
   std::vector<std::string> names;
   std::vector<float> extra;
   if (exr) aov_channels(film, layers.aovs, layers.transparent, &names, &extra);
+  if (exr && denoised) {  // the unbiased estimate beside the denoised RGB
+    std::vector<float> with(film.pixels() * (names.size() + 3));
+    size_t k = names.size();
+    for (size_t i = 0; i < film.pixels(); ++i) {
+      for (int c = 0; c < 3; ++c) with[(k + 3) * i + c] = film.mean[4 * i + c];
+      std::copy_n(extra.data() + k * i, k, with.data() + (k + 3) * i + 3);
+    }
+    names.insert(names.begin(), {"noisy.R", "noisy.G", "noisy.B"});
+    extra.swap(with);
+  }
   if (rgba) aov_channels(film, aov_bit(Aov::Alpha), false, &names, &extra);
   if (names.empty()) return write_rgb_pixels(path, film.width, film.height, rgb, exr, meta);
   std::vector<std::string> channels = {"R", "G", "B"};

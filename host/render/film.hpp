@@ -18,6 +18,9 @@ struct Film {
   // With AOVs (cl/integrator/aov.cl), 8 per pixel, else empty: the means over the pixel's
   // samples (kept and dropped) of albedo rgb, alpha, normal xyz and depth
   std::vector<float> aov;
+  // With --denoise, 3 per pixel, else empty: the denoised RGB, which image outputs show
+  // (EXR ones keep the mean as noisy.R/G/B); merges and statistics use the mean
+  std::vector<float> denoised;
 
   Film() = default;
   Film(int w, int h) : width(w), height(h), mean(size_t(w) * h * 4, 0.0f), m2(size_t(w) * h * 4, 0.0f) {}

@@ -46,14 +46,22 @@ RgbImage read_rgb_image(const std::string& path, const std::string& what) {
     if (name.rfind("candela:", 0) == 0) img.metadata[name.substr(8)] = p.get_string();
   }
   in->close();
-  int rgb[3];
+  // A denoised render's unbiased estimate is noisy.R/G/B: read that, leave the denoised RGB out
+  auto index = [&](const std::string& name) {
+    auto named = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
+    return named != spec.channelnames.end() ? int(named - spec.channelnames.begin()) : -1;
+  };
+  const bool noisy = index("noisy.R") >= 0 && index("noisy.G") >= 0 && index("noisy.B") >= 0;
+  int rgb[3], denoised[3] = {-1, -1, -1};
   for (int c = 0; c < 3; ++c) {
-    auto named = std::find(spec.channelnames.begin(), spec.channelnames.end(), std::string(1, "RGB"[c]));
-    rgb[c] = named != spec.channelnames.end() ? int(named - spec.channelnames.begin()) : std::min(c, channels - 1);
+    int plain = index(std::string(1, "RGB"[c]));
+    rgb[c] = noisy ? index(std::string("noisy.") + "RGB"[c]) : plain >= 0 ? plain : std::min(c, channels - 1);
+    if (noisy) denoised[c] = plain;
   }
   std::vector<int> others;
   for (int k = 0; k < channels; ++k)
-    if (k != rgb[0] && k != rgb[1] && k != rgb[2] && k < int(spec.channelnames.size())) {
+    if (k != rgb[0] && k != rgb[1] && k != rgb[2] && k != denoised[0] && k != denoised[1] && k != denoised[2] &&
+        k < int(spec.channelnames.size())) {
       others.push_back(k);
       img.extra_names.push_back(spec.channelnames[size_t(k)]);
     }

@@ -21,7 +21,8 @@ void write_variance_image(const std::string& path, const Film& film,
                           const std::map<std::string, std::string>& metadata);
 
 // A linear RGB float image read from a file (any format OpenImageIO reads): channels R, G, B
-// by name, else the first three (a grey image repeated into R, G and B); the others kept apart
+// by name, else the first three (a grey image repeated into R, G and B); the others kept apart.
+// A denoised render's EXR gives its unbiased estimate, noisy.R/G/B, and leaves R, G, B out.
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<float> rgb;                       // 3 per pixel, row-major from the top
