@@ -44,7 +44,7 @@ def main():
     import candela_tools as ct
     blender = shutil.which('blender')
     if not blender:
-        print('skip: blender is not installed (Debian package blender; scripts/setup.sh --blender installs it)')
+        print('skip: blender is not installed (Debian package blender: CANDELA_EXTRA_PACKAGES=blender scripts/test installs it)')
         sys.exit(SKIP)
     samples = ct.samples_folder()
     if not os.path.isdir(samples):
