@@ -7,7 +7,7 @@ posed by candela and by Blender: their silhouettes seen by the same camera at 25
 overlap with an intersection over union of at least 0.98. The metric tells poses apart: candela's
 silhouette at one moment against Blender's at another of the same animation scores below 0.95.
 Skipped (exit 77) without Debian's `blender` or the sample assets.
-Usage: blender_pose_test.py path/to/candela repo_root [--device pocl|rusticl]
+Usage: blender_pose_test.py path/to/candela repo_root [--device SEL (default: $CANDELA_TEST_DEVICE, else pocl)]
 """
 import os
 import shutil
@@ -38,7 +38,8 @@ def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
     candela, root = os.path.abspath(sys.argv[1]), sys.argv[2]
-    device = sys.argv[sys.argv.index('--device') + 1] if '--device' in sys.argv else 'pocl'
+    device = (sys.argv[sys.argv.index('--device') + 1] if '--device' in sys.argv
+              else os.environ.get('CANDELA_TEST_DEVICE', 'pocl'))
     sys.path.insert(0, os.path.join(root, 'scripts', 'compare'))
     import blender_pose as bp
     import candela_tools as ct
