@@ -35,6 +35,7 @@ dev::Material anisotropic(unsigned type, double metallic, double roughness, doub
   if (type == MATERIAL_GLTF) {
     m.params.gltf.ior = 1.5f;
     for (float& s : m.params.gltf.specular_color) s = 1.0f;
+    m.params.gltf.specular = 1.0f;
     m.params.gltf.metallic = float(metallic);
     m.params.gltf.roughness = float(roughness);
     m.params.gltf.transmission = float(transmission);

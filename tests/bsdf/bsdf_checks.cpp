@@ -165,6 +165,7 @@ dev::Material make_material(unsigned type, glm::dvec3 base_color) {
   if (type == MATERIAL_GLTF) {
     m.params.gltf.ior = 1.5f;
     for (float& s : m.params.gltf.specular_color) s = 1.0f;  // KHR_materials_specular defaults
+    m.params.gltf.specular = 1.0f;
   }
   m.normal_scale = 1.0f;
   for (dev::TextureRef& t : m.textures) {
