@@ -38,7 +38,7 @@ void check_compiled(const candela::CompiledScene& c, const candela::CameraDesc& 
     require(p.material < b.materials.size(), "prim material index");
   }
   for (const auto& m : b.materials)
-    for (const auto* t = m.textures; t != m.textures + TEX_SLOTS; ++t) {
+    for (const auto* t = m.textures; t != m.textures + candela::TEX_SLOTS; ++t) {
       require(t->index == NO_TEXTURE || (t->index >= 0 && size_t(t->index) < b.textures.size()), "texture index");
       require(t->index == NO_TEXTURE || t->texcoord <= 1, "texcoord set");
     }
