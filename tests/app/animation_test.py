@@ -19,28 +19,15 @@
   posed at a time differ from their rest pose seen by the same camera.
 Usage: animation_test.py path/to/candela repo_root
 """
-import base64
 import json
 import os
 import struct
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
 import OpenImageIO as oiio
-
-failures = []
-
-
-def check(ok, what):
-    print(('ok    ' if ok else 'FAIL  ') + what)
-    if not ok:
-        failures.append(what)
-
-
-def run(args):
-    return subprocess.run(args, capture_output=True, text=True)
+from candela_test_util import check, exr_metadata as metadata, finish, run, write_gltf
 
 
 def sliding_square(path):
@@ -50,13 +37,8 @@ def sliding_square(path):
     idx = [0, 1, 2, 0, 2, 3]
     times = [0.0, 2.0]
     moves = [(-1.0, 0, 0), (1.0, 0, 0)]
-    blobs = [b"".join(struct.pack("<3f", *p) for p in pos), b"".join(struct.pack("<H", i) for i in idx) + b"\0\0",
+    blobs = [b"".join(struct.pack("<3f", *p) for p in pos), b"".join(struct.pack("<H", i) for i in idx),
              b"".join(struct.pack("<f", t) for t in times), b"".join(struct.pack("<3f", *m) for m in moves)]
-    views, offset = [], 0
-    for b in blobs:
-        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
-        offset += len(b)
-    data = b"".join(blobs)
     doc = {
         "asset": {"version": "2.0"},
         "scene": 0,
@@ -75,12 +57,8 @@ def sliding_square(path):
         ],
         "animations": [{"name": "slide", "samplers": [{"input": 2, "output": 3}],
                         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}],
-        "bufferViews": views,
-        "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
     }
-    with open(path, "w") as f:
-        json.dump(doc, f)
+    write_gltf(path, doc, blobs)
 
 
 def render(candela, scene, out, *options):
@@ -98,11 +76,6 @@ def centroid_x(image):
     lum = image.mean(axis=2)
     w = lum / lum.sum()
     return float((w.sum(axis=0) * (np.arange(lum.shape[1]) + 0.5)).sum())
-
-
-def metadata(path):
-    spec = oiio.ImageInput.open(path).spec()
-    return {a.name.split(':', 1)[1]: a.value for a in spec.extra_attribs if a.name.startswith('candela:')}
 
 
 def check_translation(candela, tmp):
@@ -157,7 +130,7 @@ def check_sequence(candela, scene, tmp):
     os.mkdir(seq)
     args = [candela, 'render', scene, '-o', os.path.join(seq, 'f_###.exr'), '--stats', os.path.join(seq, 's_###.json'),
             '--frames', '0:48:24', '--fps', '24', *common]
-    r = subprocess.run(args, capture_output=True, text=True, env=env)
+    r = run(args, env=env)
     check(r.returncode == 0, f'a three-frame sequence renders ({r.stderr.strip()[-300:]})')
     names = sorted(os.listdir(seq))
     want = ['f_000.exr', 'f_024.exr', 'f_048.exr', 's_000.json', 's_024.json', 's_048.json']
@@ -179,7 +152,7 @@ def check_sequence(candela, scene, tmp):
     # Resuming: a missing frame and one an interruption left short are rendered, the others kept
     os.remove(os.path.join(seq, 'f_024.exr'))
     kept = os.path.getmtime(os.path.join(seq, 'f_000.exr'))
-    r = subprocess.run(args + ['--skip-existing'], capture_output=True, text=True, env=env)
+    r = run(args + ['--skip-existing'], env=env)
     check(r.returncode == 0 and '1 frame rendered (2 skipped' in r.stderr and
           os.path.exists(os.path.join(seq, 'f_024.exr')) and os.path.getmtime(os.path.join(seq, 'f_000.exr')) == kept,
           f'--skip-existing renders only the missing frame ({r.stderr.strip()[-200:]})')
@@ -187,11 +160,11 @@ def check_sequence(candela, scene, tmp):
     short = [candela, 'render', scene, '-o', os.path.join(seq, 'f_###.exr'), '--frames', '48:72:24',
              *common[:-1], '64']
     env_stop = dict(env, CANDELA_RAISE_AT='later-pass:INT', CANDELA_LAUNCH_SECONDS='0.0001')
-    r = subprocess.run(short, capture_output=True, text=True, env=env_stop)
+    r = run(short, env=env_stop)
     stopped = metadata(os.path.join(seq, 'f_048.exr')).get('spp')
     check(r.returncode == 130 and not os.path.exists(os.path.join(seq, 'f_072.exr')) and stopped not in (None, '64'),
           f'Ctrl-C writes the frame in progress ({stopped} spp) and stops the sequence (exit {r.returncode})')
-    r = subprocess.run(short + ['--skip-existing'], capture_output=True, text=True, env=env)
+    r = run(short + ['--skip-existing'], env=env)
     check(r.returncode == 0 and '2 frames rendered (0 skipped' in r.stderr and
           metadata(os.path.join(seq, 'f_048.exr')).get('spp') == '64',
           f'--skip-existing renders the interrupted frame again ({r.stderr.strip()[-200:]})')
@@ -293,9 +266,7 @@ def main():
             check_errors(candela, scene, tmp)
             check_sequence(candela, scene, tmp)
         check_samples(candela, tmp)
-    if failures:
-        print(f'{len(failures)} failed')
-        sys.exit(1)
+    finish()
     print('all passed')
 
 

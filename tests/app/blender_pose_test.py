@@ -14,7 +14,8 @@ import shutil
 import sys
 import tempfile
 
-SKIP = 77
+from candela_test_util import SKIP, check, finish
+
 SIZE = 256
 FOX_VIEW = ['--look-from', '260,40,-10', '--look-at', '0,40,-10', '--fov', '45']  # the Fox from its right side
 CASES = [  # (asset, animation, moments in seconds, camera)
@@ -24,15 +25,6 @@ CASES = [  # (asset, animation, moments in seconds, camera)
     (('SimpleSkin', 'SimpleSkin.gltf'), '0', (1.0, 0.25), ['--look-from', '0.5,1,4', '--look-at', '0.5,1,0',
                                                            '--fov', '45']),
 ]
-
-failures = []
-
-
-def check(ok, what):
-    print(('ok    ' if ok else 'FAIL  ') + what)
-    if not ok:
-        failures.append(what)
-
 
 def main():
     if len(sys.argv) < 3:
@@ -72,9 +64,7 @@ def main():
             wrong, _, _ = bp.iou(masks[0][0], theirs[1])
             check(wrong < 0.95, '%s %s: candela at %g s against Blender at %g s differ (IoU %.4f < 0.95)' % (
                 asset[1], animation, times[0], times[1], wrong))
-    if failures:
-        print('%d failed' % len(failures))
-        sys.exit(1)
+    finish()
     print('all passed')
 
 

@@ -14,28 +14,11 @@ Where the library loads (scripts/setup.sh installs it; else the rest is skipped,
 Usage: denoise_test.py path/to/candela repo_root
 """
 import os
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
-import OpenImageIO as oiio
-
-failures = []
-
-
-def check(ok, what):
-    print(('ok    ' if ok else 'FAIL  ') + what)
-    if not ok:
-        failures.append(what)
-
-
-def read(path):
-    inp = oiio.ImageInput.open(path)
-    spec = inp.spec()
-    pixels = inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT)
-    inp.close()
-    return {name: pixels[:, :, i] for i, name in enumerate(spec.channelnames)}
+from candela_test_util import SKIP, check, failures, finish, read_channels as read, run
 
 
 def rgb(channels, prefix=''):
@@ -54,7 +37,7 @@ def main():
     def render(out, *options, env=None, size=64, seed='3'):
         cmd = [candela, 'render', scene, '--width', str(size), '--height', str(size), '--device', device, '--seed', seed,
                *sum((['-o', o] for o in (out if isinstance(out, list) else [out])), []), *options]
-        return subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, **(env or {})})
+        return run(cmd, env={**os.environ, **(env or {})})
 
     with tempfile.TemporaryDirectory() as tmp:
         def at(name):
@@ -75,7 +58,7 @@ def main():
         if 'needs Open Image Denoise' in r.stderr:
             print('skip: Open Image Denoise is not installed (scripts/setup.sh installs it into build/oidn): '
                   + r.stderr.strip())
-            sys.exit(1 if failures else 77)
+            sys.exit(1 if failures else SKIP)
         check(r.returncode == 0, f'a render with --denoise=fast runs: {r.stderr.strip()}')
 
         ref = render(at('ref.exr'), '--spp', '1024', '-q', seed='11')
@@ -102,8 +85,7 @@ def main():
         for name, extra in (('d', ['--denoise=fast']), ('p', ['--aov', 'albedo,normal'])):
             for k in (0, 1):
                 render(at(f'{name}{k}.exr'), '--spp', '2', '--sample-offset', str(2 * k), '-q', *extra, size=16)
-            subprocess.run([candela, 'merge', at(f'{name}0.exr'), at(f'{name}1.exr'), '-o', at(f'{name}.exr'), '-q'],
-                           capture_output=True)
+            run([candela, 'merge', at(f'{name}0.exr'), at(f'{name}1.exr'), '-o', at(f'{name}.exr'), '-q'])
         check(os.path.exists(at('d.exr')) and os.path.exists(at('p.exr')) and
               np.array_equal(rgb(read(at('d.exr'))), rgb(read(at('p.exr')))),
               'merge of denoised shards equals the merge of the same shards without --denoise')
@@ -116,9 +98,7 @@ def main():
         r = render(at('int.exr'), '--spp', '64', '--denoise=fast', env={'CANDELA_RAISE_AT': 'later-pass:INT'}, size=16)
         check(r.returncode == 130 and 'denoised in ' in r.stderr and 'noisy.R' in read(at('int.exr')),
               f'an interrupted render is denoised too (exit {r.returncode})')
-    if failures:
-        print(f'{len(failures)} failed')
-        sys.exit(1)
+    finish()
     print('all passed')
 
 

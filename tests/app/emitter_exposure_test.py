@@ -9,8 +9,6 @@ exposure applied, the EXR stays linear (the same with and without the automatic 
 --exposure overrides it.
 Usage: emitter_exposure_test.py path/to/candela repo_root
 """
-import base64
-import json
 import math
 import os
 import struct
@@ -20,6 +18,8 @@ import tempfile
 
 import numpy as np
 import OpenImageIO as oiio
+from candela_test_util import write_gltf
+
 
 
 def room_scene(path):
@@ -50,7 +50,6 @@ def room_scene(path):
     pb = b"".join(struct.pack("<3f", *p) for p in pos)
     ib_room = b"".join(struct.pack("<I", i) for i in idx[:room_count])
     ib_em = b"".join(struct.pack("<I", i) for i in idx[room_count:])
-    data = pb + ib_room + ib_em
     lo = [min(p[k] for p in pos) for k in range(3)]
     hi = [max(p[k] for p in pos) for k in range(3)]
     # The sun's direction (0.3, -0.9, 0.3) normalized: the rotation of -z onto it
@@ -87,16 +86,8 @@ def room_scene(path):
             {"bufferView": 1, "componentType": 5125, "count": room_count, "type": "SCALAR"},
             {"bufferView": 2, "componentType": 5125, "count": len(idx) - room_count, "type": "SCALAR"},
         ],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": len(pb)},
-            {"buffer": 0, "byteOffset": len(pb), "byteLength": len(ib_room)},
-            {"buffer": 0, "byteOffset": len(pb) + len(ib_room), "byteLength": len(ib_em)},
-        ],
-        "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
     }
-    with open(path, "w") as out:
-        json.dump(doc, out)
+    write_gltf(path, doc, [pb, ib_room, ib_em])
 
 
 def pixels(path):

@@ -9,22 +9,10 @@ Usage: settings_test.py CANDELA REPO_ROOT [--update]
 import json
 import os
 import re
-import subprocess
 import sys
 import tempfile
 
-failures = []
-
-
-def check(ok, what):
-    print(('ok    ' if ok else 'FAIL  ') + what)
-    if not ok:
-        failures.append(what)
-
-
-def run(args, **kw):
-    return subprocess.run(args, capture_output=True, text=True, **kw)
-
+from candela_test_util import check, exr_metadata, finish, run
 
 # ---- docs/cli.md: the generated tables ----
 
@@ -122,20 +110,6 @@ def check_kernel(root, listing):
 
 # ---- a real render: its metadata and statistics ----
 
-def exr_metadata(path):
-    try:
-        import OpenImageIO as oiio
-    except ImportError:
-        out = run(['oiiotool', '--info', '-v', path])
-        if out.returncode != 0:
-            return None
-        return dict(re.findall(r'^\s+candela:(\w+): "?(.*?)"?$', out.stdout, re.M))
-    inp = oiio.ImageInput.open(path)
-    meta = {a.name[len('candela:'):]: str(a.value) for a in inp.spec().extra_attribs if a.name.startswith('candela:')}
-    inp.close()
-    return meta
-
-
 def render(candela, scene, tmp, name, *options):
     out = os.path.join(tmp, name)
     r = run([candela, 'render', scene, '-o', out + '.exr', '--stats', out + '.json', '--width', '8', '--height', '8',
@@ -158,7 +132,7 @@ def check_record(candela, scene, tmp, listing):
     check(out is not None, 'a render with --stats')
     if out is None:
         return
-    meta = exr_metadata(out + '.exr')
+    meta = exr_metadata(out + '.exr', text=True)
     stats = json.load(open(out + '.json'))
     settings = [o for o in listing['options'] if o['recorded']]
     want_stats = {o['stats'] for o in settings if o['stats']} | {k['key'] for k in listing['results'] if k['stats']}
@@ -237,9 +211,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         check_record(candela, scene, tmp, listing)
         check_merge(candela, scene, tmp, listing)
-    if failures:
-        print(f'{len(failures)} failed')
-        sys.exit(1)
+    finish()
     print('all passed')
 
 
