@@ -65,24 +65,35 @@ bool bsdf_dielectric_sample_smooth(float eta, bool thin, float3 tint, float3 wo,
   return true;
 }
 
+// The rough lobe's direction about the microfacet normal h: reflection with probability p,
+// else refraction; a thin sheet's transmission is the reflection mirrored through the sheet
+bool dielectric_sample_direction(float3 wo, float3 h, float eta, bool thin, float p, float uc, float3* wi) {
+  if (uc < p || thin) {
+    *wi = fresnel_reflect(wo, h);
+    if (wi->z <= 0.0f) return false;
+    if (uc >= p) wi->z = -wi->z;  // thin sheet: straight through
+    return true;
+  }
+  return fresnel_refract(wo, h, eta, wi) && wi->z < 0.0f;
+}
+
+// The rough lobe's flags and relative index once bs->wi, f and pdf are set
+bool dielectric_sample_finish(float eta, bool thin, BsdfSample* bs) {
+  bool transmits = bs->wi.z < 0.0f;
+  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | BSDF_GLOSSY;
+  bs->eta = transmits && !thin ? eta : 1.0f;
+  return bs->pdf > 0.0f;
+}
+
 bool bsdf_dielectric_sample(Ggx g, float eta, bool thin, float3 tint, float3 wo, float uc, float2 u, BsdfSample* bs) {
   if (wo.z <= 0.0f) return false;
   if (ggx_is_delta(g)) return bsdf_dielectric_sample_smooth(eta, thin, tint, wo, uc, bs);
   float3 h = ggx_sample_visible(g, wo, u);
   float r = fresnel_dielectric(dot(wo, h), eta);
   if (thin) r = dielectric_sheet_reflectance(r);
-  if (uc < r || thin) {
-    bs->wi = fresnel_reflect(wo, h);
-    if (bs->wi.z <= 0.0f) return false;
-    if (uc >= r) bs->wi.z = -bs->wi.z;  // thin sheet: straight through
-  } else if (!fresnel_refract(wo, h, eta, &bs->wi) || bs->wi.z >= 0.0f) {
-    return false;
-  }
-  bool transmits = bs->wi.z < 0.0f;
+  if (!dielectric_sample_direction(wo, h, eta, thin, r, uc, &bs->wi)) return false;
   bs->f = bsdf_dielectric_eval(g, eta, thin, tint, wo, bs->wi, &bs->pdf);
-  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | BSDF_GLOSSY;
-  bs->eta = transmits && !thin ? eta : 1.0f;
-  return bs->pdf > 0.0f;
+  return dielectric_sample_finish(eta, thin, bs);
 }
 
 #if CD_FEATURE_IRIDESCENCE
@@ -169,17 +180,8 @@ bool bsdf_dielectric_film_sample(Ggx g, float eta, bool thin, float3 tint, Diele
   }
   float3 h = ggx_sample_visible(g, wo, u);
   float p = dielectric_film_share(dielectric_film_fresnel(film, dot(wo, h), eta, thin));
-  if (uc < p || thin) {
-    bs->wi = fresnel_reflect(wo, h);
-    if (bs->wi.z <= 0.0f) return false;
-    if (uc >= p) bs->wi.z = -bs->wi.z;  // thin sheet: straight through
-  } else if (!fresnel_refract(wo, h, eta, &bs->wi) || bs->wi.z >= 0.0f) {
-    return false;
-  }
-  bool transmits = bs->wi.z < 0.0f;
+  if (!dielectric_sample_direction(wo, h, eta, thin, p, uc, &bs->wi)) return false;
   bs->f = bsdf_dielectric_film_eval(g, eta, thin, tint, film, wo, bs->wi, &bs->pdf);
-  bs->flags = (transmits ? BSDF_TRANSMISSION : BSDF_REFLECTION) | BSDF_GLOSSY;
-  bs->eta = transmits && !thin ? eta : 1.0f;
-  return bs->pdf > 0.0f;
+  return dielectric_sample_finish(eta, thin, bs);
 }
 #endif

@@ -427,8 +427,11 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
       resolve_image_size(a, scene, &w, &h);
       framed = resolve_camera(scene, float(w) / float(h));
     }
+    // Frame f renders with seed S + f (S from --seed): frames decorrelated, runs repeatable
+    RenderSettings frame_settings = settings;
+    frame_settings.seed = uint32_t(uint64_t(settings.seed) + uint64_t(frames[i]));
     KernelPrebuild later_prebuild;
-    int status = render_scene(a, settings, scene, devices, rendered == 0 ? first_prebuild : later_prebuild);
+    int status = render_scene(a, frame_settings, scene, devices, rendered == 0 ? first_prebuild : later_prebuild);
     ++rendered;
     if (a.exposure) exposure = a.exposure;
     if (status != 0) {

@@ -275,8 +275,8 @@ std::vector<RenderSetting> make_render_settings() {
        "A sequence: frames A, A + STEP, ... up to B, frame f posed at f / R seconds (R default 24). Every output "
        "(and `--variance`, `--stats`) needs a run of `#` in its file name for the zero-padded frame number "
        "(`-o fox_####.png`: `fox_0007.png`). The scene is read once, the kernel built once; each frame poses, "
-       "compiles (BVH, lights) and renders the scene with the same `--seed`, the first frame's automatic camera "
-       "and exposure. A progress line per frame; Ctrl-C writes the frame in progress and stops; "
+       "compiles (BVH, lights) and renders the scene, frame f with seed S + f (S: `--seed`; frames decorrelated, "
+       "a run repeatable), the first frame's automatic camera and exposure. A progress line per frame; Ctrl-C writes the frame in progress and stops; "
        "`--skip-existing` leaves out frames written whole (resuming). Excludes `--anim-time` and `--mpi`.",
        "", flag(&A::skip_existing)},
       {"--stats", "FILE.json", "Write render statistics as JSON to this file",

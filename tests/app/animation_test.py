@@ -12,7 +12,8 @@
   the square at -16, 0 and +16 pixels, the kernel compiled once (a fresh kernel cache: one
   build announced, the later frames' stats kernel_from_cache), a progress line per frame;
   --skip-existing renders only a missing frame and one an interruption left short; a
-  sequence whose output has no '#' is one error before anything renders.
+  sequence whose output has no '#' is one error before anything renders; frame f renders with
+  seed --seed + f (two frames of one pose differ, a second run repeats the first).
 - With the sample assets (../shared/gltf-samples): `candela info` lists Fox's three
   animations with their durations; SimpleSkin at +90 and -90 degrees of its joint (1 s, 4 s,
   and +-22.5 between keys) gives mirror-image silhouettes; SimpleSkin and AnimatedMorphSphere
@@ -168,6 +169,22 @@ def check_sequence(candela, scene, tmp):
     check(r.returncode == 0 and '2 frames rendered (0 skipped' in r.stderr and
           metadata(os.path.join(seq, 'f_048.exr')).get('spp') == '64',
           f'--skip-existing renders the interrupted frame again ({r.stderr.strip()[-200:]})')
+
+    # Seeds: frame f renders with --seed + f; two frames of one pose differ in their noise, a
+    # second run of the sequence repeats it bit for bit
+    # (60 px: the square's edges cut pixels in half, where the samples' positions tell)
+    still = [candela, 'render', scene, '-o', os.path.join(seq, 'still_###.exr'), '--frames', '120:121', '--seed', '5',
+             '--width', '60', '--height', '60', *common[4:]]
+    images = []
+    for _ in range(2):
+        r = run(still)
+        images.append([pixels(os.path.join(seq, f'still_{f}.exr')) for f in (120, 121)] if r.returncode == 0 else None)
+    seeds = [metadata(os.path.join(seq, f'still_{f}.exr')).get('seed') for f in (120, 121)] if images[0] else None
+    check(seeds == ['125', '126'], f'frame f renders with seed --seed + f ({seeds})')
+    check(images[0] is not None and not np.array_equal(*images[0]),
+          'two frames of one pose differ in their noise (decorrelated)')
+    check(images[1] is not None and all(np.array_equal(a, b) for a, b in zip(*images)),
+          'and a second run of the sequence repeats it bit for bit')
 
     # '#' patterns: a run shorter than the number keeps it whole
     r = run([candela, 'render', scene, '-o', os.path.join(seq, 'one_#.exr'), '--frames', '9:10', *common])

@@ -136,15 +136,6 @@ Scene load(const json& j, std::optional<double> t, const std::string& animation 
 
 glm::vec3 centre(const Scene& s) { return s.bounds().center(); }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 bool has_warning(const Scene& s, const std::string& part) {
   for (const std::string& w : s.warnings)
     if (w.find(part) != std::string::npos) return true;

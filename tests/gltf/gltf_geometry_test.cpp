@@ -63,15 +63,6 @@ void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
   EXPECT_NEAR(a.z, b.z, tol);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 // ../shared/gltf-samples beside the checkout (beside the main checkout from a git worktree),
 // or "" when absent
 std::string samples_dir() {

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <memory>
 
+#include "base/error.hpp"
+
 namespace candela::test {
 
 ScopedCacheDir::ScopedCacheDir() {
@@ -110,5 +112,14 @@ Renderer scene_renderer(const DeviceEntry& device, const Scene& scene, const Ren
 }
 
 const char* strategy_name(Strategy s) { return enum_name(kStrategyNames, s); }
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace candela::test

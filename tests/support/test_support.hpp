@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,5 +66,8 @@ Film render_film(const Scene& scene, Strategy strategy, int w, int h, uint32_t s
                  uint32_t seed);  // on PoCL
 
 const char* strategy_name(Strategy s);  // "nee", "bsdf" or "auto", as the CLI spells them
+
+// The message of the candela::Error that f throws; "" when it throws none
+std::string error_of(const std::function<void()>& f);
 
 }  // namespace candela::test
