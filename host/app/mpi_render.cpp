@@ -1,9 +1,11 @@
 // `candela render --mpi` (mpi_render.hpp): the MPI session, the sample blocks and the films' gathering.
 #include "app/mpi_render.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "app/render_command.hpp"
 #include "base/error.hpp"
@@ -69,6 +71,24 @@ Film mpi_gather_films(const MpiSession& s, const Film& film, uint32_t* spp, doub
   return out;
 }
 
+// Each rank's (position or -1, exposure or NaN); the earliest position's exposure wins
+static std::optional<float> mpi_gather_exposure(std::optional<size_t> position, std::optional<float> mine) {
+  double own[2] = {position ? double(*position) : -1.0, mine ? double(*mine) : std::nan("")};
+  int size = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  std::vector<double> all(2 * size_t(size));
+  MPI_Allgather(own, 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, MPI_COMM_WORLD);
+  double best = -1.0;
+  std::optional<float> chosen;
+  for (int r = 0; r < size; ++r) {
+    double at = all[2 * size_t(r)];
+    if (at < 0.0 || (best >= 0.0 && at >= best)) continue;
+    best = at;
+    chosen = std::isnan(all[2 * size_t(r) + 1]) ? std::nullopt : std::optional<float>(float(all[2 * size_t(r) + 1]));
+  }
+  return chosen;
+}
+
 void mpi_abort(int code) {
   MPI_Abort(MPI_COMM_WORLD, code);
   std::_Exit(code);
@@ -87,11 +107,13 @@ MpiSession::MpiSession() { no_mpi(); }
 MpiSession::~MpiSession() = default;
 Film mpi_gather_films(const MpiSession&, const Film&, uint32_t*, double*, bool*, bool*) { no_mpi(); }
 void mpi_abort(int code) { std::_Exit(code); }
+static std::optional<float> mpi_gather_exposure(std::optional<size_t>, std::optional<float> mine) { return mine; }
 
 #endif
 
 namespace {
 MpiSession* g_mpi = nullptr;  // the job's session while a render runs under it
+bool g_by_frames = false;     // a sequence under it: each rank renders whole frames
 }  // namespace
 
 int run_render_under_mpi(const RenderArgs& a, int (*run)(RenderArgs)) {
@@ -114,8 +136,18 @@ int run_render_under_mpi(const RenderArgs& a, int (*run)(RenderArgs)) {
 
 int mpi_ranks() { return g_mpi ? g_mpi->size() : 0; }
 
+void mpi_split_by_frames() { g_by_frames = g_mpi != nullptr; }
+
+bool mpi_renders_frame(size_t index) {
+  return !g_mpi || index % size_t(g_mpi->size()) == size_t(g_mpi->rank());
+}
+
+std::optional<float> mpi_sequence_exposure(std::optional<size_t> position, std::optional<float> mine) {
+  return g_mpi ? mpi_gather_exposure(position, mine) : mine;
+}
+
 uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
-  if (!g_mpi) return a->sample_offset;
+  if (!g_mpi || g_by_frames) return a->sample_offset;
   if (*spp == 0) throw Error("--mpi needs --spp: each rank renders a fixed block of the sample indices");
   if (*spp < uint32_t(g_mpi->size()))
     throw Error("--mpi: --spp " + std::to_string(*spp) + " is fewer than the " + std::to_string(g_mpi->size()) +
@@ -128,7 +160,7 @@ uint32_t mpi_shard(RenderArgs* a, uint32_t* spp) {
 }
 
 bool mpi_combine(RenderResult* r) {
-  if (!g_mpi) return true;
+  if (!g_mpi || g_by_frames) return true;
   r->film = mpi_gather_films(*g_mpi, r->film, &r->spp, &r->seconds, &r->interrupted, &r->partial_pass);
   return g_mpi->rank() == 0;
 }

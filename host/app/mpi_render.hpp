@@ -5,7 +5,9 @@
 // otherwise every function here throws Error saying so.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "render/film.hpp"
 #include "render/renderer.hpp"
@@ -51,6 +53,16 @@ int run_render_under_mpi(const RenderArgs& args, int (*run)(RenderArgs));
 // The ranks of the job a render runs under (run_render_under_mpi), else 0
 int mpi_ranks();
 
+// A sequence under --mpi: the ranks split it by frames, each rendering and writing whole
+// frames (mpi_shard and mpi_combine then leave the samples alone)
+void mpi_split_by_frames();
+// Whether this rank renders the sequence's index-th frame (every frame without --mpi)
+bool mpi_renders_frame(size_t index);
+// A sequence under --mpi: every rank calls this once, after metering its first frame (at
+// `position` in the sequence; nullopt for a rank without frames), and all get the exposure
+// of the earliest of those frames, so that no rank's frames flicker against another's.
+// Without --mpi: `mine`.
+std::optional<float> mpi_sequence_exposure(std::optional<size_t> position, std::optional<float> mine);
 // This rank's first sample index, and in *spp its sample count: its block of the render's
 // under --mpi (other ranks than 0 then render quietly), else --sample-offset and *spp as is
 uint32_t mpi_shard(RenderArgs* args, uint32_t* spp);

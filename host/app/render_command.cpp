@@ -126,7 +126,6 @@ void check_sequence_args(const RenderArgs& a) {
     return;
   }
   parse_frames(a.frames);
-  if (a.mpi) throw Error("--frames does not run under --mpi");
   std::vector<std::pair<std::string, std::string>> files;
   for (const auto& out : a.outputs) files.push_back({"-o", out});
   if (!a.variance.empty()) files.push_back({"--variance", a.variance});
@@ -378,6 +377,7 @@ int render_scene(RenderArgs& a, RenderSettings settings, Scene& scene, const std
   report.lighting = lighting;
   raise_if_asked("writing");
   meter_exposure(r.film, &a);
+  if (a.share_exposure) a.exposure = mpi_sequence_exposure(a.frame_position, a.exposure);
   bool denoised = a.denoise.empty() || denoise(a, devices, &r.film);
   bool all_written = write_outputs(a, r.film, report) && denoised;
   print_result(report, r.partial_pass, r.film);
@@ -397,7 +397,9 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
   size_t rendered = 0, skipped = 0;
   std::optional<float> exposure = args.exposure;
   std::optional<CameraDesc> framed;
+  mpi_split_by_frames();
   for (size_t i = 0; i < frames.size(); ++i) {
+    if (!mpi_renders_frame(i)) continue;  // another rank's
     RenderArgs a = args;
     a.anim_time = double(frames[i]) / args.fps;
     for (std::string& out : a.outputs) out = frame_path(out, frames[i]);
@@ -423,10 +425,19 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
     if (scene.cameras.empty() && framed) {
       scene.camera = framed;
     } else if (scene.cameras.empty()) {
+      // (a rank of an MPI job frames the sequence's first frame too, whichever it renders)
+      RenderArgs first = a;
+      first.anim_time = double(frames[0]) / args.fps;
+      first.repeat = true;
+      Scene posed = i == 0 ? Scene() : load_render_scene(&first, &document);
+      const Scene& framing = i == 0 ? scene : posed;
       int w = 0, h = 0;
-      resolve_image_size(a, scene, &w, &h);
-      framed = resolve_camera(scene, float(w) / float(h));
+      resolve_image_size(a, framing, &w, &h);
+      framed = resolve_camera(framing, float(w) / float(h));
+      if (i != 0) scene.camera = framed;
     }
+    a.share_exposure = rendered == 0 && mpi_ranks() > 0;
+    a.frame_position = i;
     // Frame f renders with seed S + f (S from --seed): frames decorrelated, runs repeatable
     RenderSettings frame_settings = settings;
     frame_settings.seed = uint32_t(uint64_t(settings.seed) + uint64_t(frames[i]));
@@ -440,6 +451,7 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
       return status;
     }
   }
+  if (rendered == 0 && mpi_ranks() > 0) mpi_sequence_exposure(std::nullopt, std::nullopt);  // a rank without frames
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!args.quiet)
     std::fprintf(stderr, "%zu frame%s rendered (%zu skipped, written already) in %.2f s\n", rendered,

@@ -35,6 +35,8 @@ struct RenderArgs {
   double fps = 24.0;                   // --fps R
   bool skip_existing = false;          // --skip-existing: frames whose outputs all exist are not rendered
   bool repeat = false;                 // a later frame of a sequence: the scene's notes were said for the first
+  bool share_exposure = false;         // a rank's first frame of a sequence under --mpi: the ranks agree on
+  size_t frame_position = 0;           // the exposure of the sequence's earliest (mpi_sequence_exposure)
   std::string stats;
   std::optional<float> exposure;  // --exposure EV; unset: 0, or the automatic exposure (render_scene.cpp)
   // Set where the automatic exposure applies (the scene's own lights' share of the studio's

@@ -277,7 +277,8 @@ std::vector<RenderSetting> make_render_settings() {
        "(`-o fox_####.png`: `fox_0007.png`). The scene is read once, the kernel built once; each frame poses, "
        "compiles (BVH, lights) and renders the scene, frame f with seed S + f (S: `--seed`; frames decorrelated, "
        "a run repeatable), the first frame's automatic camera and exposure. A progress line per frame; Ctrl-C writes the frame in progress and stops; "
-       "`--skip-existing` leaves out frames written whole (resuming). Excludes `--anim-time` and `--mpi`.",
+       "`--skip-existing` leaves out frames written whole (resuming). Under `--mpi` the ranks split the frames "
+       "(rank r renders the r-th, (r + N)-th, ... of the sequence), each writing its own. Excludes `--anim-time`.",
        "", flag(&A::skip_existing)},
       {"--stats", "FILE.json", "Write render statistics as JSON to this file",
        "Write render statistics ([below](#statistics---stats)).", "", option(&A::stats)},
@@ -413,7 +414,8 @@ std::vector<RenderSetting> make_render_settings() {
        "Spread --spp over the ranks of an MPI job (mpirun -np N candela render ... --mpi): each rank renders a block "
        "of the sample indices, rank 0 merges and writes (needs -DCANDELA_MPI=ON)",
        "Run under `mpirun -np N`: each rank renders a block of the `--spp` sample indices, rank 0 merges the films "
-       "and writes the outputs. Needs a build with `-DCANDELA_MPI=ON` ([devices.md](devices.md#mpi)).",
+       "and writes the outputs; with `--frames` the ranks split the frames instead. Needs a build with "
+       "`-DCANDELA_MPI=ON` ([devices.md](devices.md#mpi)).",
        "", flag(&A::mpi)},
   };
 }
