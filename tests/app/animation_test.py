@@ -18,6 +18,7 @@
   animations with their durations; SimpleSkin at +90 and -90 degrees of its joint (1 s, 4 s,
   and +-22.5 between keys) gives mirror-image silhouettes; SimpleSkin and AnimatedMorphSphere
   posed at a time differ from their rest pose seen by the same camera.
+On CANDELA_TEST_DEVICE (default pocl); the sample assets' checks on PoCL only.
 Usage: animation_test.py path/to/candela repo_root
 """
 import json
@@ -29,6 +30,8 @@ import tempfile
 import numpy as np
 import OpenImageIO as oiio
 from candela_test_util import check, exr_metadata as metadata, finish, run, write_gltf
+
+DEVICE = os.environ.get('CANDELA_TEST_DEVICE', 'pocl')  # the sample assets' checks run on PoCL only
 
 
 def sliding_square(path):
@@ -42,12 +45,14 @@ def sliding_square(path):
              b"".join(struct.pack("<f", t) for t in times), b"".join(struct.pack("<3f", *m) for m in moves)]
     doc = {
         "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_specular"],
         "scene": 0,
         "scenes": [{"nodes": [0, 1]}],
         "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
         "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.1, "zfar": 10}}],
+        # (no specular layer: the plain diffuse kernel, a short build on every device)
         "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
-                       "emissiveFactor": [1, 1, 1]}],
+                       "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
@@ -63,7 +68,7 @@ def sliding_square(path):
 
 
 def render(candela, scene, out, *options):
-    r = run([candela, 'render', scene, '-o', out, '-q', '--device', 'pocl', '--spp', '4', *options])
+    r = run([candela, 'render', scene, '-o', out, '-q', '--device', DEVICE, '--spp', '4', *options])
     if r.returncode != 0:
         print(r.stderr)
     return r
@@ -125,7 +130,7 @@ def check_errors(candela, scene, tmp):
 
 def check_sequence(candela, scene, tmp):
     common = ['--width', '64', '--height', '64', '--background', '0,0,0', '--default-light', 'off', '--max-depth', '1',
-              '--device', 'pocl', '--spp', '4']
+              '--device', DEVICE, '--spp', '4']
     env = dict(os.environ, CANDELA_CACHE_DIR=os.path.join(tmp, 'fresh-cache'))
     seq = os.path.join(tmp, 'seq')
     os.mkdir(seq)
@@ -282,7 +287,8 @@ def main():
         if scene:
             check_errors(candela, scene, tmp)
             check_sequence(candela, scene, tmp)
-        check_samples(candela, tmp)
+        if DEVICE == 'pocl':
+            check_samples(candela, tmp)
     finish()
     print('all passed')
 
