@@ -82,6 +82,7 @@ struct ViewFrame {
   uint64_t version = 0;  // the camera version it shows
   bool preview = false;
   double samples_per_second = 0.0;
+  std::string camera;  // the camera it shows as render options (ViewCamera::render_args)
 };
 
 // The render of a view on its own thread: loads and compiles the scene, then renders the

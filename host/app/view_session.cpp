@@ -277,6 +277,7 @@ void ViewSession::render_loop() {
     if (r.interrupted || r.partial_pass || r.spp < count) continue;  // a newer camera: start again
     next += r.spp;
     ViewFrame f = display(r.film, next, version, !full);
+    f.camera = camera.render_args(width, height);
     if (full) {
       st.seconds = seconds_since(full_start);
       f.samples_per_second = double(next) * width * height / std::max(st.seconds, 1e-9);

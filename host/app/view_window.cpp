@@ -164,7 +164,7 @@ std::string title_of(Viewer& v, const std::string& scene, const std::optional<Vi
   std::snprintf(text, sizeof text, "%u spp%s, %.2f Msamples/s", shown->spp, shown->preview ? " (preview)" : "",
                 shown->samples_per_second * 1e-6);
   title += text;
-  title += ": " + v.session->camera().render_args(v.width, v.height);
+  title += ": " + shown->camera;
   if (!v.saved.empty()) title += ": saved " + v.saved;
   return title;
 }
