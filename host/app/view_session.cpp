@@ -25,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 // While the camera moves: the image at a quarter of the full size each way
 constexpr int kPreviewDivisor = 4;
 // Launches short enough that a camera change restarts the render at once
-constexpr double kViewLaunchSeconds = 0.025;
+constexpr double kViewLaunchSeconds = 0.01;
 // At the full size, the frames come at least this often
 constexpr double kFrameSeconds = 0.1;
 
@@ -150,6 +150,7 @@ void ViewSession::setup() {
   prebuild.loaded();
   RenderSettings s = settings_;
   s.launch_seconds = kViewLaunchSeconds;  // CANDELA_LAUNCH_SECONDS still sets it (complete_settings)
+  s.launch_growth = 2.0;
   complete_settings(args_, scene, &s);
   auto say_compiling = s.before_kernel_compile;
   s.before_kernel_compile = [this, say_compiling](const std::string& device) {
@@ -268,8 +269,11 @@ void ViewSession::render_loop() {
       continue;
     }
     uint32_t count = full ? std::min(renderer.worker().suggested_batch(kFrameSeconds), limit - next) : 1;
+    // A newer camera stops a full-size frame between launches; a preview frame (short) is
+    // finished and shown, so that a drag shows a frame at least every other preview frame
     auto moved = [&] {
       if (quit_) return true;
+      if (!full) return false;
       std::lock_guard<std::mutex> lock(mutex_);
       return version_ != version;
     };

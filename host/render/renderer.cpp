@@ -315,12 +315,18 @@ void DeviceRenderer::allocate_film(size_t pixels) {
 
 void DeviceRenderer::set_view(const dev::Camera& camera, int width, int height) {
   size_t pixels = size_t(width) * height;
+  // The first launch: about launch_seconds at the cost per pixel measured before, if any
+  size_t first = 4096;
+  size_t before = size_t(params_host_.width) * params_host_.height;
+  if (pass_seconds_ > 0.0 && before > 0)
+    first = size_t(settings_.launch_seconds / std::max(pass_seconds_ / double(before), 1e-12));
+  first = (first + group_pixels_ - 1) / group_pixels_ * group_pixels_;
   settings_.width = width;
   settings_.height = height;
   params_host_.camera = camera;
   params_host_.width = uint32_t(width);
   params_host_.height = uint32_t(height);
-  chunk_ = std::min(pixels, std::max<size_t>(group_pixels_, 4096));
+  chunk_ = std::clamp(first, std::min(group_pixels_, pixels), pixels);
   batch_ = 1;
   pass_seconds_ = 0.0;
   if (pixels > film_pixels_) return allocate_film(pixels);
@@ -375,8 +381,10 @@ bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const s
     // Next launch: about launch_seconds of pixels at the measured cost
     double cost = dt / (double(end - begin) * count);
     size_t want = size_t(settings_.launch_seconds / std::max(cost * count, 1e-12));
-    chunk_ =
-        std::clamp((want + group_pixels_ - 1) / group_pixels_ * group_pixels_, std::min(group_pixels_, pixels), pixels);
+    size_t most = pixels;
+    if (settings_.launch_growth > 0.0) most = std::min(pixels, size_t(double(end - begin) * settings_.launch_growth));
+    chunk_ = std::clamp((want + group_pixels_ - 1) / group_pixels_ * group_pixels_, std::min(group_pixels_, pixels),
+                        std::max(most, std::min(group_pixels_, pixels)));
     if (end < pixels && progress) progress(double(end) / double(pixels));
   }
   // Next range: whole-image launches of several samples once one sample is cheap enough

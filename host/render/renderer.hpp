@@ -70,6 +70,9 @@ struct RenderSettings {
   bool aov = false;
   bool transparent = false;
   double launch_seconds = 0.2;  // target duration of one launch
+  // > 0: a launch covers at most this many times the pixels of the one before (the live
+  // view: a cheap launch over the sky does not make the next one over the model long)
+  double launch_growth = 0.0;
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
   bool packets = true;
