@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "app/render_command.hpp"
+#include "render/tonemap.hpp"
 #include "scene/scene.hpp"
 
 namespace candela {
@@ -108,6 +109,12 @@ class ViewSession {
   bool size(int* width, int* height);
   bool ready();                // the scene is compiled and rendering
   std::exception_ptr error();  // what stopped the session, if anything
+  // The display transform from now on (the newest frame shown again through it): the
+  // exposure in stops (unset: --exposure, or the metered one) and the tone map
+  void set_display(std::optional<float> exposure, Tonemap tonemap);
+  // The exposure the newest frame was shown at
+  float exposure();
+  const RenderArgs& args() const { return args_; }  // as the scene completed them (once ready)
   // Saves the image as it stands (PNG through the display transform, EXR linear); the
   // names written come back through saved()
   void request_save();
@@ -132,6 +139,9 @@ class ViewSession {
   std::string status_, device_;
   std::vector<std::string> saved_;
   bool ready_ = false, save_asked_ = false;
+  std::optional<float> exposure_;  // set_display's
+  Tonemap tonemap_ = Tonemap::Neutral;
+  uint64_t display_version_ = 0;
   std::exception_ptr error_;
   std::atomic<bool> quit_{false};
   int width_ = 0, height_ = 0;

@@ -40,11 +40,14 @@ struct ViewSession::State {
   std::optional<RenderResult> last;  // the newest frame's render, the film holding all its samples
   float exposure = 0.0f;             // the newest frame's (metered when automatic)
   double seconds = 0.0;              // the full-size render's time so far
+  double last_rate = 0.0;            // the newest frame's samples per second
 };
 
 ViewSession::ViewSession(RenderArgs args, RenderSettings settings, std::function<void()> wake)
     : args_(std::move(args)), settings_(std::move(settings)), wake_(std::move(wake)), state_(new State) {
   status_ = "loading " + args_.scene;
+  exposure_ = args_.exposure;
+  tonemap_ = parse_tonemap(args_.tonemap);
   thread_ = std::thread([this] { run(); });
 }
 
@@ -109,6 +112,21 @@ bool ViewSession::ready() {
 std::exception_ptr ViewSession::error() {
   std::lock_guard<std::mutex> lock(mutex_);
   return error_;
+}
+
+void ViewSession::set_display(std::optional<float> exposure, Tonemap tonemap) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    exposure_ = exposure;
+    tonemap_ = tonemap;
+    ++display_version_;
+  }
+  changed_.notify_all();
+}
+
+float ViewSession::exposure() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_->exposure;
 }
 
 void ViewSession::request_save() {
@@ -200,8 +218,15 @@ ViewFrame ViewSession::display(const Film& film, uint32_t spp, uint64_t version,
   State& st = *state_;
   // The display transform of PNG outputs: the exposure (metered from the image when
   // automatic, as render meters it), the tone map, the sRGB encoding
-  float exposure = args_.exposure.value_or(0.0f);
-  if (!args_.exposure && args_.auto_exposure_share) {
+  std::optional<float> given;
+  Tonemap tonemap;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    given = exposure_;
+    tonemap = tonemap_;
+  }
+  float exposure = given.value_or(0.0f);
+  if (!given && args_.auto_exposure_share) {
     std::vector<float> lum(film.pixels());
     for (size_t i = 0; i < film.pixels(); ++i) {
       glm::vec3 v = film.pixel(i);
@@ -209,8 +234,10 @@ ViewFrame ViewSession::display(const Film& film, uint32_t spp, uint64_t version,
     }
     exposure = image_exposure(lum, film.width, film.height).value_or(0.0f);
   }
-  st.exposure = exposure;
-  Tonemap tonemap = parse_tonemap(args_.tonemap);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    st.exposure = exposure;
+  }
   float scale = std::exp2(exposure);
   ViewFrame f;
   f.width = film.width;
@@ -235,24 +262,33 @@ void ViewSession::render_loop() {
   const int preview_width = std::max(1, width / kPreviewDivisor);
   const int preview_height = std::max(1, height / kPreviewDivisor);
   const uint32_t limit = args_.spp ? args_.spp : kMaxSamplesPerPixel;
-  uint64_t shown = ~uint64_t(0);
+  uint64_t shown = ~uint64_t(0), display_shown = 0;
   bool full = false;
   uint32_t next = 0;
   Clock::time_point full_start = Clock::now();
   while (!quit_) {
     uint64_t version;
     ViewCamera camera;
-    bool save_now;
+    bool save_now, redisplay;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      if (version_ == shown && full && next >= limit && !save_asked_)  // converged: wait for a change
-        changed_.wait_for(lock, std::chrono::milliseconds(100));
+      if (version_ == shown && full && next >= limit && !save_asked_ && display_version_ == display_shown)
+        changed_.wait_for(lock, std::chrono::milliseconds(100));  // converged: wait for a change
+      redisplay = display_version_ != display_shown && st.last && version_ == shown;
+      display_shown = display_version_;
       version = version_;
       camera = camera_;
       save_now = save_asked_ && st.last;
       if (save_now) save_asked_ = false;
     }
     if (quit_) break;
+    if (redisplay) {  // the newest frame through the new display transform
+      ViewFrame f = display(st.last->film, st.last->spp, version, !full);
+      f.camera = camera.render_args(width, height);
+      f.samples_per_second = st.last_rate;
+      std::lock_guard<std::mutex> lock(mutex_);
+      frame_ = std::move(f);
+    }
     if (save_now) save(*st.last);
     if (version != shown) {  // moved: restart small
       renderer.set_view(make_device_camera(camera.desc(), preview_width, preview_height), preview_width,
@@ -286,6 +322,7 @@ void ViewSession::render_loop() {
       st.seconds = seconds_since(full_start);
       f.samples_per_second = double(next) * width * height / std::max(st.seconds, 1e-9);
     }
+    st.last_rate = f.samples_per_second;
     r.spp = next;
     r.seconds = full ? st.seconds : r.seconds;
     st.last = std::move(r);
@@ -318,7 +355,12 @@ void ViewSession::save(const RenderResult& result) {
   std::map<std::string, std::string> meta = image_metadata(report);
   std::vector<std::string> written;
   try {
-    write_image(base + ".png", result.film, meta, {st.exposure, parse_tonemap(args_.tonemap)});
+    Tonemap tonemap;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      tonemap = tonemap_;
+    }
+    write_image(base + ".png", result.film, meta, {st.exposure, tonemap});
     written.push_back(base + ".png");
     write_image(base + ".exr", result.film, meta);
     written.push_back(base + ".exr");

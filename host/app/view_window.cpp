@@ -12,6 +12,7 @@
 
 #include "app/render_scene.hpp"
 #include "app/view.hpp"
+#include "app/view_panel.hpp"
 #include "base/error.hpp"
 #include "base/file_access.hpp"
 
@@ -40,7 +41,7 @@ struct Viewer {
   Clock::time_point pending_since;
   uint64_t pending_version = 0;
   std::vector<double> latencies;  // seconds from a change to the first frame that shows it
-  std::string saved;              // the names the last save wrote
+  PanelState panel;               // the panel's state, the last save's names among it
 
   void move(const std::function<void(ViewCamera&)>& change) {
     if (!session->update_camera(change)) return;
@@ -58,6 +59,7 @@ void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   Viewer& v = viewer_of(w);
   glfwGetCursorPos(w, &v.x, &v.y);
   bool down = action == GLFW_PRESS;
+  if (down && panel_wants_mouse()) return;
   if (button == GLFW_MOUSE_BUTTON_MIDDLE || (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT) && down)) {
     v.panning = down;
     if (button == GLFW_MOUSE_BUTTON_LEFT) v.orbiting = false;
@@ -80,12 +82,24 @@ void on_cursor(GLFWwindow* w, double x, double y) {
 }
 
 void on_scroll(GLFWwindow* w, double, double dy) {
+  if (panel_wants_mouse()) return;
   viewer_of(w).move([&](ViewCamera& c) { c.dolly(float(dy)); });
 }
 
-void on_key(GLFWwindow* w, int key, int, int action, int) {
-  if (action != GLFW_PRESS) return;
-  Viewer& v = viewer_of(w);
+// The camera options with the display options the panel changed
+std::string printed_options(Viewer& v) {
+  std::string text = v.session->camera().render_args(v.width, v.height);
+  const RenderArgs& a = v.session->args();
+  char exposure[48];
+  std::snprintf(exposure, sizeof exposure, " --exposure %.9g", double(v.panel.exposure));
+  if (!v.panel.exposure_automatic) text += exposure;
+  std::string tonemap = kTonemapNames[v.panel.tonemap].name;
+  if (tonemap != a.tonemap) text += " --tonemap " + tonemap;
+  return text;
+}
+
+void act(Viewer& v, int key) {
+  GLFWwindow* w = v.window;
   if (!v.session->ready()) {
     if (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q) glfwSetWindowShouldClose(w, GLFW_TRUE);
     return;
@@ -97,7 +111,7 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
       glfwSetWindowShouldClose(w, GLFW_TRUE);
       break;
     case GLFW_KEY_P:
-      std::printf("camera: %s\n", v.session->camera().render_args(v.width, v.height).c_str());
+      std::printf("camera: %s\n", printed_options(v).c_str());
       std::fflush(stdout);
       break;
     case GLFW_KEY_S:
@@ -114,9 +128,17 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
         if (c.scene_camera_count() > 0) c.scene_camera((c.scene_camera_index() + 1) % c.scene_camera_count());
       });
       break;
+    case GLFW_KEY_TAB:
+      v.panel.visible = !v.panel.visible;
+      break;
     default:
       if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) v.move([&](ViewCamera& c) { c.scene_camera(key - GLFW_KEY_1); });
   }
+}
+
+void on_key(GLFWwindow* w, int key, int, int action, int) {
+  if (action != GLFW_PRESS || panel_wants_keyboard()) return;
+  act(viewer_of(w), key);
 }
 
 void upload(GLuint texture, const ViewFrame& f) {
@@ -153,7 +175,6 @@ void draw(GLFWwindow* window, GLuint texture, bool any) {
     glEnd();
     glDisable(GL_TEXTURE_2D);
   }
-  glfwSwapBuffers(window);
 }
 
 std::string title_of(Viewer& v, const std::string& scene, const std::optional<ViewFrame>& shown) {
@@ -165,7 +186,7 @@ std::string title_of(Viewer& v, const std::string& scene, const std::optional<Vi
                 shown->samples_per_second * 1e-6);
   title += text;
   title += ": " + shown->camera;
-  if (!v.saved.empty()) title += ": saved " + v.saved;
+  if (!v.panel.saved.empty()) title += ": saved " + v.panel.saved;
   return title;
 }
 
@@ -223,6 +244,9 @@ int run_view(RenderArgs args) {
   glfwSetKeyCallback(window, on_key);
   ViewSession session(args, settings, [] { glfwPostEmptyEvent(); });
   v.session = &session;
+  v.panel.session = &session;
+  v.panel.press = [&v](int key) { act(v, key); };
+  bool panel = false;  // started once the scene is ready (its options known)
   bool visible = false;
   std::optional<ViewFrame> shown;  // without its pixels
   std::string title;
@@ -244,15 +268,24 @@ int run_view(RenderArgs args) {
       f->rgba.clear();
       shown = std::move(f);
     }
-    if (visible) draw(window, texture, shown.has_value());
+    if (!panel && session.ready()) {
+      panel_init(window, &v.panel);
+      panel = true;
+    }
+    if (visible) {
+      draw(window, texture, shown.has_value());
+      v.panel.shown = shown ? &*shown : nullptr;
+      if (panel) panel_draw(&v.panel);
+      glfwSwapBuffers(window);
+    }
     if (v.pending && shown && shown->version >= v.pending_version) {
       v.latencies.push_back(std::chrono::duration<double>(Clock::now() - v.pending_since).count());
       v.pending = false;
     }
     std::vector<std::string> saved = session.saved();
     if (!saved.empty()) {
-      v.saved.clear();
-      for (const std::string& name : saved) v.saved += (v.saved.empty() ? "" : ", ") + name;
+      v.panel.saved.clear();
+      for (const std::string& name : saved) v.panel.saved += (v.panel.saved.empty() ? "" : ", ") + name;
     }
     std::string now = title_of(v, args.scene, shown);
     if (now != title) glfwSetWindowTitle(window, (title = now).c_str());
@@ -260,6 +293,7 @@ int run_view(RenderArgs args) {
   if (!session.ready()) leave_now(0);
   session.stop();
   report_latency(v);
+  panel_shutdown();
   glDeleteTextures(1, &texture);
   glfwDestroyWindow(window);
   glfwTerminate();

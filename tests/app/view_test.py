@@ -2,7 +2,7 @@
 """candela view driven as a person drives it, under Xvfb with Mesa's software OpenGL:
 - no display: one error line, exit 1; a missing scene under a display: one error line, exit 1;
 - the Cornell box in a 128x128 window at --spp 8: once the title says 8 spp (not the
-  preview), a screenshot of the window (xwd) equals `candela render` with the options the P
+  preview), a screenshot of the window (xwd, the panel hidden with Tab) equals `candela render` with the options the P
   key prints and --spp 8 (the same samples: each channel within 2 of 255, means within 0.5);
 - a left drag (xdotool) changes the printed camera and the window, and the render of the new
   printed options equals the new screenshot;
@@ -198,7 +198,11 @@ def drive(candela, scene, device, env, tmp, view, out_path, common):
         return
     geometry = xdotool(env, 'getwindowgeometry', window)
     check('Geometry: %dx%d' % (SIZE, SIZE) in geometry, 'the window is %dx%d: %s' % (SIZE, SIZE, geometry))
+    panel = xwd_pixels(window, env)
+    xdotool(env, 'key', '--window', window, 'Tab')  # hides the panel
+    time.sleep(0.5)
     shot = xwd_pixels(window, env)
+    print('note: the panel %s' % ('shows until Tab' if not same_image(panel, shot) else 'is not built in'))
     check(float(shot.std()) > 5.0, 'the screenshot shows an image (std %.1f)' % shot.std())
     camera = printed_camera(env, window, out_path, 1)
     check(camera is not None and camera[:2] == ['--camera', '0'], 'P prints the scene camera: %s' % camera)
