@@ -54,12 +54,14 @@ class ViewCamera {
   std::string render_args(int width, int height) const;
   bool moved() const { return moved_; }
 
-  void orbit(float yaw, float pitch);        // radians
-  void pan(float dx, float dy, int height);  // pixels of a window `height` tall
-  void dolly(float steps);                   // wheel steps, positive: closer
-  void frame_all(float aspect);              // the bounds in view, same direction
-  void reset();                              // the first camera
-  void scene_camera(int index);              // the scene's camera `index`
+  void orbit(float yaw, float pitch);              // radians
+  void look(float yaw, float pitch);               // turns about the camera (fly)
+  void fly(float forward, float right, float up);  // steps of 5 % of the scene's radius
+  void pan(float dx, float dy, int height);        // pixels of a window `height` tall
+  void dolly(float steps);                         // wheel steps, positive: closer
+  void frame_all(float aspect);                    // the bounds in view, same direction
+  void reset();                                    // the first camera
+  void scene_camera(int index);                    // the scene's camera `index`
   int scene_camera_count() const { return int(start_.cameras.size()); }
   int scene_camera_index() const { return index_; }
 

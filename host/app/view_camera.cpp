@@ -87,9 +87,11 @@ std::string ViewCamera::render_args(int width, int height) const {
   return args + "--width " + std::to_string(width) + " --height " + std::to_string(height);
 }
 
-void ViewCamera::orbit(float yaw, float pitch) {
-  detach();
-  glm::vec3 u = glm::normalize(up_), offset = from_ - at_;
+namespace {
+
+// `offset` turned by `yaw` about `up` and tilted by `pitch` towards it (kept off its poles)
+glm::vec3 turned_offset(glm::vec3 offset, glm::vec3 up, float yaw, float pitch) {
+  glm::vec3 u = glm::normalize(up);
   float r = glm::length(offset);
   glm::vec3 n = offset / r;
   float theta = std::acos(std::clamp(glm::dot(n, u), -1.0f, 1.0f));
@@ -99,7 +101,29 @@ void ViewCamera::orbit(float yaw, float pitch) {
   h = glm::normalize(h);
   glm::vec3 turned = std::cos(yaw) * h + std::sin(yaw) * glm::cross(u, h);
   theta = std::clamp(theta - pitch, 0.02f, kPi - 0.02f);
-  from_ = at_ + r * (std::cos(theta) * u + std::sin(theta) * turned);
+  return r * (std::cos(theta) * u + std::sin(theta) * turned);
+}
+
+}  // namespace
+
+void ViewCamera::orbit(float yaw, float pitch) {
+  detach();
+  from_ = at_ + turned_offset(from_ - at_, up_, yaw, pitch);
+}
+
+void ViewCamera::look(float yaw, float pitch) {
+  detach();
+  at_ = from_ + turned_offset(at_ - from_, up_, yaw, -pitch);
+}
+
+void ViewCamera::fly(float forward, float right, float up) {
+  detach();
+  glm::vec3 f = glm::normalize(at_ - from_);
+  glm::vec3 r = glm::normalize(glm::cross(f, up_));
+  float step = 0.05f * std::max(start_.bounds.empty() ? 1.0f : start_.bounds.radius(), 1e-3f);
+  glm::vec3 shift = step * (forward * f + right * r + up * glm::normalize(up_));
+  from_ += shift;
+  at_ += shift;
 }
 
 void ViewCamera::pan(float dx, float dy, int height) {

@@ -34,8 +34,9 @@ struct Viewer {
   ViewSession* session = nullptr;
   GLFWwindow* window = nullptr;
   int width = 256, height = 256;
-  bool orbiting = false, panning = false;
-  double x = 0.0, y = 0.0;
+  bool orbiting = false, panning = false, looking = false;
+  double x = 0.0, y = 0.0;  // the cursor, as the last motion left it
+  bool cursor_known = false;
   // The first camera change no frame shows yet: since when, and its version
   bool pending = false;
   Clock::time_point pending_since;
@@ -57,10 +58,16 @@ Viewer& viewer_of(GLFWwindow* w) { return *static_cast<Viewer*>(glfwGetWindowUse
 
 void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   Viewer& v = viewer_of(w);
-  glfwGetCursorPos(w, &v.x, &v.y);
+  // Where the last motion left the cursor (glfwGetCursorPos would give where it is now,
+  // past motions still queued)
+  if (!v.cursor_known) glfwGetCursorPos(w, &v.x, &v.y);
+  v.cursor_known = true;
   bool down = action == GLFW_PRESS;
   if (down && panel_wants_mouse()) return;
-  if (button == GLFW_MOUSE_BUTTON_MIDDLE || (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT) && down)) {
+  if (button == GLFW_MOUSE_BUTTON_RIGHT) {
+    v.looking = down;
+  } else if (button == GLFW_MOUSE_BUTTON_MIDDLE ||
+             (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT) && down)) {
     v.panning = down;
     if (button == GLFW_MOUSE_BUTTON_LEFT) v.orbiting = false;
   } else if (button == GLFW_MOUSE_BUTTON_LEFT) {
@@ -74,8 +81,12 @@ void on_cursor(GLFWwindow* w, double x, double y) {
   double dx = x - v.x, dy = y - v.y;
   v.x = x;
   v.y = y;
+  if (!v.cursor_known) dx = dy = 0.0;
+  v.cursor_known = true;
   if (dx == 0.0 && dy == 0.0) return;
-  if (v.panning)
+  if (v.looking)
+    v.move([&](ViewCamera& c) { c.look(float(-dx * kOrbitRadiansPerPixel), float(-dy * kOrbitRadiansPerPixel)); });
+  else if (v.panning)
     v.move([&](ViewCamera& c) { c.pan(float(dx), float(dy), v.height); });
   else if (v.orbiting)
     v.move([&](ViewCamera& c) { c.orbit(float(-dx * kOrbitRadiansPerPixel), float(-dy * kOrbitRadiansPerPixel)); });
@@ -136,9 +147,40 @@ void act(Viewer& v, int key) {
   }
 }
 
+// With the right button held, W A S D Q E fly (held down: repeated)
+bool fly(Viewer& v, int key) {
+  float f = 0.0f, r = 0.0f, u = 0.0f;
+  switch (key) {
+    case GLFW_KEY_W:
+      f = 1.0f;
+      break;
+    case GLFW_KEY_S:
+      f = -1.0f;
+      break;
+    case GLFW_KEY_D:
+      r = 1.0f;
+      break;
+    case GLFW_KEY_A:
+      r = -1.0f;
+      break;
+    case GLFW_KEY_E:
+      u = 1.0f;
+      break;
+    case GLFW_KEY_Q:
+      u = -1.0f;
+      break;
+    default:
+      return false;
+  }
+  v.move([&](ViewCamera& c) { c.fly(f, r, u); });
+  return true;
+}
+
 void on_key(GLFWwindow* w, int key, int, int action, int) {
-  if (action != GLFW_PRESS || panel_wants_keyboard()) return;
-  act(viewer_of(w), key);
+  if (action == GLFW_RELEASE || panel_wants_keyboard()) return;
+  Viewer& v = viewer_of(w);
+  if (v.looking && v.session->ready() && fly(v, key)) return;
+  if (action == GLFW_PRESS) act(v, key);
 }
 
 void upload(GLuint texture, const ViewFrame& f) {
