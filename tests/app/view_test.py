@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """candela view driven as a person drives it, under Xvfb with Mesa's software OpenGL:
-- no display: one error line, exit 1; a missing scene under a display: one error line, exit 1;
+- no display, no OpenGL context (Mesa without its drivers), a missing scene: one error line
+  (besides libGL's own), exit 1;
 - the Cornell box in a 128x128 window at --spp 8: once the title says 8 spp (not the
   preview), a screenshot of the window (xwd, the panel hidden with Tab) equals `candela render` with the options the P
   key prints and --spp 8 (the same samples: each channel within 2 of 255, means within 0.5);
@@ -125,6 +126,13 @@ def run_view(candela, scene, device, env, tmp):
     lines = r.stderr.strip().splitlines()
     check(r.returncode == 1 and len(lines) == 1 and lines[0].startswith('candela: error:'),
           'a missing scene: one error line, exit 1 (%d: %s)' % (r.returncode, r.stderr.strip()))
+
+    # Mesa without its drivers: no OpenGL context (libGL says why on stderr, candela in one line)
+    r = subprocess.run([candela, 'view', scene], env={**env, 'LIBGL_DRIVERS_PATH': tmp}, capture_output=True,
+                       text=True)
+    ours = [line for line in r.stderr.splitlines() if line.startswith('candela')]
+    check(r.returncode == 1 and len(ours) == 1 and 'OpenGL' in ours[0],
+          'no OpenGL context: one error line, exit 1 (%d: %s)' % (r.returncode, ' / '.join(ours)))
 
     out_path, err_path = os.path.join(tmp, 'out.txt'), os.path.join(tmp, 'err.txt')
     common = ['--device', device, '--width', str(SIZE), '--height', str(SIZE), '--spp', str(SPP)]
