@@ -360,9 +360,12 @@ void ViewSession::save(const RenderResult& result) {
       std::lock_guard<std::mutex> lock(mutex_);
       tonemap = tonemap_;
     }
-    write_image(base + ".png", result.film, meta, {st.exposure, tonemap});
+    ImageLayers layers;  // as render writes them: --aov's channels in the EXR, --transparent's alpha
+    layers.aovs = requested_aovs(args_);
+    layers.transparent = args_.transparent;
+    write_image(base + ".png", result.film, meta, {st.exposure, tonemap}, layers);
     written.push_back(base + ".png");
-    write_image(base + ".exr", result.film, meta);
+    write_image(base + ".exr", result.film, meta, {}, layers);
     written.push_back(base + ".exr");
   } catch (const Error& e) {
     std::fprintf(stderr, "candela: error: %s\n", e.what());
