@@ -114,6 +114,8 @@ class ViewSession {
   // The display transform from now on (the newest frame shown again through it): the
   // exposure in stops (unset: --exposure, or the metered one) and the tone map
   void set_display(std::optional<float> exposure, Tonemap tonemap);
+  // The strategy and maximum depth from now on (the render restarts)
+  void set_kernel(Strategy strategy, uint32_t max_depth);
   // The exposure the newest frame was shown at
   float exposure();
   const RenderArgs& args() const { return args_; }  // as the scene completed them (once ready)
@@ -144,6 +146,7 @@ class ViewSession {
   std::optional<float> exposure_;  // set_display's
   Tonemap tonemap_ = Tonemap::Neutral;
   uint64_t display_version_ = 0;
+  std::optional<std::pair<Strategy, uint32_t>> kernel_;  // set_kernel's, not applied yet
   std::exception_ptr error_;
   std::atomic<bool> quit_{false};
   int width_ = 0, height_ = 0;

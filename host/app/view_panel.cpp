@@ -6,9 +6,11 @@
 #include <backends/imgui_impl_opengl2.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iterator>
 
+#include "app/options.hpp"
 #include "app/render_devices.hpp"
 #endif
 
@@ -35,7 +37,15 @@ void panel_init(GLFWwindow* window, PanelState* state) {
   ImGui::StyleColorsDark();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL2_Init();
-  state->tonemap = int(parse_tonemap(state->session->args().tonemap));
+  const RenderArgs& a = state->session->args();
+  state->tonemap = int(parse_tonemap(a.tonemap));
+  Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
+  for (size_t i = 0; i < std::size(kStrategyNames); ++i)
+    if (kStrategyNames[i].value == strategy) state->strategy = int(i);
+  state->max_depth = int(a.settings.max_depth);
+  state->device = state->session->device();
+  state->first_strategy = state->strategy;
+  state->first_max_depth = state->max_depth;
   g_started = true;
 }
 
@@ -64,8 +74,12 @@ void panel_draw(PanelState* p) {
                   p->shown->samples_per_second * 1e-6);
     }
     const RenderArgs& a = session.args();
-    ImGui::Text("%s", session.device().c_str());
-    ImGui::Text("strategy %s, max depth %u", a.strategy.c_str(), a.settings.max_depth);
+    ImGui::Text("%s", p->device.c_str());
+    const char* strategies[std::size(kStrategyNames)];
+    for (size_t i = 0; i < std::size(kStrategyNames); ++i) strategies[i] = kStrategyNames[i].name;
+    bool kernel = ImGui::Combo("strategy", &p->strategy, strategies, int(std::size(kStrategyNames)));
+    kernel |= ImGui::SliderInt("max depth", &p->max_depth, 0, 64);
+    if (kernel) session.set_kernel(kStrategyNames[p->strategy].value, uint32_t(std::max(p->max_depth, 0)));
     bool changed = ImGui::Checkbox("automatic exposure", &p->exposure_automatic);
     if (p->exposure_automatic) {
       p->exposure = session.exposure();

@@ -21,7 +21,11 @@ struct PanelState {
   // `exposure` stops, and the tone map
   bool exposure_automatic = true;
   float exposure = 0.0f;
-  int tonemap = 0;                     // kTonemapNames index
+  int tonemap = 0;   // kTonemapNames index
+  int strategy = 0;  // kStrategyNames index
+  int max_depth = 16;
+  int first_strategy = 0, first_max_depth = 16;  // as the options gave them
+  std::string device;
   std::function<void(int key)> press;  // the key's action (P, S, F, R, C)
 };
 

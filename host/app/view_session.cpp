@@ -124,6 +124,15 @@ void ViewSession::set_display(std::optional<float> exposure, Tonemap tonemap) {
   changed_.notify_all();
 }
 
+void ViewSession::set_kernel(Strategy strategy, uint32_t max_depth) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    kernel_ = {strategy, max_depth};
+    ++version_;
+  }
+  changed_.notify_all();
+}
+
 float ViewSession::exposure() {
   std::lock_guard<std::mutex> lock(mutex_);
   return state_->exposure;
@@ -270,6 +279,7 @@ void ViewSession::render_loop() {
     uint64_t version;
     ViewCamera camera;
     bool save_now, redisplay;
+    std::optional<std::pair<Strategy, uint32_t>> kernel;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       if (version_ == shown && full && next >= limit && !save_asked_ && display_version_ == display_shown)
@@ -278,6 +288,8 @@ void ViewSession::render_loop() {
       display_shown = display_version_;
       version = version_;
       camera = camera_;
+      kernel = kernel_;
+      kernel_.reset();
       save_now = save_asked_ && st.last;
       if (save_now) save_asked_ = false;
     }
@@ -290,6 +302,13 @@ void ViewSession::render_loop() {
       frame_ = std::move(f);
     }
     if (save_now) save(*st.last);
+    if (kernel) {  // another strategy or depth: the film restarts below (a new version)
+      st.settings.strategy = kernel->first;
+      st.settings.max_depth = kernel->second;
+      args_.strategy = enum_name(kStrategyNames, kernel->first);
+      args_.settings.max_depth = kernel->second;
+      renderer.set_kernel_settings(st.settings);
+    }
     if (version != shown) {  // moved: restart small
       renderer.set_view(make_device_camera(camera.desc(), preview_width, preview_height), preview_width,
                         preview_height);

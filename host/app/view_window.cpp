@@ -106,6 +106,9 @@ std::string printed_options(Viewer& v) {
   if (!v.panel.exposure_automatic) text += exposure;
   std::string tonemap = kTonemapNames[v.panel.tonemap].name;
   if (tonemap != a.tonemap) text += " --tonemap " + tonemap;
+  if (v.panel.strategy != v.panel.first_strategy)
+    text += std::string(" --strategy ") + kStrategyNames[v.panel.strategy].name;
+  if (v.panel.max_depth != v.panel.first_max_depth) text += " --max-depth " + std::to_string(v.panel.max_depth);
   return text;
 }
 

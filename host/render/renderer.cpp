@@ -341,6 +341,14 @@ void DeviceRenderer::set_view(const dev::Camera& camera, int width, int height) 
   }
 }
 
+void DeviceRenderer::set_kernel_settings(const RenderSettings& settings) {
+#define CD_SET_KERNEL_SETTING(type, name, default_value) \
+  settings_.name = settings.name;                        \
+  params_host_.name = uint32_t(settings.name);
+  CD_KERNEL_SETTINGS(CD_SET_KERNEL_SETTING)
+#undef CD_SET_KERNEL_SETTING
+}
+
 DeviceRenderer::~DeviceRenderer() {
   if (host_arrays_.empty()) return;
   try {
@@ -568,6 +576,10 @@ Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<Comp
 
 void Renderer::set_view(const dev::Camera& camera, int width, int height) {
   for (auto& w : workers_) w->set_view(camera, width, height);
+}
+
+void Renderer::set_kernel_settings(const RenderSettings& settings) {
+  for (auto& w : workers_) w->set_kernel_settings(settings);
 }
 
 double Renderer::kernel_build_seconds() const {

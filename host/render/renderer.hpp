@@ -189,6 +189,8 @@ class DeviceRenderer {
   // Renders through `camera` at width x height from now on, the film cleared (the live
   // view: a preview size while the camera moves, the full one once it rests)
   void set_view(const dev::Camera& camera, int width, int height);
+  // The kernel settings (CD_KERNEL_SETTINGS) from now on; set_view clears the film after
+  void set_kernel_settings(const RenderSettings& settings);
 
   Film film();  // reads the film back from the device
   // How many of the scene's buffers are host arrays taken over in place (adopt)
@@ -269,8 +271,9 @@ class Renderer {
   size_t worker_count() const { return workers_.size(); }
   DeviceRenderer& worker(size_t i) { return *workers_.at(i); }
   const DeviceRenderer& worker(size_t i) const { return *workers_.at(i); }
-  // Every worker's DeviceRenderer::set_view
+  // Every worker's DeviceRenderer::set_view, set_kernel_settings
   void set_view(const dev::Camera& camera, int width, int height);
+  void set_kernel_settings(const RenderSettings& settings);
   // The first worker's kernel build; with several devices, the sum of all of them
   double kernel_build_seconds() const;
   bool kernel_from_cache() const;  // every worker's kernel came from the cache
