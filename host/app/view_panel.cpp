@@ -8,13 +8,26 @@
 
 #include <algorithm>
 #include <cstdio>
+#endif
+
 #include <iterator>
 
 #include "app/options.hpp"
-#include "app/render_devices.hpp"
-#endif
 
 namespace candela {
+
+void panel_ready(PanelState* state) {
+  const RenderArgs& a = state->session->args();
+  state->tonemap = int(parse_tonemap(a.tonemap));
+  Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
+  for (size_t i = 0; i < std::size(kStrategyNames); ++i)
+    if (kStrategyNames[i].value == strategy) state->strategy = int(i);
+  state->max_depth = int(a.settings.max_depth);
+  state->device = state->session->device();
+  state->first_strategy = state->strategy;
+  state->first_max_depth = state->max_depth;
+  state->ready = true;
+}
 
 #ifndef CANDELA_WITH_IMGUI
 bool panel_built_in() { return false; }
@@ -30,22 +43,13 @@ bool g_started = false;
 
 bool panel_built_in() { return true; }
 
-void panel_init(GLFWwindow* window, PanelState* state) {
+void panel_init(GLFWwindow* window, PanelState*) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
   ImGui::StyleColorsDark();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL2_Init();
-  const RenderArgs& a = state->session->args();
-  state->tonemap = int(parse_tonemap(a.tonemap));
-  Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
-  for (size_t i = 0; i < std::size(kStrategyNames); ++i)
-    if (kStrategyNames[i].value == strategy) state->strategy = int(i);
-  state->max_depth = int(a.settings.max_depth);
-  state->device = state->session->device();
-  state->first_strategy = state->strategy;
-  state->first_max_depth = state->max_depth;
   g_started = true;
 }
 
@@ -65,7 +69,13 @@ void panel_draw(PanelState* p) {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   ViewSession& session = *p->session;
-  if (p->visible && session.ready()) {
+  if (!p->ready) {  // loading, compiling: what it waits for
+    std::string status = session.status();
+    ImGui::SetNextWindowPos(ImVec2(4, 4), ImGuiCond_Always);
+    ImGui::Begin("candela view", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+    ImGui::TextUnformatted(status.empty() ? "starting" : status.c_str());
+    ImGui::End();
+  } else if (p->visible) {
     ImGui::SetNextWindowPos(ImVec2(4, 4), ImGuiCond_Once);
     ImGui::SetNextWindowBgAlpha(0.75f);
     ImGui::Begin("candela view (Tab hides)", nullptr, ImGuiWindowFlags_AlwaysAutoResize);

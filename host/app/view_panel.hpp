@@ -26,6 +26,7 @@ struct PanelState {
   int max_depth = 16;
   int first_strategy = 0, first_max_depth = 16;  // as the options gave them
   std::string device;
+  bool ready = false;                  // panel_ready ran
   std::function<void(int key)> press;  // the key's action (P, S, F, R, C)
 };
 
@@ -33,7 +34,9 @@ struct PanelState {
 bool panel_built_in();
 // Before the window's callbacks run: ImGui takes them over and calls the window's after
 void panel_init(GLFWwindow* window, PanelState* state);
-// Draws the panel over the frame (before the buffers swap)
+// Once the scene is ready: the controls start from its options
+void panel_ready(PanelState* state);
+// Draws the panel over the frame (before the buffers swap): until ready, the status
 void panel_draw(PanelState* state);
 void panel_shutdown();
 // Whether ImGui takes the mouse or the keyboard now (the camera leaves them alone)

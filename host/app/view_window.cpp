@@ -114,7 +114,7 @@ std::string printed_options(Viewer& v) {
 
 void act(Viewer& v, int key) {
   GLFWwindow* w = v.window;
-  if (!v.session->ready()) {
+  if (!v.panel.ready) {
     if (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q) glfwSetWindowShouldClose(w, GLFW_TRUE);
     return;
   }
@@ -182,7 +182,7 @@ bool fly(Viewer& v, int key) {
 void on_key(GLFWwindow* w, int key, int, int action, int) {
   if (action == GLFW_RELEASE || panel_wants_keyboard()) return;
   Viewer& v = viewer_of(w);
-  if (v.looking && v.session->ready() && fly(v, key)) return;
+  if (v.looking && v.panel.ready && fly(v, key)) return;
   if (action == GLFW_PRESS) act(v, key);
 }
 
@@ -291,7 +291,7 @@ int run_view(RenderArgs args) {
   v.session = &session;
   v.panel.session = &session;
   v.panel.press = [&v](int key) { act(v, key); };
-  bool panel = false;  // started once the scene is ready (its options known)
+  panel_init(window, &v.panel);
   bool visible = false;
   std::optional<ViewFrame> shown;  // without its pixels
   std::string title;
@@ -313,14 +313,11 @@ int run_view(RenderArgs args) {
       f->rgba.clear();
       shown = std::move(f);
     }
-    if (!panel && session.ready()) {
-      panel_init(window, &v.panel);
-      panel = true;
-    }
+    if (!v.panel.ready && session.ready()) panel_ready(&v.panel);
     if (visible) {
       draw(window, texture, shown.has_value());
       v.panel.shown = shown ? &*shown : nullptr;
-      if (panel) panel_draw(&v.panel);
+      panel_draw(&v.panel);
       glfwSwapBuffers(window);
     }
     if (v.pending && shown && shown->version >= v.pending_version) {
