@@ -12,6 +12,8 @@ CANDELA_PACKAGES=(
   libopenimageio-dev openimageio-tools libglm-dev libcli11-dev libnanovdb-dev libopenvdb-dev
   googletest libgtest-dev clang-format
   python3-numpy python3-openimageio python3-matplotlib python3-pil python3-pip
+  # candela view's window (GLFW, Dear ImGui, Mesa's OpenGL) and its test (ctest view: Xvfb, xdotool, xwd)
+  libglfw3-dev libimgui-dev libgl1-mesa-dri xvfb xdotool x11-apps
 )
 # A script sourcing this may add packages (scripts/fuzz: clang and libFuzzer)
 read -r -a _candela_extra <<<"${CANDELA_EXTRA_PACKAGES:-}"

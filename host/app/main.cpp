@@ -9,6 +9,7 @@
 #include "app/options.hpp"
 #include "app/render_command.hpp"
 #include "app/settings.hpp"
+#include "app/view.hpp"
 #include "base/error.hpp"
 #include "device/device.hpp"
 #include "device/kernel_sources.hpp"
@@ -65,6 +66,8 @@ int main(int argc, char** argv) {
   CLI::App* devices_cmd = add_devices_command(&app);
   RenderArgs render_args;
   add_render_command(&app, &render_args);
+  RenderArgs view_args;
+  CLI::App* view_cmd = add_view_command(&app, &view_args);
   CompareCommand compare;
   CLI::App* compare_cmd = add_compare_command(&app, &compare);
   MergeArgs merge_args;
@@ -80,7 +83,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return fail(parse_error_message(e.what()));
   }
-  enable_rusticl_if_named(render_args.device);
+  enable_rusticl_if_named(*view_cmd ? view_args.device : render_args.device);
   return run_reporting_errors([&] {
     if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
     if (*devices_cmd) return run_devices_command();
@@ -88,6 +91,7 @@ int main(int argc, char** argv) {
     if (*merge_cmd) return run_merge(merge_args);
     if (*info_cmd) return run_info_command(info_args);
     if (*help_options_cmd) return run_help_options(help_options_args);
+    if (*view_cmd) return run_view(view_args);
     return run_render_command(render_args);
   });
 }

@@ -136,8 +136,9 @@ void check_sequence_args(const RenderArgs& a) {
                   " needs a run of # in its name for the frame number (fox_####.png)");
 }
 
-// What can be checked before the scene loads: option names and output paths
-RenderSettings check_render_args(const RenderArgs& a) {
+}  // namespace
+
+RenderSettings prepare_render_settings(const RenderArgs& a) {
   RenderSettings settings = a.settings;
   if (!a.quiet) {
     settings.before_kernel_compile = [](const std::string& device) {
@@ -155,6 +156,14 @@ RenderSettings check_render_args(const RenderArgs& a) {
   }
   apply_render_settings(a, &settings);  // names of enums, and what they set
   check_camera_options(a);
+  return settings;
+}
+
+namespace {
+
+// What can be checked before the scene loads: option names and output paths
+RenderSettings check_render_args(const RenderArgs& a) {
+  RenderSettings settings = prepare_render_settings(a);
   if (a.outputs.empty()) throw Error("no output file: pass -o OUT.exr or -o OUT.png");
   for (const auto& out : a.outputs) check_output_path(parse_output(out).path);
   check_variance_path(a);
@@ -164,7 +173,8 @@ RenderSettings check_render_args(const RenderArgs& a) {
   return settings;
 }
 
-// The settings that need the loaded scene: its strategy and the camera's aspect ratio
+}  // namespace
+
 void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* settings) {
   settings->strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
   resolve_image_size(a, scene, &settings->width, &settings->height);
@@ -178,6 +188,8 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
   }
 }
 
+namespace {
+
 // The kernel features the renderer builds with: the compiled scene's, without the light
 // tree when --light-selection power leaves it out (the generic kernel keeps every feature)
 SceneFeatures kernel_features(const CompiledScene& c, const RenderArgs& a) {
@@ -186,10 +198,8 @@ SceneFeatures kernel_features(const CompiledScene& c, const RenderArgs& a) {
   return features;
 }
 
-// The renderer of the scene through its camera, on the devices. Host memory: the loaded
-// scene's arrays go once compiled, the compiled scene's as the devices take their copies
-// (README, Performance: Memory). --generic: every kernel feature on (and the vertex arrays
-// those features read).
+}  // namespace
+
 Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& settings,
                        const std::vector<DeviceEntry>& devices, KernelPrebuild& prebuild) {
   // The kernels build while the BVH does: a cold build (seconds) overlaps the scene's
@@ -209,6 +219,8 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
     renderer.worker(i).count_prebuild(prebuild.result(i));
   return renderer;
 }
+
+namespace {
 
 // The render with its progress bar; Ctrl-C stops it between launches
 RenderResult render_with_progress(Renderer& renderer, const RenderArgs& a, const RenderSettings& settings,

@@ -66,6 +66,20 @@ struct RenderArgs {
 
 CLI::App* add_render_command(CLI::App* app, RenderArgs* args);
 
+// The steps of a render that `candela view` shares (view.hpp):
+// the settings the options give, checked as far as they can be before the scene loads
+// (without the outputs' checks), with the kernel-build notes on stderr unless --quiet
+RenderSettings prepare_render_settings(const RenderArgs& args);
+// The settings that need the loaded scene: its strategy and the camera's aspect ratio
+struct Scene;
+void complete_settings(const RenderArgs& args, const Scene& scene, RenderSettings* settings);
+// The renderer of the scene through its camera, on the devices. Host memory: the loaded
+// scene's arrays go once compiled (`scene` is left empty), the compiled scene's as the
+// devices take their copies (README, Performance: Memory). --generic: every kernel feature
+// on (and the vertex arrays those features read).
+Renderer make_renderer(const RenderArgs& args, Scene* scene, const RenderSettings& settings,
+                       const std::vector<DeviceEntry>& devices, KernelPrebuild& prebuild);
+
 // The AOVs a render computes: --aov's, those that outputs FILE.png:NAME name (render/aov.hpp),
 // and with --denoise its guides, albedo and normal
 uint32_t requested_aovs(const RenderArgs& args);

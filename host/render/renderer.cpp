@@ -279,16 +279,28 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
 
   size_t pixels = size_t(settings.width) * settings.height;
   chunk_ = std::min(pixels, std::max<size_t>(group_pixels_, 4096));
-  size_t film_bytes = pixels * 4 * sizeof(float);
   try {
     params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
+    cl_uint arg = 0;
+    for (const cl::Buffer& b : scene_buffers_) kernel_.setArg(arg++, b);
+    kernel_.setArg(arg, params_);
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("allocating the render parameters", e.err()));
+  }
+  allocate_film(pixels);
+}
+
+// The film's buffers for `pixels` pixels (cleared) bound as the kernel's last arguments
+void DeviceRenderer::allocate_film(size_t pixels) {
+  const bool aov = settings_.aov || settings_.transparent;
+  size_t film_bytes = pixels * 4 * sizeof(float);
+  try {
     film_mean_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
     film_m2_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
     queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, film_bytes);
     queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, film_bytes);
-    cl_uint arg = 0;
-    for (const cl::Buffer& b : scene_buffers_) kernel_.setArg(arg++, b);
-    for (const cl::Buffer* b : {&params_, &film_mean_, &film_m2_}) kernel_.setArg(arg++, *b);
+    cl_uint arg = dev::kSceneBufferCount + 1;
+    for (const cl::Buffer* b : {&film_mean_, &film_m2_}) kernel_.setArg(arg++, *b);
     if (aov) {
       film_aov_ = cl::Buffer(context_, CL_MEM_READ_WRITE, 2 * film_bytes);
       queue_.enqueueFillBuffer(film_aov_, 0.0f, 0, 2 * film_bytes);
@@ -298,6 +310,43 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   } catch (const cl::Error& e) {
     throw Error(cl_error_message("allocating the film", e.err()));
   }
+  film_pixels_ = pixels;
+}
+
+void DeviceRenderer::set_view(const dev::Camera& camera, int width, int height) {
+  size_t pixels = size_t(width) * height;
+  // The first launch: about launch_seconds at the cost per pixel measured before, if any
+  size_t first = 4096;
+  size_t before = size_t(params_host_.width) * params_host_.height;
+  if (pass_seconds_ > 0.0 && before > 0)
+    first = size_t(settings_.launch_seconds / std::max(pass_seconds_ / double(before), 1e-12));
+  first = (first + group_pixels_ - 1) / group_pixels_ * group_pixels_;
+  settings_.width = width;
+  settings_.height = height;
+  params_host_.camera = camera;
+  params_host_.width = uint32_t(width);
+  params_host_.height = uint32_t(height);
+  chunk_ = std::clamp(first, std::min(group_pixels_, pixels), pixels);
+  batch_ = 1;
+  pass_seconds_ = 0.0;
+  if (pixels > film_pixels_) return allocate_film(pixels);
+  size_t bytes = pixels * 4 * sizeof(float);
+  try {
+    queue_.enqueueFillBuffer(film_mean_, 0.0f, 0, bytes);
+    queue_.enqueueFillBuffer(film_m2_, 0.0f, 0, bytes);
+    if (settings_.aov || settings_.transparent) queue_.enqueueFillBuffer(film_aov_, 0.0f, 0, 2 * bytes);
+    queue_.finish();
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("clearing the film", e.err()));
+  }
+}
+
+void DeviceRenderer::set_kernel_settings(const RenderSettings& settings) {
+#define CD_SET_KERNEL_SETTING(type, name, default_value) \
+  settings_.name = settings.name;                        \
+  params_host_.name = uint32_t(settings.name);
+  CD_KERNEL_SETTINGS(CD_SET_KERNEL_SETTING)
+#undef CD_SET_KERNEL_SETTING
 }
 
 DeviceRenderer::~DeviceRenderer() {
@@ -340,8 +389,10 @@ bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const s
     // Next launch: about launch_seconds of pixels at the measured cost
     double cost = dt / (double(end - begin) * count);
     size_t want = size_t(settings_.launch_seconds / std::max(cost * count, 1e-12));
-    chunk_ =
-        std::clamp((want + group_pixels_ - 1) / group_pixels_ * group_pixels_, std::min(group_pixels_, pixels), pixels);
+    size_t most = pixels;
+    if (settings_.launch_growth > 0.0) most = std::min(pixels, size_t(double(end - begin) * settings_.launch_growth));
+    chunk_ = std::clamp((want + group_pixels_ - 1) / group_pixels_ * group_pixels_, std::min(group_pixels_, pixels),
+                        std::max(most, std::min(group_pixels_, pixels)));
     if (end < pixels && progress) progress(double(end) / double(pixels));
   }
   // Next range: whole-image launches of several samples once one sample is cheap enough
@@ -521,6 +572,14 @@ Renderer::Renderer(const std::vector<DeviceEntry>& devices, std::shared_ptr<Comp
     workers_.push_back(std::make_unique<DeviceRenderer>(
         devices[i], *scene_, camera, settings, release_host_arrays && i + 1 == devices.size() ? scene.get() : nullptr));
   if (release_host_arrays) scene->release_host_arrays();
+}
+
+void Renderer::set_view(const dev::Camera& camera, int width, int height) {
+  for (auto& w : workers_) w->set_view(camera, width, height);
+}
+
+void Renderer::set_kernel_settings(const RenderSettings& settings) {
+  for (auto& w : workers_) w->set_kernel_settings(settings);
 }
 
 double Renderer::kernel_build_seconds() const {

@@ -69,7 +69,10 @@ struct RenderSettings {
   // the environment seen through see-through paths left out (CD_TRANSPARENT; needs aov)
   bool aov = false;
   bool transparent = false;
-  double launch_seconds = 0.2;       // target duration of one launch
+  double launch_seconds = 0.2;  // target duration of one launch
+  // > 0: a launch covers at most this many times the pixels of the one before (the live
+  // view: a cheap launch over the sky does not make the next one over the model long)
+  double launch_growth = 0.0;
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
   bool packets = true;
@@ -183,6 +186,12 @@ class DeviceRenderer {
   // and no more than fit in `seconds_left`
   uint32_t suggested_batch(double seconds_left) const;
 
+  // Renders through `camera` at width x height from now on, the film cleared (the live
+  // view: a preview size while the camera moves, the full one once it rests)
+  void set_view(const dev::Camera& camera, int width, int height);
+  // The kernel settings (CD_KERNEL_SETTINGS) from now on; set_view clears the film after
+  void set_kernel_settings(const RenderSettings& settings);
+
   Film film();  // reads the film back from the device
   // How many of the scene's buffers are host arrays taken over in place (adopt)
   size_t adopted_buffers() const { return host_arrays_.size(); }
@@ -198,6 +207,7 @@ class DeviceRenderer {
   const DeviceEntry& device() const { return device_; }
 
  private:
+  void allocate_film(size_t pixels);
   void launch(uint32_t sample_begin, uint32_t count, size_t pixel_begin, size_t pixel_end);
   // Appends the buffer of one scene array (`data`); `released`: the same array when the
   // scene releases it (freed once copied, or taken over in place when `adopts` and it can be)
@@ -219,6 +229,7 @@ class DeviceRenderer {
   size_t pixels_per_item_ = 1;  // 8 with packets (render_packets)
   size_t group_pixels_ = 1;     // launch indices per work-group: local_size_ x pixels_per_item_
   size_t chunk_ = 1;            // launch indices (pixels) per launch
+  size_t film_pixels_ = 0;      // the film buffers' size
   uint32_t batch_ = 1;          // samples per pixel for the next range
   double pass_seconds_ = 0.0;   // one sample of every pixel, measured; 0 = not yet
   double kernel_build_seconds_ = 0.0;
@@ -260,6 +271,9 @@ class Renderer {
   size_t worker_count() const { return workers_.size(); }
   DeviceRenderer& worker(size_t i) { return *workers_.at(i); }
   const DeviceRenderer& worker(size_t i) const { return *workers_.at(i); }
+  // Every worker's DeviceRenderer::set_view, set_kernel_settings
+  void set_view(const dev::Camera& camera, int width, int height);
+  void set_kernel_settings(const RenderSettings& settings);
   // The first worker's kernel build; with several devices, the sum of all of them
   double kernel_build_seconds() const;
   bool kernel_from_cache() const;  // every worker's kernel came from the cache

@@ -1,0 +1,125 @@
+// `candela view`'s panel (view_panel.hpp): Dear ImGui over GLFW and OpenGL 2.
+#include "app/view_panel.hpp"
+
+#ifdef CANDELA_WITH_IMGUI
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl2.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <cstdio>
+#endif
+
+#include <iterator>
+
+#include "app/options.hpp"
+
+namespace candela {
+
+void panel_ready(PanelState* state) {
+  const RenderArgs& a = state->session->args();
+  state->tonemap = int(parse_tonemap(a.tonemap));
+  Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
+  for (size_t i = 0; i < std::size(kStrategyNames); ++i)
+    if (kStrategyNames[i].value == strategy) state->strategy = int(i);
+  state->max_depth = int(a.settings.max_depth);
+  state->device = state->session->device();
+  state->first_strategy = state->strategy;
+  state->first_max_depth = state->max_depth;
+  state->ready = true;
+}
+
+#ifndef CANDELA_WITH_IMGUI
+bool panel_built_in() { return false; }
+void panel_init(GLFWwindow*, PanelState*) {}
+void panel_draw(PanelState*) {}
+void panel_shutdown() {}
+bool panel_wants_mouse() { return false; }
+bool panel_wants_keyboard() { return false; }
+#else
+namespace {
+bool g_started = false;
+}  // namespace
+
+bool panel_built_in() { return true; }
+
+void panel_init(GLFWwindow* window, PanelState*) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL2_Init();
+  g_started = true;
+}
+
+void panel_shutdown() {
+  if (!g_started) return;
+  ImGui_ImplOpenGL2_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  g_started = false;
+}
+
+bool panel_wants_mouse() { return g_started && ImGui::GetIO().WantCaptureMouse; }
+bool panel_wants_keyboard() { return g_started && ImGui::GetIO().WantCaptureKeyboard; }
+
+void panel_draw(PanelState* p) {
+  ImGui_ImplOpenGL2_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  ViewSession& session = *p->session;
+  if (!p->ready) {  // loading, compiling: what it waits for
+    std::string status = session.status();
+    ImGui::SetNextWindowPos(ImVec2(4, 4), ImGuiCond_Always);
+    ImGui::Begin("candela view", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+    ImGui::TextUnformatted(status.empty() ? "starting" : status.c_str());
+    ImGui::End();
+  } else if (p->visible) {
+    ImGui::SetNextWindowPos(ImVec2(4, 4), ImGuiCond_Once);
+    ImGui::SetNextWindowBgAlpha(0.75f);
+    ImGui::Begin("candela view (Tab hides)", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+    if (p->shown) {
+      ImGui::Text("%u spp%s, %.2f Msamples/s", p->shown->spp, p->shown->preview ? " (preview)" : "",
+                  p->shown->samples_per_second * 1e-6);
+    }
+    const RenderArgs& a = session.args();
+    ImGui::Text("%s", p->device.c_str());
+    const char* strategies[std::size(kStrategyNames)];
+    for (size_t i = 0; i < std::size(kStrategyNames); ++i) strategies[i] = kStrategyNames[i].name;
+    bool kernel = ImGui::Combo("strategy", &p->strategy, strategies, int(std::size(kStrategyNames)));
+    kernel |= ImGui::SliderInt("max depth", &p->max_depth, 0, 64);
+    if (kernel) session.set_kernel(kStrategyNames[p->strategy].value, uint32_t(std::max(p->max_depth, 0)));
+    bool changed = ImGui::Checkbox("automatic exposure", &p->exposure_automatic);
+    if (p->exposure_automatic) {
+      p->exposure = session.exposure();
+    } else {
+      changed |= ImGui::SliderFloat("exposure (EV)", &p->exposure, -10.0f, 10.0f, "%.1f");
+    }
+    const char* names[std::size(kTonemapNames)];
+    for (size_t i = 0; i < std::size(kTonemapNames); ++i) names[i] = kTonemapNames[i].name;
+    changed |= ImGui::Combo("tone map", &p->tonemap, names, int(std::size(kTonemapNames)));
+    if (changed)
+      session.set_display(p->exposure_automatic ? a.exposure : std::optional<float>(p->exposure), Tonemap(p->tonemap));
+    if (ImGui::Button("Frame all (F)")) p->press('F');
+    ImGui::SameLine();
+    if (ImGui::Button("Reset (R)")) p->press('R');
+    ImGui::SameLine();
+    if (ImGui::Button("Next camera (C)")) p->press('C');
+    if (ImGui::Button("Print camera (P)")) p->press('P');
+    ImGui::SameLine();
+    if (ImGui::Button("Save PNG + EXR (S)")) p->press('S');
+    if (p->shown) {
+      ImGui::PushTextWrapPos(360.0f);
+      ImGui::TextUnformatted(p->shown->camera.c_str());
+      ImGui::PopTextWrapPos();
+    }
+    if (!p->saved.empty()) ImGui::Text("saved %s", p->saved.c_str());
+    ImGui::End();
+  }
+  ImGui::Render();
+  ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
+}
+#endif
+
+}  // namespace candela
