@@ -72,7 +72,7 @@ struct RenderSettings {
   // Adaptive sampling above 0 (render/adaptive.hpp): the estimated relative error at which
   // a pixel stops; a build option (CD_ADAPTIVE: the active-pixel list and the half film)
   double noise_threshold = 0.0;
-  double launch_seconds = 0.2;       // target duration of one launch
+  double launch_seconds = 0.2;  // target duration of one launch
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
   bool packets = true;

@@ -9,7 +9,8 @@
 - the Cornell box: the adaptive image's mean equals a uniform 256-spp render's (another seed)
   within 4 standard errors of the two (their variance images);
 - without --noise-threshold the image is the same, bit for bit, as before (its stats say
-  noise_threshold off), and --noise-threshold with --time stops at the time.
+  noise_threshold off), --noise-threshold with --time stops at the time, and merge refuses
+  adaptive renders (their pixels hold different sample counts).
 Usage: adaptive_test.py path/to/candela repo_root
 """
 import json
@@ -116,6 +117,10 @@ def main():
             stats = json.load(open(at('t.json')))
             check(stats['seconds'] < 3.0 and read(at('t.exr'))['spp.Y'].min() >= 1,
                   f'--time 1 stops after {stats["seconds"]:.2f} s with every pixel sampled')
+        m = subprocess.run([candela, 'merge', at('a.exr'), at('b.exr'), '-o', at('m.exr')], capture_output=True,
+                           text=True)
+        check(m.returncode == 1 and m.stderr.startswith('candela: error: cannot merge'),
+              'merge refuses adaptive renders: ' + m.stderr.strip())
     print('%d failure(s)' % len(failures))
     return 1 if failures else 0
 
