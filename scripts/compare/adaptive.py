@@ -4,7 +4,9 @@
   scripts/compare/adaptive.py bias SCENE [--threshold E] [--spp N] [--seeds K] [--ref-spp M] [--width W]
   scripts/compare/adaptive.py time SCENE [--threshold E] [--time S] [--seeds K] [--ref-spp M] [--width W]
 
-Both render a uniform reference (M spp, seed 1000) into --out DIR (kept: a second run reuses it).
+Both render a uniform reference (M spp, seed 1000) into --out DIR (kept: a second run reuses it); time takes
+--reference REF.exr instead, an image k times as wide (averaged over k x k blocks: the same pixels under the
+box filter).
 bias: K seeds of the adaptive render (at most N spp) and, as a control, K uniform renders at the adaptive
 renders' mean spp. Prints the ratio of the image means to the reference's with its standard error (over the
 seeds, and the reference's own from its variance image), and the median over pixels of the pixel ratio
@@ -22,6 +24,11 @@ import candela_tools as ct  # noqa: E402
 
 
 def reference(args):
+    if args.reference:  # an image k times as wide: averaged over k x k blocks (exact under the box filter)
+        rgb, _ = ct.read_rgb(args.reference)
+        k = rgb.shape[1] // args.width
+        h, w = rgb.shape[0] // k, rgb.shape[1] // k
+        return rgb[:h * k, :w * k].reshape(h, k, w, k, 3).mean(axis=(1, 3)), None
     ref = os.path.join(args.out, "ref-%s-%d-%d.exr" % (os.path.basename(args.scene), args.width, args.ref_spp))
     var = ref[:-4] + "-var.exr"
     if not os.path.exists(ref) or not os.path.exists(var):
@@ -58,7 +65,7 @@ def bias(args):
         pooled = sum(images) / len(images)
         keep = ref > 0.01 * ref_mean
         median = float(np.median(pooled[keep] / ref[keep]))
-        print("  %-8s mean spp %7.1f  mean ratio %.4f ± %.4f  median pixel ratio %.4f" %
+        print("  %-8s mean spp %7.1f  mean ratio %.5f ± %.5f  median pixel ratio %.4f" %
               (kind, statistics.mean(spps), statistics.mean(means), se, median))
 
 
@@ -69,6 +76,8 @@ def math_hypot(a, b):
 def equal_time(args):
     ref, _ = reference(args)
     errs = {"uniform": [], "adaptive": []}
+    for extra in ([], ["--noise-threshold", args.threshold]):  # warm-ups: the kernels built and cached
+        ct.render(args.scene, os.path.join(args.out, "warm-up.exr"), ["--spp", 1] + args.common + extra)
     for seed in range(args.seeds):
         for kind in (("uniform", "adaptive") if seed % 2 == 0 else ("adaptive", "uniform")):
             path = os.path.join(args.out, "time-%s-%d.exr" % (kind, seed))
@@ -95,6 +104,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--width", type=int, default=128)
+    ap.add_argument("--reference", help="time: a reference k times as wide, rendered with the box filter")
     ap.add_argument("--device", default="pocl")
     ap.add_argument("--out", default="adaptive-out")
     ap.add_argument("--candela", help="the candela binary (default: build/candela)")
