@@ -136,7 +136,10 @@ def run(args):
 
 def scene_rows(args, scene, ladder, mi, blender, rows, failures, hosts):
     stem = os.path.splitext(os.path.basename(scene))[0]
-    width, height = vs_mitsuba.image_size(types.SimpleNamespace(size=args.size, height=None, scene=scene))
+    try:  # the camera's aspect ratio, read by the Mitsuba converter (glTF JSON only)
+        width, height = vs_mitsuba.image_size(types.SimpleNamespace(size=args.size, height=None, scene=scene))
+    except (ValueError, UnicodeDecodeError):
+        width, height = args.size, args.size
     tag = "%s-%dx%d-d%d-%dspp" % (stem, width, height, args.max_depth, args.ref_spp)
 
     def add(series, spp, seconds, rel, reference, render_seconds=None, den=0.0, mean_spp=None, threshold=""):
@@ -162,7 +165,9 @@ def scene_rows(args, scene, ladder, mi, blender, rows, failures, hosts):
 
         # Mitsuba: converted scene, warm-up, its own reference
         mts = mref = None
-        if mi is not None:
+        if mi is not None and scene.lower().endswith(".glb"):
+            failures[(stem, "Mitsuba 3")] = "scripts/candela_tools/mitsuba.py converts .gltf (JSON), not .glb"
+        elif mi is not None:
             try:
                 mts = mitsuba_scene.Mitsuba(mi, scene, width, height, args.max_depth, "independent", tmp)
                 mts.render(ladder[0], 999)  # Dr.Jit compiles the kernel (the independent sampler reuses it)
