@@ -219,7 +219,9 @@ def scene_rows(args, scene, ladder, mi, blender, rows, failures, hosts):
                     add("Cycles", spp, seconds, ct.rel_mse(image, cref), "candela")
                     add("Cycles (own ref)", spp, seconds, ct.rel_mse(image, cyref), "own")
             except UserError as e:
-                failures[(stem, "Cycles")] = str(e).strip().splitlines()[-1][:160]
+                lines = str(e).strip().splitlines()
+                errs = [l for l in lines if l.startswith("Error:")]  # Blender's own reason, e.g. no camera
+                failures[(stem, "Cycles")] = (errs or lines)[0 if errs else -1][:160]
 
 
 def write_csv(args, rows):
