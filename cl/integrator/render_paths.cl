@@ -58,6 +58,32 @@ Ray pixel_camera_ray(__global const RenderParams* params, uint px, uint py, Rng*
   return film_camera_ray(params, (float)px + film.x, (float)py + film.y, rng);
 }
 
+// CD_ADAPTIVE (adaptive sampling, host/render/adaptive.hpp): render_paths takes two more
+// buffers: the pixels of the launch indices (the active pixels, a compacted list in place of
+// pixel_of_launch_index), and per pixel the running mean, squared deviations and count
+// (x, y, z) of the channel average of the samples with odd indices, from which the host
+// decides which pixels go on (film_add_adaptive)
+#ifndef CD_ADAPTIVE
+#define CD_ADAPTIVE 0
+#endif
+#if CD_ADAPTIVE
+#define ADAPTIVE_PARAM , __global const uint* active, __global float4* film_half
+#define LAUNCH_PIXEL(i) active[i]
+#define FILM_ADD(mean, m2, half_film, sample, l) film_add_adaptive(mean, m2, half_film, sample, l)
+void film_add_adaptive(float4* mean, float4* m2, float4* half_film, uint sample, float3 l) {
+  film_add(mean, m2, l);
+  if ((sample & 1u) == 0u || !all_finite(l)) return;
+  float v = (l.x + l.y + l.z) / 3.0f, n = half_film->z + 1.0f, delta = v - half_film->x;
+  half_film->x += delta / n;
+  half_film->y += delta * (v - half_film->x);
+  half_film->z = n;
+}
+#else
+#define ADAPTIVE_PARAM
+#define LAUNCH_PIXEL(i) pixel_of_launch_index(i, params->width, params->height)
+#define FILM_ADD(mean, m2, half_film, sample, l) film_add(mean, m2, l)
+#endif
+
 // With CD_AOV, render_paths takes one more buffer: two float4 per pixel, the running means of
 // (albedo, alpha) and (normal, depth) over the pixel's samples (aov_add), n = mean.w + m2.w
 #if CD_AOV
@@ -139,7 +165,7 @@ void packet_camera_rays(__global const RenderParams* params, const uint pixel[8]
 }
 
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                           __global float4* film_mean, __global float4* film_m2 AOV_FILM_PARAM) {
+                           __global float4* film_mean, __global float4* film_m2 AOV_FILM_PARAM ADAPTIVE_PARAM) {
   uint first = params->pixel_begin + 8u * (uint)get_global_id(0);
   if (first >= params->pixel_end) return;
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
@@ -150,17 +176,23 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
 #if CD_AOV
   float4 aov0[8], aov1[8];
 #endif
+#if CD_ADAPTIVE
+  float4 hm[8];
+#endif
   for (uint l = 0u; l < 8u; ++l) {
     // A lane past the launch's end repeats the first lane's pixel, finds nothing (tmax 0)
     // and is never written
     bool inside = first + l < params->pixel_end;
-    pixel[l] = pixel_of_launch_index(inside ? first + l : first, params->width, params->height);
+    pixel[l] = LAUNCH_PIXEL(inside ? first + l : first);
     tmax[l] = inside ? INFINITY : 0.0f;
     mean[l] = film_mean[pixel[l]];
     m2[l] = film_m2[pixel[l]];
 #if CD_AOV
     aov0[l] = film_aov[2u * pixel[l]];
     aov1[l] = film_aov[2u * pixel[l] + 1u];
+#endif
+#if CD_ADAPTIVE
+    hm[l] = film_half[pixel[l]];
 #endif
   }
   uint hashed_seed = rng_hash_seed(params->seed);
@@ -178,14 +210,14 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
 #if CD_AOV
       PathAov a = aov_start();
       float4 m = mean[l], v = m2[l], a0 = aov0[l], a1 = aov1[l];
-      film_add(&m, &v, path_trace(&sc, ray, &hit, &r, &a));
+      FILM_ADD(&m, &v, &hm[l], params->sample_begin + k, path_trace(&sc, ray, &hit, &r, &a));
       aov_add(&a0, &a1, &a, m.w + v.w);
       mean[l] = m;
       m2[l] = v;
       aov0[l] = a0;
       aov1[l] = a1;
 #else
-      film_add(&mean[l], &m2[l], path_trace(&sc, ray, &hit, &r));
+      FILM_ADD(&mean[l], &m2[l], &hm[l], params->sample_begin + k, path_trace(&sc, ray, &hit, &r));
 #endif
     }
   }
@@ -197,14 +229,17 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
     film_aov[2u * pixel[l]] = aov0[l];
     film_aov[2u * pixel[l] + 1u] = aov1[l];
 #endif
+#if CD_ADAPTIVE
+    film_half[pixel[l]] = hm[l];
+#endif
   }
 }
 #else
 __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const RenderParams* params,
-                           __global float4* film_mean, __global float4* film_m2 AOV_FILM_PARAM) {
+                           __global float4* film_mean, __global float4* film_m2 AOV_FILM_PARAM ADAPTIVE_PARAM) {
   uint index = params->pixel_begin + (uint)get_global_id(0);
   if (index >= params->pixel_end) return;
-  uint pixel = pixel_of_launch_index(index, params->width, params->height);
+  uint pixel = LAUNCH_PIXEL(index);
   SceneData sc = {CD_SCENE_BUFFERS(CD_SCENE_INIT) params};
   if (!params->energy_compensation) sc.ggx_albedo = 0;  // no table: no energy compensation
   uint px = pixel % params->width, py = pixel / params->width;
@@ -213,15 +248,18 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
 #if CD_AOV
   float4 a0 = film_aov[2u * pixel], a1 = film_aov[2u * pixel + 1u];
 #endif
+#if CD_ADAPTIVE
+  float4 hm = film_half[pixel];
+#endif
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
     Ray ray = pixel_camera_ray(params, px, py, &rng);
 #if CD_AOV
     PathAov a = aov_start();
-    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng, &a));
+    FILM_ADD(&mean, &m2, &hm, params->sample_begin + k, path_trace(&sc, ray, 0, &rng, &a));
     aov_add(&a0, &a1, &a, mean.w + m2.w);
 #else
-    film_add(&mean, &m2, path_trace(&sc, ray, 0, &rng));
+    FILM_ADD(&mean, &m2, &hm, params->sample_begin + k, path_trace(&sc, ray, 0, &rng));
 #endif
   }
   film_mean[pixel] = mean;
@@ -229,6 +267,9 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
 #if CD_AOV
   film_aov[2u * pixel] = a0;
   film_aov[2u * pixel + 1u] = a1;
+#endif
+#if CD_ADAPTIVE
+  film_half[pixel] = hm;
 #endif
 }
 #endif

@@ -96,6 +96,9 @@ Input read_input(const std::string& path) {
                 ": no candela metadata (candela:spp); merge reads .exr images written by candela render");
   if (auto it = x.img.metadata.find("image"); it != x.img.metadata.end())
     throw Error("cannot merge " + path + ": it is a " + it->second + " image, not a render");
+  if (auto it = x.img.metadata.find("noise_threshold"); it != x.img.metadata.end() && it->second != "off")
+    throw Error("cannot merge " + path + ": an adaptive render (candela:noise_threshold " + it->second +
+                "), whose pixels hold different sample counts");
   x.spp = parse_count(path, "spp", x.img.metadata.at("spp"));
   if (x.spp == 0) throw Error("cannot merge " + path + ": it holds no complete pass of samples (candela:spp 0)");
   x.ranges = ranges_of(x.img, path, x.spp);

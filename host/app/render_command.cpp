@@ -346,6 +346,18 @@ void print_result(const RenderReport& report, bool partial_pass, const Film& fil
     std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n", (unsigned long long)report.dropped_samples);
 }
 
+// Adaptive sampling: how many samples the pixels got
+void print_adaptive(const Film& film) {
+  double total = 0.0, most = 0.0, fewest = film.pixels() ? 1e30 : 0.0;
+  for (size_t p = 0; p < film.pixels(); ++p) {
+    total += film.samples_taken(p);
+    most = std::max<double>(most, film.samples_taken(p));
+    fewest = std::min<double>(fewest, film.samples_taken(p));
+  }
+  std::printf("adaptive: %.1f samples per pixel on average, %.0f to %.0f\n",
+              total / double(std::max<size_t>(film.pixels(), 1)), fewest, most);
+}
+
 }  // namespace
 
 uint32_t requested_aovs(const RenderArgs& a) {
@@ -393,6 +405,7 @@ int render_scene(RenderArgs& a, RenderSettings settings, Scene& scene, const std
   bool denoised = a.denoise.empty() || denoise(a, devices, &r.film);
   bool all_written = write_outputs(a, r.film, report) && denoised;
   print_result(report, r.partial_pass, r.film);
+  if (settings.noise_threshold > 0.0 && !a.quiet) print_adaptive(r.film);
   if (!a.stats.empty()) all_written = write_stats_reporting(report, a.stats) && all_written;
   if (!all_written) return 1;
   return exit_status(r);

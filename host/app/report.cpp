@@ -89,6 +89,8 @@ void record_render(const RenderArgs& a, const RenderSettings& settings, const Re
   report.seconds = r.seconds;
   report.dropped_samples = r.film.dropped_samples();
   report.samples_per_second = r.spp * (double(settings.width) * settings.height) / std::max(r.seconds, 1e-9);
+  if (settings.noise_threshold > 0.0 && !r.worker_samples.empty())  // adaptive: the samples taken
+    report.samples_per_second = double(r.worker_samples.front()) / std::max(r.seconds, 1e-9);
   report.interrupted = r.interrupted;
   report.partial_pass = r.partial_pass;
   report.sample_end = uint64_t(a.sample_offset) + r.samples_taken;

@@ -114,6 +114,25 @@ std::vector<RenderSetting> make_render_settings() {
        "always runs). Excludes `--spp`.",
        "", option(&A::time, [](CLI::Option* o) { o->check(positive_number())->excludes("--spp"); })},
       recorded(
+          {"--noise-threshold", "E",
+           "Adaptive sampling: after the first 16 samples, samples go only to pixels whose estimated relative "
+           "error exceeds E (e.g. 0.02); --spp is then the most a pixel gets, --time the budget; the spp AOV "
+           "holds the counts",
+           "Adaptive sampling, E > 0 ([integrator.md](integrator.md#adaptive-sampling)): every pixel gets the first "
+           "16 samples (all when `--spp` is lower), then passes go only to pixels whose estimated relative error of "
+           "the mean, or a neighbour's, exceeds E, until none does, `--spp` (the most a pixel gets) is reached or "
+           "`--time` is up. One device; not with `--mpi`. The `spp` AOV holds each pixel's count.",
+           "", in_settings(&S::noise_threshold, check(positive_number())),
+           [](const A& a, S* s) {
+             if (s->noise_threshold > 0.0 && a.mpi) throw Error("--noise-threshold does not work with --mpi");
+           }},
+          [](const A&, const S& s) -> SettingValue {
+            char text[32] = "off";
+            if (s.noise_threshold > 0.0) std::snprintf(text, sizeof text, "%.6g", s.noise_threshold);
+            return std::string(text);
+          },
+          "noise_threshold", "noise_threshold", kMustMatch, "CD_ADAPTIVE"),
+      recorded(
           {"--width", "W", "Image width (default 512, or from --height and the camera aspect)", "", "512",
            option(&A::width, check(integer_in(1, 65536)))},
           [](const A&, const S& s) -> SettingValue { return count(s.width); }, nullptr, "width", false,

@@ -18,6 +18,7 @@
 #include "device/kernel_sources.hpp"
 #include "device/program_cache.hpp"
 #include "device/tables_program.hpp"
+#include "render/adaptive.hpp"
 
 namespace candela {
 namespace {
@@ -123,6 +124,7 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
   if (render_packets(device, settings)) options += " -DCD_PACKETS=1";
   if (settings.aov || settings.transparent) options += " -DCD_AOV=1";
   if (settings.transparent) options += " -DCD_TRANSPARENT=1";
+  if (settings.noise_threshold > 0.0) options += " -DCD_ADAPTIVE=1";
   return options;
 }
 
@@ -239,8 +241,9 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   kernel_from_cache_ = build.from_cache;
   kernel_ = cl::Kernel(build.program, "render_paths");
   const bool aov = settings.aov || settings.transparent;
-  // + params and the film's two buffers, and the AOVs' one
-  const unsigned want_args = dev::kSceneBufferCount + 3 + (aov ? 1 : 0);
+  const bool adaptive = settings.noise_threshold > 0.0;
+  // + params and the film's two buffers, the AOVs' one, the active pixels and the half film
+  const unsigned want_args = dev::kSceneBufferCount + 3 + (aov ? 1 : 0) + (adaptive ? 2 : 0);
   if (kernel_.getInfo<CL_KERNEL_NUM_ARGS>() != want_args)
     throw Error("render_paths takes " + std::to_string(kernel_.getInfo<CL_KERNEL_NUM_ARGS>()) +
                 " arguments, but the host binds " + std::to_string(want_args) +
@@ -278,6 +281,7 @@ DeviceRenderer::DeviceRenderer(const DeviceEntry& device, const CompiledScene& s
   params_host_.environment_light = scene.environment_light;
 
   size_t pixels = size_t(settings.width) * settings.height;
+  launches_ = pixels;
   chunk_ = std::min(pixels, std::max<size_t>(group_pixels_, 4096));
   try {
     params_ = cl::Buffer(context_, CL_MEM_READ_ONLY, sizeof(dev::RenderParams));
@@ -305,6 +309,14 @@ void DeviceRenderer::allocate_film(size_t pixels) {
       film_aov_ = cl::Buffer(context_, CL_MEM_READ_WRITE, 2 * film_bytes);
       queue_.enqueueFillBuffer(film_aov_, 0.0f, 0, 2 * film_bytes);
       kernel_.setArg(arg++, film_aov_);
+    }
+    if (adaptive) {
+      std::vector<uint32_t> order = launch_order(settings.width, settings.height);
+      active_ = cl::Buffer(context_, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(uint32_t), order.data());
+      film_half_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
+      queue_.enqueueFillBuffer(film_half_, 0.0f, 0, film_bytes);
+      kernel_.setArg(arg++, active_);
+      kernel_.setArg(arg++, film_half_);
     }
     queue_.finish();
   } catch (const cl::Error& e) {
@@ -377,7 +389,8 @@ void DeviceRenderer::launch(uint32_t sample_begin, uint32_t count, size_t pixel_
 
 bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const std::function<bool()>& stop,
                                   const std::function<void(double)>& progress) {
-  const size_t pixels = size_t(settings_.width) * settings_.height;
+  const size_t pixels = launches_;
+  if (pixels == 0) return true;
   double seconds = 0.0;
   for (size_t begin = 0, end = 0; begin < pixels; begin = end) {
     if (begin > 0 && stop && stop()) return false;
@@ -406,6 +419,28 @@ bool DeviceRenderer::render_range(uint32_t sample_begin, uint32_t count, const s
 uint32_t DeviceRenderer::suggested_batch(double seconds_left) const {
   if (pass_seconds_ <= 0.0) return batch_;
   return uint32_t(std::clamp(seconds_left / pass_seconds_, 1.0, double(batch_)));
+}
+
+void DeviceRenderer::set_active(const std::vector<uint32_t>& active) {
+  if (!active_()) throw Error("set_active needs a renderer with noise_threshold");
+  try {
+    if (!active.empty())
+      queue_.enqueueWriteBuffer(active_, CL_TRUE, 0, active.size() * sizeof(uint32_t), active.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("writing the active pixels", e.err()));
+  }
+  launches_ = active.size();
+  chunk_ = std::min(chunk_, std::max<size_t>(launches_, 1));
+}
+
+std::vector<float> DeviceRenderer::half_film() {
+  std::vector<float> out(size_t(settings_.width) * settings_.height * 4);
+  try {
+    queue_.enqueueReadBuffer(film_half_, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_error_message("reading back the film", e.err()));
+  }
+  return out;
 }
 
 Film DeviceRenderer::film() {
@@ -599,6 +634,8 @@ RenderResult Renderer::render(uint32_t sample_begin, uint32_t spp, double time_l
                               const std::function<bool()>& stop) {
   std::vector<DeviceRenderer*> workers;
   for (auto& w : workers_) workers.push_back(w.get());
+  if (workers.front()->settings().noise_threshold > 0.0)
+    return render_adaptive(workers, sample_begin, spp, time_limit, progress, stop);
   return render_samples(workers, sample_begin, spp, time_limit, progress, stop);
 }
 

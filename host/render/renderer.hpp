@@ -69,6 +69,9 @@ struct RenderSettings {
   // the environment seen through see-through paths left out (CD_TRANSPARENT; needs aov)
   bool aov = false;
   bool transparent = false;
+  // Adaptive sampling above 0 (render/adaptive.hpp): the estimated relative error at which
+  // a pixel stops; a build option (CD_ADAPTIVE: the active-pixel list and the half film)
+  double noise_threshold = 0.0;
   double launch_seconds = 0.2;  // target duration of one launch
   // > 0: a launch covers at most this many times the pixels of the one before (the live
   // view: a cheap launch over the sky does not make the next one over the model long)
@@ -193,6 +196,12 @@ class DeviceRenderer {
   void set_kernel_settings(const RenderSettings& settings);
 
   Film film();  // reads the film back from the device
+  // With noise_threshold: the pixels that the next ranges render (launch index i renders
+  // pixel active[i]; at first every pixel, in pixel_of_launch_index order), and per pixel
+  // the (mean, squared deviations, count) of the odd-indexed samples' channel average
+  void set_active(const std::vector<uint32_t>& active);
+  std::vector<float> half_film();
+  const RenderSettings& settings() const { return settings_; }
   // How many of the scene's buffers are host arrays taken over in place (adopt)
   size_t adopted_buffers() const { return host_arrays_.size(); }
   double kernel_build_seconds() const { return kernel_build_seconds_; }
@@ -223,7 +232,8 @@ class DeviceRenderer {
   cl::CommandQueue queue_;
   cl::Kernel kernel_;
   std::vector<cl::Buffer> scene_buffers_;  // CD_SCENE_BUFFERS order
-  cl::Buffer params_, film_mean_, film_m2_, film_aov_;
+  cl::Buffer params_, film_mean_, film_m2_, film_aov_, active_, film_half_;
+  size_t launches_ = 0;  // launch indices of a range: every pixel, or the active ones
   dev::RenderParams params_host_{};
   size_t local_size_ = 1;
   size_t pixels_per_item_ = 1;  // 8 with packets (render_packets)

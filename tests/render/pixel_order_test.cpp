@@ -2,7 +2,8 @@
 // as the kernel computes it on PoCL:
 //  - it equals the order written out here by enumeration (bands of 8 rows from the top,
 //    8x8 tiles from the left, Z-order inside a whole tile, row-major inside a cut one), and
-//    is a bijection onto the pixels, for images whose sides are and are not multiples of 8;
+//    is a bijection onto the pixels, for images whose sides are and are not multiples of 8,
+//    and the host's launch_order (adaptive sampling's first active list) equals it;
 //  - a whole tile is 64 consecutive launch indices and its Z-order keeps every aligned run
 //    of 4 (16) indices inside a 2x2 (4x4) block;
 //  - renders of an odd-sized image give every pixel its samples, and launches of one
@@ -12,6 +13,7 @@
 #include <algorithm>
 
 #include "gltf/gltf_loader.hpp"
+#include "render/adaptive.hpp"
 #include "render/renderer.hpp"
 #include "support/kernels.hpp"
 #include "support/scenes.hpp"
@@ -57,6 +59,8 @@ TEST(PixelOrder, KernelOrderIsTheTiledZOrderAndABijection) {
     SCOPED_TRACE(std::to_string(s[0]) + "x" + std::to_string(s[1]));
     std::vector<cl_uint> got = kernel_order(s[0], s[1]);
     EXPECT_EQ(got, enumerated_order(s[0], s[1]));
+    std::vector<uint32_t> host = launch_order(int(s[0]), int(s[1]));  // adaptive sampling's active list
+    EXPECT_EQ(std::vector<cl_uint>(host.begin(), host.end()), got);
     std::vector<cl_uint> sorted = got;
     std::sort(sorted.begin(), sorted.end());
     for (size_t p = 0; p < sorted.size(); ++p) ASSERT_EQ(sorted[p], p) << "pixel " << p << " missing or repeated";
