@@ -310,8 +310,8 @@ void DeviceRenderer::allocate_film(size_t pixels) {
       queue_.enqueueFillBuffer(film_aov_, 0.0f, 0, 2 * film_bytes);
       kernel_.setArg(arg++, film_aov_);
     }
-    if (adaptive) {
-      std::vector<uint32_t> order = launch_order(settings.width, settings.height);
+    if (settings_.noise_threshold > 0.0) {  // adaptive: the active pixels and the half film
+      std::vector<uint32_t> order = launch_order(settings_.width, settings_.height);
       active_ = cl::Buffer(context_, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(uint32_t), order.data());
       film_half_ = cl::Buffer(context_, CL_MEM_READ_WRITE, film_bytes);
       queue_.enqueueFillBuffer(film_half_, 0.0f, 0, film_bytes);
