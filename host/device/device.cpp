@@ -185,7 +185,7 @@ DeviceEntry select_device(const std::string& selector) {
         return e;
     throw Error(
         "--device intel: Intel's OpenCL CPU runtime is not installed; install it into the build folder with "
-        "`CANDELA_INTEL_OPENCL=1 scripts/setup.sh`");
+        "`CANDELA_INTEL_OPENCL=1 bash scripts/setup.sh`");
   }
   for (const auto& e : devices) {
     for (const std::string& field : {e.platform_name, e.platform_vendor, e.platform_version, e.name})

@@ -18,7 +18,7 @@ OCL_ICD_VENDORS=/etc/OpenCL/vendors "$bin" render "$scene" --device intel --spp 
   -o "$tmp/x.png" >"$tmp/out" 2>"$tmp/err"
 rc=$?
 if [ $rc -ne 1 ] || [ "$(grep -c '^candela: error' "$tmp/err")" -ne 1 ] ||
-  ! grep -q 'CANDELA_INTEL_OPENCL=1 scripts/setup.sh' "$tmp/err"; then
+  ! grep -q 'CANDELA_INTEL_OPENCL=1 bash scripts/setup.sh' "$tmp/err"; then
   echo "FAIL: --device intel without the runtime: exit $rc, expected one error line naming the switch:"
   cat "$tmp/err"
   exit 1
@@ -27,7 +27,7 @@ echo "ok: --device intel without the runtime: $(cat "$tmp/err")"
 
 "$bin" devices >"$tmp/devices" || exit 1
 if ! grep -q '(Intel(R) OpenCL)$' "$tmp/devices"; then
-  echo "skip: Intel's OpenCL CPU runtime is not installed (CANDELA_INTEL_OPENCL=1 scripts/setup.sh installs it into the build folder)"
+  echo "skip: Intel's OpenCL CPU runtime is not installed (CANDELA_INTEL_OPENCL=1 bash scripts/setup.sh installs it into the build folder)"
   exit 77
 fi
 cat "$tmp/devices"
