@@ -1,5 +1,6 @@
 # Shared set-up for scripts/demo, scripts/test and scripts/bench/bench.sh (sourced, not run):
-# installs missing Debian packages and Open Image Denoise, then configures and builds Release into build/
+# installs missing Debian packages, Open Image Denoise and (with CANDELA_INTEL_OPENCL=1) Intel's OpenCL CPU
+# runtime, then configures and builds Release into build/
 # (scripts/fuzz sets CANDELA_SKIP_BUILD=1: it builds build-fuzz/ with clang instead).
 set -euo pipefail
 
@@ -76,6 +77,57 @@ PY
   rm -rf "$tmp"
 }
 
+# Intel's OpenCL CPU runtime, with CANDELA_INTEL_OPENCL=1: the PyPI packages intel-opencl-rt and
+# intel-cmplr-lib-rt (with tbb and tcmlib; about 270 MB to download, 500 MB installed) installed
+# into a scratch prefix, their libraries moved to build/intel-opencl/lib (libintelocl.so finds
+# the others beside itself), an ICD file written beside them, build/intel-opencl/intel-cpu.icd,
+# and links to its oneTBB in build/intel-opencl/tbb.
+# candela adds that ICD to the system's (docs/devices.md). Skipped when there; without PyPI
+# one notice, and the rest goes on.
+CANDELA_INTEL_OPENCL_PACKAGES=("intel-opencl-rt==2026.*" "intel-cmplr-lib-rt==2026.*")
+candela_install_intel_opencl() {
+  local dest="$CANDELA_ROOT/build/intel-opencl"
+  [ "${CANDELA_INTEL_OPENCL:-0}" = 1 ] || return 0
+  [ -e "$dest/lib/libintelocl.so" ] && [ -e "$dest/tbb/libtbb.so.12" ] && [ -e "$dest/intel-cpu.icd" ] && return 0
+  local tmp
+  tmp=$(mktemp -d)
+  echo "candela: installing Intel's OpenCL CPU runtime (PyPI ${CANDELA_INTEL_OPENCL_PACKAGES[*]}, about 270 MB) into $dest" >&2
+  if python3 -m pip install -q --disable-pip-version-check --no-warn-script-location --ignore-installed \
+    --prefix "$tmp/prefix" "${CANDELA_INTEL_OPENCL_PACKAGES[@]}" >/dev/null 2>&1 &&
+    python3 - "$tmp/prefix" "$dest" <<'PY'
+import filecmp, glob, os, shutil, sys
+prefix, dest = sys.argv[1], sys.argv[2]
+# The libraries' folder: prefix/lib, or prefix/local/lib under Debian's Python
+lib = os.path.dirname(glob.glob(os.path.join(prefix, '**', 'libintelocl.so'), recursive=True)[0])
+# The wheels carry each library under all its names as copies: keep one, link the others
+files = sorted((f for f in os.listdir(lib) if os.path.isfile(os.path.join(lib, f))), key=lambda f: (-len(f), f))
+for i, f in enumerate(files):
+    for g in files[:i]:
+        a, b = os.path.join(lib, f), os.path.join(lib, g)
+        if not os.path.islink(b) and os.path.getsize(a) == os.path.getsize(b) and filecmp.cmp(a, b, shallow=False):
+            os.remove(a)
+            os.symlink(g, a)
+            break
+shutil.rmtree(dest, ignore_errors=True)
+os.makedirs(dest)
+shutil.move(lib, os.path.join(dest, 'lib'))
+# Its oneTBB, newer than Debian's, where candela's RPATH looks first (CMakeLists.txt)
+os.makedirs(os.path.join(dest, 'tbb'))
+for f in os.listdir(os.path.join(dest, 'lib')):
+    if f.startswith('libtbb'):
+        os.symlink(os.path.join('..', 'lib', f), os.path.join(dest, 'tbb', f))
+with open(os.path.join(dest, 'intel-cpu.icd'), 'w') as icd:
+    icd.write(os.path.join(os.path.abspath(dest), 'lib', 'libintelocl.so') + '\n')
+PY
+  then
+    echo "candela: Intel's OpenCL CPU runtime is in $dest (candela lists it as Intel(R) OpenCL; --device intel)" >&2
+  else
+    echo "candela: note: could not install Intel's OpenCL CPU runtime from PyPI (offline, or no pip): --device intel is unavailable; the rest works" >&2
+  fi
+  rm -rf "$tmp"
+}
+
 candela_install_packages
 candela_install_oidn
+candela_install_intel_opencl
 [ "${CANDELA_SKIP_BUILD:-0}" = 1 ] || candela_build

@@ -221,9 +221,10 @@ float energy_dielectric_average(const DielectricEnergy* d, int side) {
 
 // E_avg of node row (j, k, side) = 2 integral of E mu dmu over the E the lookups
 // interpolate: 8-point Gauss-Legendre between the mu of consecutive y nodes. Runs after
-// energy_dielectric_albedo_table; global size (R, 2 F).
+// energy_dielectric_albedo_table; global size (R, 2 F). Not vectorized across work-items
+// on Intel's CPU compiler, which gets it wrong (as energy_ggx_average_table).
 #if CD_TABLE_KERNELS
-__kernel void energy_dielectric_average_table(__global float* table) {
+__kernel __attribute__((vec_type_hint(float4))) void energy_dielectric_average_table(__global float* table) {
   const float x[4] = {0.1834346424956498f, 0.5255324099163290f, 0.7966664774136267f, 0.9602898564975363f};
   const float w[4] = {0.3626837833783620f, 0.3137066458778873f, 0.2223810344533745f, 0.1012285362903763f};
   int j = (int)get_global_id(0), ks = (int)get_global_id(1);

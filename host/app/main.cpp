@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "app/commands.hpp"
@@ -24,6 +25,13 @@ void enable_rusticl_if_named(const std::string& device) {
   if ((wanted.find("rusticl") != std::string::npos || wanted.find("llvmpipe") != std::string::npos) &&
       !std::getenv("RUSTICL_ENABLE"))
     setenv("RUSTICL_ENABLE", "llvmpipe", 0);
+}
+
+// Intel's OpenCL CPU runtime where scripts/setup.sh installs it, beside the executable
+void add_intel_runtime_beside_executable() {
+  std::error_code ec;
+  std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) add_installed_intel_runtime((exe.parent_path() / "intel-opencl").string());
 }
 
 int fail(const std::string& message) {
@@ -84,6 +92,7 @@ int main(int argc, char** argv) {
     return fail(parse_error_message(e.what()));
   }
   enable_rusticl_if_named(*view_cmd ? view_args.device : render_args.device);
+  add_intel_runtime_beside_executable();
   return run_reporting_errors([&] {
     if (!kernel_dir.empty()) set_kernel_source_root(kernel_dir);
     if (*devices_cmd) return run_devices_command();

@@ -146,9 +146,10 @@ std::vector<RenderSetting> make_render_settings() {
           [](const A&, const S& s) -> SettingValue { return count(s.height); }, nullptr, "height", false,
           "RenderParams.height"),
       {"--device", "SEL",
-       "OpenCL device: index, P.D, cpu, gpu, or a name substring (pocl, rusticl, nvidia); default first GPU, else "
-       "first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once",
-       "`0` (an index of `candela devices`), `1.0` (platform.device), `cpu`, `gpu`, or a case-insensitive substring "
+       "OpenCL device: index, P.D, cpu, gpu, intel, or a name substring (pocl, rusticl, nvidia); default first GPU, "
+       "else first CPU. A comma-separated list (pocl,rusticl) or `all` renders on several devices at once",
+       "`0` (an index of `candela devices`), `1.0` (platform.device), `cpu`, `gpu`, `intel` (Intel's OpenCL CPU "
+       "runtime, [devices.md](devices.md#intels-opencl-cpu-runtime)), or a case-insensitive substring "
        "of the platform's name, vendor or version or of the device's name (`pocl`, `rusticl`, `llvmpipe`, "
        "`nvidia`). The default is the first GPU, else the first CPU. A comma-separated list (`pocl,rusticl`) or "
        "`all` (every listed device, once each) renders on several devices at once ([devices.md](devices.md)).",

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
 #include <sstream>
 
 #include "base/error.hpp"
@@ -33,7 +36,49 @@ bool parse_index(const std::string& s, size_t* out) {
   return true;
 }
 
+// Intel's CPU runtime's platform (its GPU platforms are "Intel(R) OpenCL Graphics" and the like)
+bool is_intel_cpu_runtime(const std::string& platform_name) { return platform_name == "Intel(R) OpenCL"; }
+
+// The platforms in the order candela numbers them: the loader's, Intel's CPU runtime last
+std::vector<cl::Platform> ordered_platforms() {
+  std::vector<cl::Platform> platforms;
+  cl::Platform::get(&platforms);
+  std::stable_partition(platforms.begin(), platforms.end(), [](const cl::Platform& p) {
+    return !is_intel_cpu_runtime(trim(p.getInfo<CL_PLATFORM_NAME>()));
+  });
+  return platforms;
+}
+
 }  // namespace
+
+bool add_installed_intel_runtime(const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path icd = fs::path(folder) / "intel-cpu.icd";
+  if (std::getenv("OCL_ICD_VENDORS") || std::getenv("OPENCL_VENDOR_PATH") || !fs::exists(icd, ec)) return false;
+  const fs::path vendors = fs::path(folder) / "vendors";
+  fs::create_directories(vendors, ec);
+  std::set<std::string> wanted;
+  bool complete = true;
+  auto link = [&](const fs::path& target, const std::string& name) {
+    wanted.insert(name);
+    const fs::path l = vendors / name;
+    std::error_code e;
+    if (fs::is_symlink(l, e) && fs::read_symlink(l, e) == target) return;
+    fs::remove(l, e);
+    fs::create_symlink(target, l, e);
+    if (e) complete = false;
+  };
+  // Refreshed at every start: a driver installed or removed later is seen
+  for (const auto& entry : fs::directory_iterator("/etc/OpenCL/vendors", ec))
+    if (entry.path().extension() == ".icd") link(entry.path(), entry.path().filename().string());
+  link(fs::absolute(icd, ec), "candela-intel-cpu.icd");
+  for (const auto& entry : fs::directory_iterator(vendors, ec))
+    if (!wanted.count(entry.path().filename().string())) fs::remove(entry.path(), ec);
+  if (!complete) return false;  // e.g. a read-only build folder: the system's ICDs alone
+  setenv("OCL_ICD_VENDORS", vendors.c_str(), 0);
+  return true;
+}
 
 std::string DeviceEntry::selector() const {
   return std::to_string(platform_index) + "." + std::to_string(device_index);
@@ -50,8 +95,7 @@ std::vector<DeviceEntry> list_devices() {
         "pocl-opencl-icd` (scripts/demo does this)");
   if (err != CL_SUCCESS) throw Error(cl_error_message("clGetPlatformIDs", err));
 
-  std::vector<cl::Platform> platforms;
-  cl::Platform::get(&platforms);
+  std::vector<cl::Platform> platforms = ordered_platforms();
   std::vector<DeviceEntry> out;
   for (size_t p = 0; p < platforms.size(); ++p) {
     std::vector<cl::Device> devices;
@@ -85,8 +129,7 @@ std::vector<DeviceEntry> list_devices() {
 }
 
 std::vector<std::string> list_empty_platforms() {
-  std::vector<cl::Platform> platforms;
-  cl::Platform::get(&platforms);
+  std::vector<cl::Platform> platforms = ordered_platforms();
   std::vector<std::string> out;
   for (size_t p = 0; p < platforms.size(); ++p) {
     std::vector<cl::Device> devices;
@@ -133,6 +176,16 @@ DeviceEntry select_device(const std::string& selector) {
   }
   if (sel == "cpu" || sel == "gpu" || sel == "accelerator") {
     if (auto e = first_of_type(sel)) return *e;
+  }
+  // Intel's own platforms only: PoCL's device names carry the processor's, "...Intel(R) Xeon(R)..."
+  if (sel == "intel") {
+    for (const auto& e : devices)
+      if (lower(e.platform_name).find("intel") != std::string::npos ||
+          lower(e.platform_vendor).find("intel") != std::string::npos)
+        return e;
+    throw Error(
+        "--device intel: Intel's OpenCL CPU runtime is not installed; install it into the build folder with "
+        "`CANDELA_INTEL_OPENCL=1 bash scripts/setup.sh`");
   }
   for (const auto& e : devices) {
     for (const std::string& field : {e.platform_name, e.platform_vendor, e.platform_version, e.name})
