@@ -69,6 +69,9 @@ struct RenderSettings {
   // the environment seen through see-through paths left out (CD_TRANSPARENT; needs aov)
   bool aov = false;
   bool transparent = false;
+  // Motion blur (CD_MOTION_STEPS): the poses across the shutter less one, 0 without blur; the
+  // compiled scene then holds that many + 1 poses of its vertices and cameras
+  uint32_t motion_steps = 0;
   double launch_seconds = 0.2;       // target duration of one launch
   // Camera rays in packets of eight on CPU devices (render_packets); false: one pixel per
   // work-item on every device (the same samples: tests compare the two kernels)
@@ -106,7 +109,7 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
                                   const DeviceEntry& device);
 // Whether render_paths traces camera rays in packets of eight on the device (CD_PACKETS):
 // on CPU devices, where packets are what puts the traversal's tests in SIMD lanes, unless
-// the settings turn them off
+// the settings turn them off or ask for motion blur
 bool render_packets(const DeviceEntry& device, const RenderSettings& settings);
 
 // Builds the render kernel program into the kernel cache on threads of their own, while
