@@ -12,6 +12,17 @@
 struct SceneData;
 bool scene_alpha_passes(const struct SceneData* sc, uint prim, float b1, float b2, Ray ray);
 
+// CD_MOTION_STEPS = K > 0 (motion blur, set by the host with --shutter): the vertices hold
+// K + 1 poses across the shutter, the leaves' boxes bound every pose, and a leaf's triangle
+// is the scene's at the time the SceneData carries (scene_prim_positions), not the copy in
+// BvhTriangle. Camera rays only then go without packets (CD_PACKETS 0).
+#ifndef CD_MOTION_STEPS
+#define CD_MOTION_STEPS 0
+#endif
+#if CD_MOTION_STEPS
+void scene_prim_positions(const struct SceneData* sc, uint prim, float3* p0, float3* p1, float3* p2);
+#endif
+
 CD_ALWAYS_INLINE bool bvh_leaf_triangle_hit(const WatertightRay* r, __global const BvhTriangle* tri, float tmax,
                                             float* t, float* b1, float* b2) {
   return intersect_triangle(r, load3(tri->v0), load3(tri->v1), load3(tri->v2), tmax, t, b1, b2);
@@ -98,7 +109,13 @@ CD_ALWAYS_INLINE void bvh_node_children(const BvhRay* r, __global const BvhNode*
 CD_ALWAYS_INLINE bool bvh_leaf_hit(const struct SceneData* sc, const WatertightRay* wr,
                                    __global const BvhTriangle* tris, int i, uint flags, Ray ray, float tmax, float* t,
                                    float* b1, float* b2) {
+#if CD_MOTION_STEPS
+  float3 v0, v1, v2;
+  scene_prim_positions(sc, tris[i].prim, &v0, &v1, &v2);
+  return intersect_triangle(wr, v0, v1, v2, tmax, t, b1, b2)
+#else
   return bvh_leaf_triangle_hit(wr, &tris[i], tmax, t, b1, b2)
+#endif
 #if CD_FEATURE_ALPHA
          && (!(flags & BVH_TRI_ALPHA_TEST) || scene_alpha_passes(sc, tris[i].prim, *b1, *b2, ray))
 #endif

@@ -84,6 +84,27 @@ void film_add_adaptive(float4* mean, float4* m2, float4* half_film, uint sample,
 #define FILM_ADD(mean, m2, half_film, sample, l) film_add(mean, m2, l)
 #endif
 
+#if CD_MOTION_STEPS
+// Motion blur: pixel_camera_ray's ray at the sample's time, a uniform point of the shutter
+// drawn after the film position's numbers, which *sc takes for the path (scene_set_time)
+Ray pixel_camera_ray_in_time(SceneData* sc, uint px, uint py, Rng* rng) {
+  __global const RenderParams* params = sc->params;
+  float jx = rng_next(rng), jy = rng_next(rng);
+  float2 film = filter_sample(params->filter, jx, jy);
+  scene_set_time(sc, (float)CD_MOTION_STEPS * rng_next(rng));
+  Camera c = camera_at_time(sc);
+  float2 lens = (float2)(0.0f);
+  if (c.lens_radius > 0.0f) {
+    lens.x = rng_next(rng);
+    lens.y = rng_next(rng);
+  }
+  return camera_ray_through(params, &c, (float)px + film.x, (float)py + film.y, lens);
+}
+#if CD_PACKETS
+#error "motion blur (CD_MOTION_STEPS) traces camera rays one by one: no CD_PACKETS"
+#endif
+#endif
+
 // With CD_AOV, render_paths takes one more buffer: two float4 per pixel, the running means of
 // (albedo, alpha) and (normal, depth) over the pixel's samples (aov_add), n = mean.w + m2.w
 #if CD_AOV
@@ -253,7 +274,11 @@ __kernel void render_paths(CD_SCENE_BUFFERS(CD_SCENE_PARAM) __global const Rende
 #endif
   for (uint k = 0u; k < params->sample_count; ++k) {
     Rng rng = rng_init(pixel, params->sample_begin + k, params->seed);
+#if CD_MOTION_STEPS
+    Ray ray = pixel_camera_ray_in_time(&sc, px, py, &rng);
+#else
     Ray ray = pixel_camera_ray(params, px, py, &rng);
+#endif
 #if CD_AOV
     PathAov a = aov_start();
     FILM_ADD(&mean, &m2, &hm, params->sample_begin + k, path_trace(&sc, ray, 0, &rng, &a));

@@ -57,8 +57,13 @@ SurfaceHit surface_at(const SceneData* sc, uint prim, float b1, float b2, float3
   s.ng = triangle_normal_area(v0, v1, v2, &area);
   s.front = dot(s.ng, ray_dir) < 0.0f;
   if (!s.front) s.ng = -s.ng;
+#if CD_MOTION_STEPS
+  float3 n = b0 * scene_motion_vertex(sc, sc->normals, pr->v[0]) + b1 * scene_motion_vertex(sc, sc->normals, pr->v[1]) +
+             b2 * scene_motion_vertex(sc, sc->normals, pr->v[2]);
+#else
   float3 n =
       b0 * vload3(pr->v[0], sc->normals) + b1 * vload3(pr->v[1], sc->normals) + b2 * vload3(pr->v[2], sc->normals);
+#endif
   float len = length(n);
   s.ns = len > 0.0f && isfinite(len) ? n / len : s.ng;
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;

@@ -482,9 +482,11 @@ static inline int environment_guide_cells(int n) { return (n + 3) / 4 > 1 ? (n +
 // generates the kernel's parameters and SceneData (cl/scene/scene_data.cl) and the host's
 // SceneBuffers, upload and argument binding (host/scene_compiler.hpp, renderer.cpp).
 // Per-vertex arrays hold 3 (positions, normals, colors), 2 (uv) or 4 (tangents) floats a
-// vertex; an array the scene does not need holds one dummy element. nanovdb holds the NanoVDB
+// vertex (positions and normals CD_MOTION_STEPS + 1 poses a vertex, with motion blur); an array the scene
+// does not need holds one dummy element. nanovdb holds the NanoVDB
 // grids of MEDIUM_NANOVDB media, each a NanoVDB buffer starting on a 32-byte boundary. env_distribution holds
-// the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. ggx_albedo and
+// the environment map's sampling CDFs (cl/lights/environment.cl), one dummy without a map. camera_steps holds
+// the camera at each pose of the shutter with motion blur (CD_MOTION_STEPS), else one dummy. ggx_albedo and
 // sheen_albedo are no part of the scene: each renderer computes them on its device (GGX_ALBEDO_SIZE floats,
 // energy.cl; SHEEN_ALBEDO_SIZE floats, sheen.cl, only for a kernel with CD_FEATURE_SHEEN).
 // One entry per line, columns aligned:
@@ -512,6 +514,7 @@ static inline int environment_guide_cells(int n) { return (n + 3) / 4 > 1 ? (n +
   X(Medium, media)           \
   X(float, densities)        \
   X(unsigned int, nanovdb)   \
+  X(Camera, camera_steps)    \
   X(float, ggx_albedo)       \
   X(float, sheen_albedo)
 // clang-format on

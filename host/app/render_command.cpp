@@ -190,11 +190,15 @@ void complete_settings(const RenderArgs& a, const Scene& scene, RenderSettings* 
 
 namespace {
 
+// Light selection by power alone: --light-selection power, or motion blur (the light tree's
+// bounds hold one pose of the moving emitters)
+bool power_selection(const RenderArgs& a) { return a.light_selection == "power" || !a.shutter.empty(); }
+
 // The kernel features the renderer builds with: the compiled scene's, without the light
 // tree when --light-selection power leaves it out (the generic kernel keeps every feature)
 SceneFeatures kernel_features(const CompiledScene& c, const RenderArgs& a) {
   SceneFeatures features = c.features;
-  if (!a.generic) features.light_tree = !c.buffers.light_tree.empty() && a.light_selection != "power";
+  if (!a.generic) features.light_tree = !c.buffers.light_tree.empty() && !power_selection(a);
   return features;
 }
 
@@ -210,8 +214,13 @@ Renderer make_renderer(const RenderArgs& a, Scene* scene, const RenderSettings& 
   auto compiled = std::make_shared<CompiledScene>(
       a.generic ? compile_scene(*scene, SceneFeatures::all(), features_known) : compile_scene(*scene, features_known));
   compiled->features = kernel_features(*compiled, a);
-  if (a.light_selection == "power") drop_light_tree(&compiled->buffers);
+  if (power_selection(a)) drop_light_tree(&compiled->buffers);
   dev::Camera camera = compile_camera(*scene, settings.width, settings.height);
+  if (scene->motion_steps > 0) {
+    compiled->buffers.camera_steps.clear();
+    for (const CameraDesc& c : scene->camera_steps)
+      compiled->buffers.camera_steps.push_back(make_device_camera(c, settings.width, settings.height));
+  }
   *scene = Scene();
   prebuild.wait();
   Renderer renderer(devices, std::move(compiled), camera, settings, true);
@@ -411,6 +420,17 @@ int render_scene(RenderArgs& a, RenderSettings settings, Scene& scene, const std
   return exit_status(r);
 }
 
+// The scene of a frame at a->anim_time; with motion blur posed at the shutter's middle (the
+// poses across it are added once its camera is settled: add_motion_poses)
+Scene load_frame_scene(RenderArgs* a, const GltfDocument& document) {
+  if (a->shutter.empty()) return load_render_scene(a, &document);
+  double frame_time = *a->anim_time;
+  a->anim_time = shutter_middle(*a, frame_time);
+  Scene scene = load_render_scene(a, &document);
+  a->anim_time = frame_time;
+  return scene;
+}
+
 // --frames: the document read once; each frame posed, compiled and rendered into the outputs
 // its number names. The first frame's metered exposure holds for the others (no flicker).
 int render_sequence(const RenderArgs& args, const RenderSettings& settings, const std::vector<DeviceEntry>& devices,
@@ -444,7 +464,7 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
     a.repeat = rendered > 0;
     a.exposure = exposure;
     enter_phase(kPreparing);
-    Scene scene = load_render_scene(&a, &document);
+    Scene scene = load_frame_scene(&a, document);
     // A file without a camera: the first frame's camera (framed, or placed by the options)
     // holds for all, not framing each pose anew
     if (scene.cameras.empty() && framed) {
@@ -454,13 +474,14 @@ int render_sequence(const RenderArgs& args, const RenderSettings& settings, cons
       RenderArgs first = a;
       first.anim_time = double(frames[0]) / args.fps;
       first.repeat = true;
-      Scene posed = i == 0 ? Scene() : load_render_scene(&first, &document);
+      Scene posed = i == 0 ? Scene() : load_frame_scene(&first, document);
       const Scene& framing = i == 0 ? scene : posed;
       int w = 0, h = 0;
       resolve_image_size(a, framing, &w, &h);
       framed = resolve_camera(framing, float(w) / float(h));
       if (i != 0) scene.camera = framed;
     }
+    if (!a.shutter.empty()) add_motion_poses(a, document, &scene);
     a.share_exposure = rendered == 0 && mpi_ranks() > 0;
     a.frame_position = i;
     // Frame f renders with seed S + f (S from --seed): frames decorrelated, runs repeatable
@@ -497,6 +518,13 @@ int run_render(RenderArgs a) {
   for (const DeviceEntry& d : devices) prebuild.start_tables(d, settings);
   raise_if_asked("loading");
   if (!a.frames.empty()) return render_sequence(a, settings, devices, prebuild);
+  if (!a.shutter.empty()) {  // motion blur: the document posed across the shutter
+    GltfDocument document(a.scene, render_load_options(a));
+    prebuild.loaded();
+    Scene scene = load_frame_scene(&a, document);
+    add_motion_poses(a, document, &scene);
+    return render_scene(a, settings, scene, devices, prebuild);
+  }
   Scene scene = load_render_scene(&a);
   prebuild.loaded();
   return render_scene(a, settings, scene, devices, prebuild);

@@ -34,6 +34,8 @@ struct RenderArgs {
   std::string frames;                  // --frames A:B[:STEP]: a sequence, frame f at f / fps seconds
   double fps = 24.0;                   // --fps R
   bool skip_existing = false;          // --skip-existing: frames whose outputs all exist are not rendered
+  std::string shutter;                 // --shutter OPEN:CLOSE: motion blur over that span of frames; empty: none
+  int shutter_steps = 4;               // --shutter-steps K: poses across the shutter less one
   bool repeat = false;                 // a later frame of a sequence: the scene's notes were said for the first
   bool share_exposure = false;         // a rank's first frame of a sequence under --mpi: the ranks agree on
   size_t frame_position = 0;           // the exposure of the sequence's earliest (mpi_sequence_exposure)

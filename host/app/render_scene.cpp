@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 
 #include "app/options.hpp"
@@ -211,6 +212,64 @@ Scene load_render_scene(RenderArgs* args, const GltfDocument* document) {
                  left_out.c_str());
   }
   return scene;
+}
+
+Shutter parse_shutter(const std::string& text) {
+  size_t colon = text.find(':');
+  Shutter s;
+  char* end = nullptr;
+  bool ok = colon != std::string::npos && colon > 0 && colon + 1 < text.size();
+  if (ok) {
+    std::string open = text.substr(0, colon), close = text.substr(colon + 1);
+    s.open = std::strtod(open.c_str(), &end);
+    ok = *end == 0;
+    s.close = std::strtod(close.c_str(), &end);
+    ok = ok && *end == 0 && std::isfinite(s.open) && std::isfinite(s.close) && s.open < s.close &&
+         s.close - s.open <= 1000.0;
+  }
+  if (!ok)
+    throw Error("--shutter must be OPEN:CLOSE, frames relative to the frame's time with OPEN < CLOSE (e.g. 0:0.5 "
+                "or -0.25:0.25), not '" + text + "'");
+  return s;
+}
+
+double shutter_middle(const RenderArgs& a, double frame_time) {
+  Shutter s = parse_shutter(a.shutter);
+  return frame_time + 0.5 * (s.open + s.close) / a.fps;
+}
+
+void add_motion_poses(const RenderArgs& a, const GltfDocument& document, Scene* scene) {
+  Shutter shutter = parse_shutter(a.shutter);
+  const int steps = a.shutter_steps;
+  const size_t poses = size_t(steps) + 1;
+  int w = 0, h = 0;
+  resolve_image_size(a, *scene, &w, &h);
+  const float aspect = float(w) / float(h);
+  const CameraDesc still = resolve_camera(*scene, aspect);
+  for (MeshDesc& m : scene->meshes) {
+    m.motion_positions.assign(m.positions.size() * poses, glm::vec3(0.0f));
+    m.motion_normals.assign(m.normals.empty() ? 0 : m.normals.size() * poses, glm::vec3(0.0f));
+  }
+  scene->camera_steps.clear();
+  for (int s = 0; s < steps + 1; ++s) {
+    double frames = shutter.open + (shutter.close - shutter.open) * double(s) / double(steps);
+    Scene pose = document.scene(*a.anim_time + frames / a.fps);
+    apply_camera_options(a, &pose);
+    if (pose.meshes.size() != scene->meshes.size())
+      throw Error("--shutter: the scene's meshes change in number across the shutter");
+    for (size_t i = 0; i < pose.meshes.size(); ++i) {
+      const MeshDesc& from = pose.meshes[i];
+      MeshDesc& to = scene->meshes[i];
+      if (from.positions.size() != to.positions.size() || from.normals.size() != to.normals.size())
+        throw Error("--shutter: a mesh of the scene changes its vertex count across the shutter");
+      for (size_t v = 0; v < from.positions.size(); ++v) {
+        to.motion_positions[v * poses + size_t(s)] = from.positions[v];
+        if (!from.normals.empty()) to.motion_normals[v * poses + size_t(s)] = from.normals[v];
+      }
+    }
+    scene->camera_steps.push_back(pose.cameras.empty() ? still : resolve_camera(pose, aspect));
+  }
+  scene->motion_steps = steps;
 }
 
 void resolve_image_size(const RenderArgs& a, const Scene& scene, int* w, int* h) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/options.hpp"
+#include "app/render_scene.hpp"
 #include "app/report.hpp"
 #include "base/error.hpp"
 #include "render/aov.hpp"
@@ -300,6 +301,31 @@ std::vector<RenderSetting> make_render_settings() {
        "`--skip-existing` leaves out frames written whole (resuming). Under `--mpi` the ranks split the frames "
        "(rank r renders the r-th, (r + N)-th, ... of the sequence), each writing its own. Excludes `--anim-time`.",
        "", flag(&A::skip_existing)},
+      recorded(
+          {"--shutter", "OPEN:CLOSE",
+           "Motion blur: each sample at a moment of this span of frames around the frame's time (e.g. 0:0.5 or "
+           "-0.25:0.25; needs --anim-time or --frames)",
+           "", "", option(&A::shutter),
+           [](const A& a, S* s) {
+             s->motion_steps = 0;
+             if (a.shutter.empty()) return;
+             parse_shutter(a.shutter);
+             if (!a.anim_time && a.frames.empty())
+               throw Error("--shutter needs --anim-time or --frames (the frame whose moments it blurs)");
+             s->motion_steps = uint32_t(a.shutter_steps);
+           }},
+          [](const A& a, const S&) -> SettingValue {
+            return a.shutter.empty() ? std::string("none")
+                                     : a.shutter + " in " + std::to_string(a.shutter_steps) + " steps";
+          },
+          "shutter", "shutter", kMustMatch, "CD_MOTION_STEPS"),
+      {"--shutter-steps", "K", "With --shutter: poses across the shutter less one, 1 to 64 (default 4)",
+       "Motion blur ([scene-format.md](scene-format.md#motion-blur)): each camera sample takes a uniform moment "
+       "in OPEN to CLOSE, in frames (1 / `--fps` seconds) relative to the frame's time (`--anim-time` or the "
+       "frame of `--frames`, which it needs), OPEN < CLOSE; camera, nodes, skins and morphs move. The scene is "
+       "posed at K + 1 moments evenly across the shutter, 1 ≤ K ≤ 64 (default 4), linear between them. Default: "
+       "no blur.",
+       "4", option(&A::shutter_steps, check(integer_in(1, 64)))},
       {"--stats", "FILE.json", "Write render statistics as JSON to this file",
        "Write render statistics ([below](#statistics---stats)).", "", option(&A::stats)},
       {"--exposure", "EV",

@@ -261,6 +261,7 @@ int run_view(RenderArgs args) {
   RenderSettings settings = prepare_render_settings(args);
   if (settings.noise_threshold > 0.0)
     throw Error("--noise-threshold is for candela render: the view refines every pixel alike");
+  if (!args.shutter.empty()) throw Error("--shutter is for candela render: the view shows one moment");
   check_regular_file(args.scene, "scene file");
   glfwSetErrorCallback(on_glfw_error);
   auto unset = [](const char* name) { return !std::getenv(name) || !*std::getenv(name); };

@@ -45,8 +45,12 @@ struct Job {
 class Builder {
  public:
   Builder(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-          const std::vector<bool>& alpha_tested, int threads)
-      : positions_(positions), prims_(prims), alpha_tested_(alpha_tested), threads_(std::max(1, threads)) {
+          const std::vector<bool>& alpha_tested, int threads, int poses)
+      : positions_(positions),
+        prims_(prims),
+        alpha_tested_(alpha_tested),
+        threads_(std::max(1, threads)),
+        poses_(size_t(std::max(1, poses))) {
     refs_.resize(prims.size());
     parallel_for(prims.size(), [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) {
@@ -55,6 +59,12 @@ class Builder {
         Ref& r = refs_[i];
         r.lo = vmin(vmin(a, b), c);
         r.hi = vmax(vmax(a, b), c);
+        for (size_t s = 1; s < poses_; ++s)
+          for (int k = 0; k < 3; ++k) {
+            v4f q = vertex(p.v[k], s);
+            r.lo = vmin(r.lo, q);
+            r.hi = vmax(r.hi, q);
+          }
         uint32_t prim = uint32_t(i);
         std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &prim, 4);
       }
@@ -130,8 +140,8 @@ class Builder {
   }
 
  private:
-  v4f vertex(uint32_t v) const {
-    const float* p = &positions_[3 * size_t(v)];
+  v4f vertex(uint32_t v, size_t pose = 0) const {
+    const float* p = &positions_[3 * (size_t(v) * poses_ + pose)];
     return v4f{p[0], p[1], p[2], 0.0f};
   }
 
@@ -212,9 +222,9 @@ class Builder {
       dev::BvhTriangle& d = bvh_.tris[i];
       d = dev::BvhTriangle{};
       for (int a = 0; a < 3; ++a) {
-        d.v0[a] = positions_[3 * size_t(p.v[0]) + a];
-        d.v1[a] = positions_[3 * size_t(p.v[1]) + a];
-        d.v2[a] = positions_[3 * size_t(p.v[2]) + a];
+        d.v0[a] = positions_[3 * size_t(p.v[0]) * poses_ + a];
+        d.v1[a] = positions_[3 * size_t(p.v[1]) * poses_ + a];
+        d.v2[a] = positions_[3 * size_t(p.v[2]) * poses_ + a];
       }
       d.prim = prim;
       if (p.material < alpha_tested_.size() && alpha_tested_[p.material]) d.flags |= BVH_TRI_ALPHA_TEST;
@@ -359,6 +369,7 @@ class Builder {
   const std::vector<dev::Prim>& prims_;
   const std::vector<bool>& alpha_tested_;
   const int threads_;
+  const size_t poses_;
   uint32_t job_refs_ = kMinJobRefs;
   std::atomic<int> busy_{1};  // threads at work in the top phase (the caller's included)
   UninitVector<Ref> refs_;    // refs_[i]: primitive stored at leaf position i once built
@@ -413,8 +424,8 @@ double sah_cost(const Bvh& bvh) {
 }
 
 Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-              const std::vector<bool>& alpha_tested, int threads) {
-  return Builder(positions, prims, alpha_tested, threads > 0 ? threads : bvh_build_threads()).build();
+              const std::vector<bool>& alpha_tested, int threads, int poses) {
+  return Builder(positions, prims, alpha_tested, threads > 0 ? threads : bvh_build_threads(), poses).build();
 }
 
 }  // namespace candela

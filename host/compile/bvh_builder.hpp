@@ -24,9 +24,11 @@ constexpr int kMaxBvhDepth = 60;
 // `positions`: xyz per vertex; `prims`: vertex indices per primitive (stable order);
 // `alpha_tested`: by Prim::material, whether hits on its triangles call the kernel's alpha
 // test (BVH_TRI_ALPHA_TEST); empty for none. `threads`: 0 for bvh_build_threads(); the
-// tree is the same for any thread count (the workers build disjoint subtrees).
+// tree is the same for any thread count (the workers build disjoint subtrees). `poses` > 1
+// (motion blur): `positions` holds that many poses a vertex (vertex v's pose s at v poses + s);
+// a triangle's box bounds all of them and its leaf copy is pose 0.
 Bvh build_bvh(const std::vector<float>& positions, const std::vector<dev::Prim>& prims,
-              const std::vector<bool>& alpha_tested = {}, int threads = 0);
+              const std::vector<bool>& alpha_tested = {}, int threads = 0, int poses = 1);
 
 // Threads build_bvh uses by default: CANDELA_BVH_THREADS when set (> 0), else every core
 int bvh_build_threads();

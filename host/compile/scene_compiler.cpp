@@ -58,6 +58,25 @@ void compile_geometry(const Scene& scene, const SceneFeatures& f, dev::SceneBuff
   }
 }
 
+// Motion blur: positions and normals replaced by every mesh's poses across the shutter
+// (MeshDesc::motion_positions), in the same vertex order; what was compiled before from the
+// middle pose (lights) keeps it
+void compile_motion(const Scene& scene, dev::SceneBuffers* b) {
+  const size_t poses = size_t(scene.motion_steps) + 1;
+  std::vector<float> positions, normals;
+  positions.reserve(b->positions.size() * poses);
+  normals.reserve(b->positions.size() * poses);
+  for (const MeshDesc& m : scene.meshes) {
+    size_t n = m.positions.size() * poses;
+    if (m.motion_positions.size() != n) throw Error("compile_scene: a mesh lacks its motion poses");
+    append_attribute<3>(&positions, m.motion_positions, n, glm::vec3(0.0f));
+    append_attribute<3>(&normals, m.motion_normals.size() == n ? m.motion_normals : std::vector<glm::vec3>(), n,
+                        glm::vec3(0.0f));
+  }
+  b->positions = std::move(positions);
+  b->normals = std::move(normals);
+}
+
 dev::TextureRef compile_texture_ref(const TextureSlot& r) {
   dev::TextureRef d{};
   d.index = r.index;
@@ -548,18 +567,20 @@ CompiledScene compile_scene(const Scene& scene, const SceneFeatures& features, c
   compile_media(scene, c.features, &c.buffers, &c.grids);
   c.environment_light = compile_lights(scene, &c.buffers);
   c.features.light_tree = features.light_tree || !c.buffers.light_tree.empty();  // a scene's need only known here
+  c.buffers.camera_steps.push_back(dev::Camera{});  // motion blur: the image size's cameras, set by the app
+  if (scene.motion_steps > 0) compile_motion(scene, &c.buffers);
   if (features_known) features_known(c);
   auto bvh_start = Clock::now();
   std::vector<bool> alpha_tested;
   for (const MaterialDesc& m : scene.materials) alpha_tested.push_back(m.alpha_tested());
-  Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims, alpha_tested);
+  Bvh bvh = build_bvh(c.buffers.positions, c.buffers.prims, alpha_tested, 0, scene.motion_steps + 1);
   c.bvh_build_seconds = seconds_since(bvh_start);
   c.bvh_sah_cost = sah_cost(bvh);
   c.bvh_depth = bvh.depth;
   c.buffers.bvh_nodes = std::move(bvh.nodes);
   c.buffers.bvh_tris = std::move(bvh.tris);
   c.triangles = c.buffers.prims.size();
-  c.vertices = c.buffers.positions.size() / 3;
+  c.vertices = c.buffers.positions.size() / 3 / size_t(scene.motion_steps + 1);
   c.device_bytes = c.buffers.bytes();
   c.compile_seconds = seconds_since(start);
   return c;

@@ -114,7 +114,8 @@ bool writable_cache() {
 }  // namespace
 
 bool render_packets(const DeviceEntry& device, const RenderSettings& settings) {
-  return settings.packets && (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  return settings.packets && settings.motion_steps == 0 &&
+         (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
 }
 
 std::string render_kernel_options(const SceneFeatures& features, const RenderSettings& settings,
@@ -125,6 +126,7 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
   if (settings.aov || settings.transparent) options += " -DCD_AOV=1";
   if (settings.transparent) options += " -DCD_TRANSPARENT=1";
   if (settings.noise_threshold > 0.0) options += " -DCD_ADAPTIVE=1";
+  if (settings.motion_steps > 0) options += " -DCD_MOTION_STEPS=" + std::to_string(settings.motion_steps);
   return options;
 }
 

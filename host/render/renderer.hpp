@@ -72,6 +72,9 @@ struct RenderSettings {
   // Adaptive sampling above 0 (render/adaptive.hpp): the estimated relative error at which
   // a pixel stops; a build option (CD_ADAPTIVE: the active-pixel list and the half film)
   double noise_threshold = 0.0;
+  // Motion blur (CD_MOTION_STEPS): the poses across the shutter less one, 0 without blur; the
+  // compiled scene then holds that many + 1 poses of its vertices and cameras
+  uint32_t motion_steps = 0;
   double launch_seconds = 0.2;  // target duration of one launch
   // > 0: a launch covers at most this many times the pixels of the one before (the live
   // view: a cheap launch over the sky does not make the next one over the model long)
@@ -112,7 +115,7 @@ std::string render_kernel_options(const SceneFeatures& features, const RenderSet
                                   const DeviceEntry& device);
 // Whether render_paths traces camera rays in packets of eight on the device (CD_PACKETS):
 // on CPU devices, where packets are what puts the traversal's tests in SIMD lanes, unless
-// the settings turn them off
+// the settings turn them off or ask for motion blur
 bool render_packets(const DeviceEntry& device, const RenderSettings& settings);
 
 // Builds the render kernel program into the kernel cache on threads of their own, while

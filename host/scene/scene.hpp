@@ -135,6 +135,10 @@ struct MeshDesc {
   std::vector<glm::vec3> colors;    // COLOR_0 rgb, linear; empty when absent
   std::vector<uint32_t> indices;    // three per triangle, counter-clockwise = front
   uint32_t material = 0;
+  // Motion blur (Scene::motion_steps K > 0): positions and normals at each of the K + 1 poses
+  // across the shutter, vertex-major (vertex i's pose s at i (K + 1) + s); the arrays above
+  // hold the shutter's middle
+  std::vector<glm::vec3> motion_positions, motion_normals;
   size_t triangles() const { return indices.size() / 3; }
 };
 
@@ -219,6 +223,8 @@ struct Scene {
   std::vector<std::string> extensions_used;  // the file's extensionsUsed
   std::vector<std::string> variants;         // KHR_materials_variants names (LoadOptions::variant picks one)
   std::vector<AnimationDesc> animations;     // the file's animations, in order
+  int motion_steps = 0;                      // motion blur: the poses across the shutter less one; 0: none
+  std::vector<CameraDesc> camera_steps;      // motion blur: the camera at each pose (resolved)
 
   size_t triangles() const;
   Bounds bounds() const;

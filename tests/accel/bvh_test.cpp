@@ -204,6 +204,37 @@ TEST(BvhBuilder, EveryTriangleInExactlyOneLeafAndBoxesNest) {
   check_bvh(Soup(tris).bvh, tris);
 }
 
+// Motion blur: with three poses a vertex, every pose of every triangle lies inside the boxes
+// of its leaf and of the nodes above it, and a leaf's copy of the triangle is pose 0
+TEST(BvhBuilder, BoxesBoundEveryPose) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<std::vector<Tri>> poses(3);
+  for (int i = 0; i < 2000; ++i) {
+    glm::vec3 c(u(rng), u(rng), u(rng)), move(u(rng), u(rng), u(rng));
+    Tri t = make_tri(c, c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)), c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)));
+    for (int s = 0; s < 3; ++s) {
+      Tri moved = t;
+      for (glm::vec3& p : moved.p) p += 0.2f * float(s) * move;
+      poses[size_t(s)].push_back(moved);
+    }
+  }
+  std::vector<float> positions;  // vertex v's pose s at v 3 + s
+  std::vector<dev::Prim> prims;
+  for (size_t i = 0; i < poses[0].size(); ++i) {
+    dev::Prim p{};
+    for (int k = 0; k < 3; ++k) {
+      p.v[k] = uint32_t(3 * i + size_t(k));
+      for (int s = 0; s < 3; ++s)
+        for (int a = 0; a < 3; ++a) positions.push_back(poses[size_t(s)][i].p[k][a]);
+    }
+    prims.push_back(p);
+  }
+  Bvh bvh = build_bvh(positions, prims, {}, 0, 3);
+  for (const std::vector<Tri>& pose : poses) check_bvh(bvh, pose);
+  for (const dev::BvhTriangle& t : bvh.tris) EXPECT_EQ(t.v1[0], poses[0][t.prim].p[1][0]);
+}
+
 // A chain of ever smaller triangles, split off a few at a time: a deep tree stays within
 // the depth limit and the traversal stack
 TEST(BvhBuilder, DeepChainStaysWithinTheStack) {
