@@ -11,32 +11,20 @@ the fraction of its area and of the shutter that the shape covers.
   shutter: at radius r inside the swept quarter a point is covered for the bar's angular
   width 2 asin(w / 2r) out of the 90 degrees; outside the quarter nothing.
 - Without --shutter the quad's edges are sharp; bad --shutter values are one error line.
+On CANDELA_TEST_DEVICE (default pocl).
 Usage: motion_blur_test.py path/to/candela repo_root
 """
-import base64
-import json
 import math
 import os
 import struct
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
 import OpenImageIO as oiio
+from candela_test_util import check, finish, run, write_gltf
 
-failures = []
-
-
-def check(ok, what):
-    print(('ok    ' if ok else 'FAIL  ') + what)
-    if not ok:
-        failures.append(what)
-
-
-def run(args):
-    return subprocess.run(args, capture_output=True, text=True)
-
+DEVICE = os.environ.get('CANDELA_TEST_DEVICE', 'pocl')
 
 def write_scene(path, pos, idx, times, path_name, values, animated_node):
     """An emissive mesh (node 0) and an orthographic camera (node 1, at z = 5 looking down
@@ -44,20 +32,17 @@ def write_scene(path, pos, idx, times, path_name, values, animated_node):
     width = {'translation': '<3f', 'rotation': '<4f'}[path_name]
     blobs = [b''.join(struct.pack('<3f', *p) for p in pos), b''.join(struct.pack('<H', i) for i in idx),
              b''.join(struct.pack('<f', t) for t in times), b''.join(struct.pack(width, *v) for v in values)]
-    views, offset, data = [], 0, b''
-    for b in blobs:
-        b += b'\0' * (-len(b) % 4)
-        views.append({'buffer': 0, 'byteOffset': offset, 'byteLength': len(b)})
-        offset += len(b)
-        data += b
     lo = [min(p[k] for p in pos) for k in range(3)]
     hi = [max(p[k] for p in pos) for k in range(3)]
     doc = {
         'asset': {'version': '2.0'}, 'scene': 0, 'scenes': [{'nodes': [0, 1]}],
         'nodes': [{'mesh': 0}, {'camera': 0, 'translation': [0, 0, 5]}],
         'cameras': [{'type': 'orthographic', 'orthographic': {'xmag': 1, 'ymag': 1, 'znear': 0.1, 'zfar': 10}}],
+        # (no specular layer: the plain diffuse kernel, a short build on every device)
+        'extensionsUsed': ['KHR_materials_specular'],
         'materials': [{'pbrMetallicRoughness': {'baseColorFactor': [0, 0, 0, 1], 'metallicFactor': 0},
-                       'emissiveFactor': [1, 1, 1], 'doubleSided': True}],
+                       'emissiveFactor': [1, 1, 1], 'doubleSided': True,
+                       'extensions': {'KHR_materials_specular': {'specularFactor': 0}}}],
         'meshes': [{'primitives': [{'attributes': {'POSITION': 0}, 'indices': 1, 'material': 0}]}],
         'accessors': [
             {'bufferView': 0, 'componentType': 5126, 'count': len(pos), 'type': 'VEC3', 'min': lo, 'max': hi},
@@ -69,19 +54,15 @@ def write_scene(path, pos, idx, times, path_name, values, animated_node):
         ],
         'animations': [{'samplers': [{'input': 2, 'output': 3}],
                         'channels': [{'sampler': 0, 'target': {'node': animated_node, 'path': path_name}}]}],
-        'bufferViews': views,
-        'buffers': [{'byteLength': len(data),
-                     'uri': 'data:application/octet-stream;base64,' + base64.b64encode(data).decode()}],
     }
-    with open(path, 'w') as f:
-        json.dump(doc, f)
+    write_gltf(path, doc, blobs)
 
 
 def rect(x0, x1, y0, y1):
     return [(x0, y0, 0), (x1, y0, 0), (x1, y1, 0), (x0, y1, 0)], [0, 1, 2, 0, 2, 3]
 
 
-COMMON = ['-q', '--device', 'pocl', '--background', '0,0,0', '--default-light', 'off', '--max-depth', '0']
+COMMON = ['-q', '--device', DEVICE, '--background', '0,0,0', '--default-light', 'off', '--max-depth', '0']
 
 
 def render(candela, scene, out, size, spp, *options, written=None):
@@ -200,9 +181,7 @@ def main():
         check_translation(candela, tmp)
         check_rotation(candela, tmp)
         check_errors(candela, tmp)
-    if failures:
-        print(f'{len(failures)} failed')
-        sys.exit(1)
+    finish()
     print('all passed')
 
 
