@@ -4,8 +4,9 @@
 Fox at three moments of Survey and two of Walk and Run (between keys, not only at them), and
 SimpleSkin at its screenshot's moment (1 s: the joint at +90 degrees) and between keys (0.25 s), and
 the morph targets of AnimatedMorphSphere and MorphStressTest at two moments each, posed by candela
-and by Blender: their silhouettes seen by the same camera at 256 x 256 pixels overlap with an intersection over union of at least 0.98. The metric tells poses apart: candela's
-silhouette at one moment against Blender's at another of the same animation scores below 0.95.
+and by Blender: their silhouettes seen by the same camera at 256 x 256 pixels overlap with an
+intersection over union of at least 0.98. The metric tells poses apart: candela's silhouette at
+one moment against Blender's at another of the same animation scores below 0.95.
 Skipped (exit 77) without Debian's `blender` or the sample assets.
 Usage: blender_pose_test.py path/to/candela repo_root [--device SEL (default: $CANDELA_TEST_DEVICE, else pocl)]
 """
