@@ -60,6 +60,7 @@ class ViewCamera {
   void pan(float dx, float dy, int height);        // pixels of a window `height` tall
   void dolly(float steps);                         // wheel steps, positive: closer
   void frame_all(float aspect);                    // the bounds in view, same direction
+  void focus(glm::vec3 point);                     // the pivot at `point`, turned to face it
   void reset();                                    // the first camera
   void scene_camera(int index);                    // the scene's camera `index`
   int scene_camera_count() const { return int(start_.cameras.size()); }
@@ -102,6 +103,10 @@ class ViewSession {
   bool update_camera(const std::function<void(ViewCamera&)>& change);
   ViewCamera camera();
   uint64_t camera_version();
+  // The surface point the current camera sees through (u, v) of the image (0..1 across,
+  // 0..1 down), by a ray cast against the scene's triangles as loaded; none when it sees
+  // the background
+  std::optional<glm::vec3> pick(double u, double v);
   // The newest frame not taken yet
   std::optional<ViewFrame> take_frame();
   // What the window title says before the first frame: loading, compiling

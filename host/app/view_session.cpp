@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "app/options.hpp"
 #include "app/render_devices.hpp"
@@ -41,7 +42,29 @@ struct ViewSession::State {
   float exposure = 0.0f;             // the newest frame's (metered when automatic)
   double seconds = 0.0;              // the full-size render's time so far
   double last_rate = 0.0;            // the newest frame's samples per second
+  // The scene's triangles as loaded (three corners each, world space) for pick(): the
+  // device holds the compiled scene, and a click's ray cast is rare enough to test them all
+  std::vector<glm::vec3> corners;
 };
+
+namespace {
+
+// The distance along the ray to the triangle (a, b, c), two-sided, or a negative number
+float hit_distance(glm::vec3 o, glm::vec3 d, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  glm::vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+  float det = glm::dot(e1, p);
+  if (std::abs(det) < 1e-20f) return -1.0f;
+  float inv = 1.0f / det;
+  glm::vec3 t = o - a;
+  float u = glm::dot(t, p) * inv;
+  if (u < 0.0f || u > 1.0f) return -1.0f;
+  glm::vec3 q = glm::cross(t, e1);
+  float v = glm::dot(d, q) * inv;
+  if (v < 0.0f || u + v > 1.0f) return -1.0f;
+  return glm::dot(e2, q) * inv;
+}
+
+}  // namespace
 
 ViewSession::ViewSession(RenderArgs args, RenderSettings settings, std::function<void()> wake)
     : args_(std::move(args)), settings_(std::move(settings)), wake_(std::move(wake)), state_(new State) {
@@ -78,6 +101,37 @@ ViewCamera ViewSession::camera() {
 uint64_t ViewSession::camera_version() {
   std::lock_guard<std::mutex> lock(mutex_);
   return version_;
+}
+
+std::optional<glm::vec3> ViewSession::pick(double u, double v) {
+  CameraDesc desc;
+  int width, height;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!ready_) return std::nullopt;
+    desc = camera_.desc();
+    width = width_;
+    height = height_;
+  }
+  // The pinhole ray through (u, v), as the kernel's camera makes it
+  dev::Camera c = make_device_camera(desc, width, height);
+  glm::vec3 f(c.forward[0], c.forward[1], c.forward[2]), r(c.right[0], c.right[1], c.right[2]),
+      up(c.up[0], c.up[1], c.up[2]), o(c.origin[0], c.origin[1], c.origin[2]);
+  float sx = float(2.0 * u - 1.0), sy = float(1.0 - 2.0 * v);
+  glm::vec3 d = f + sx * r + sy * up;
+  if (c.type == CAMERA_ORTHOGRAPHIC) {
+    o += sx * r + sy * up;
+    d = f;
+  }
+  d = glm::normalize(d);
+  const std::vector<glm::vec3>& p = state_->corners;  // written before ready_, unchanged since
+  float nearest = std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i + 2 < p.size(); i += 3) {
+    float t = hit_distance(o, d, p[i], p[i + 1], p[i + 2]);
+    if (t > 0.0f && t < nearest) nearest = t;
+  }
+  if (!std::isfinite(nearest)) return std::nullopt;
+  return o + nearest * d;
 }
 
 std::optional<ViewFrame> ViewSession::take_frame() {
@@ -214,6 +268,8 @@ void ViewSession::setup() {
     status_ = "preparing the scene";
   }
   if (wake_) wake_();
+  for (const MeshDesc& m : scene.meshes)
+    for (uint32_t i : m.indices) st.corners.push_back(m.positions[i]);
   st.renderer = std::make_unique<Renderer>(make_renderer(args_, &scene, s, st.devices, prebuild));
   st.settings = s;
   {

@@ -43,6 +43,8 @@ struct Viewer {
   uint64_t pending_version = 0;
   std::vector<double> latencies;  // seconds from a change to the first frame that shows it
   PanelState panel;               // the panel's state, the last save's names among it
+  Clock::time_point last_click;   // the last left press: a second one soon after is a double-click
+  double click_x = -1e9, click_y = -1e9;
 
   void move(const std::function<void(ViewCamera&)>& change) {
     if (!session->update_camera(change)) return;
@@ -55,6 +57,18 @@ struct Viewer {
 };
 
 Viewer& viewer_of(GLFWwindow* w) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(w)); }
+
+// The pivot at the surface point under the cursor (the image spans the window)
+void focus_at_cursor(Viewer& v) {
+  int ww = 0, wh = 0;
+  glfwGetWindowSize(v.window, &ww, &wh);
+  if (ww <= 0 || wh <= 0) return;
+  std::optional<glm::vec3> point = v.session->pick(v.x / ww, v.y / wh);
+  if (point) v.move([&](ViewCamera& c) { c.focus(*point); });
+}
+
+// Two left presses within this long and this many pixels of each other
+constexpr double kDoubleClickSeconds = 0.4, kDoubleClickPixels = 4.0;
 
 void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   Viewer& v = viewer_of(w);
@@ -73,6 +87,18 @@ void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   } else if (button == GLFW_MOUSE_BUTTON_LEFT) {
     v.orbiting = down;
     if (!down) v.panning = false;
+    if (down) {
+      Clock::time_point now = Clock::now();
+      bool twice = std::chrono::duration<double>(now - v.last_click).count() < kDoubleClickSeconds &&
+                   std::abs(v.x - v.click_x) <= kDoubleClickPixels && std::abs(v.y - v.click_y) <= kDoubleClickPixels;
+      v.last_click = now;
+      v.click_x = v.x;
+      v.click_y = v.y;
+      if (twice) {
+        v.click_x = -1e9;  // a third press starts anew
+        focus_at_cursor(v);
+      }
+    }
   }
 }
 
@@ -133,6 +159,9 @@ void act(Viewer& v, int key) {
       break;
     case GLFW_KEY_F:
       v.move([&](ViewCamera& c) { c.frame_all(aspect); });
+      break;
+    case GLFW_KEY_G:
+      focus_at_cursor(v);
       break;
     case GLFW_KEY_R:
       v.move([&](ViewCamera& c) { c.reset(); });

@@ -15,6 +15,7 @@ Skipped (77) without Xvfb, xdotool or xwd (scripts/setup.sh installs them), or a
 built without GLFW.
 Usage: view_test.py path/to/candela repo_root
 """
+import json
 import os
 import re
 import shutil
@@ -81,6 +82,16 @@ def png_pixels(path):
 
 def exr_rgb(path):
     return oiio.ImageBuf(path).get_pixels(oiio.FLOAT)[:, :, :3].astype(np.float64)
+
+
+def scene_bounds(scene):
+    """The bounds of a glTF's POSITION accessors (min, max: the box's walls for the Cornell box)"""
+    with open(scene) as f:
+        gltf = json.load(f)
+    used = [p['attributes']['POSITION'] for m in gltf['meshes'] for p in m['primitives']]
+    lo = np.min([gltf['accessors'][a]['min'] for a in used], axis=0)
+    hi = np.max([gltf['accessors'][a]['max'] for a in used], axis=0)
+    return lo, hi
 
 
 def same_image(a, b):
@@ -248,6 +259,21 @@ def drive(candela, scene, device, env, tmp, view, out_path, common):
         saved, rendered = exr_rgb(exr).mean(axis=(0, 1)), exr_rgb(os.path.join(tmp, 'moved.exr')).mean(axis=(0, 1))
         check(np.all(np.abs(saved - rendered) <= 0.005 * rendered + 1e-6),
               'the saved EXR matches render at %d spp: means %s vs %s' % (SPP, saved, rendered))
+
+    # A double-click: the pivot (--look-at) moves to the surface point under the cursor, the
+    # camera stays where it is (--look-from)
+    xdotool(env, 'mousemove', '--window', window, '40', '40', 'click', '--repeat', '2', '--delay', '80', '1')
+    time.sleep(0.3)
+    focused = printed_camera(env, window, out_path, 3)
+    check(focused is not None and moved is not None and focused[focused.index('--look-from') + 1] ==
+          moved[moved.index('--look-from') + 1] and focused[focused.index('--look-at') + 1] !=
+          moved[moved.index('--look-at') + 1], 'the double-click moved the pivot, not the camera: %s' % focused)
+    if focused is not None:
+        at = np.array([float(x) for x in focused[focused.index('--look-at') + 1].split(',')])
+        lo, hi = scene_bounds(scene)
+        gap = np.minimum(np.abs(at - lo), np.abs(at - hi))
+        check(np.all(at >= lo - 1e-4) and np.all(at <= hi + 1e-4) and gap.min() < 1e-4 * np.abs(hi - lo).max(),
+              'the new pivot %s lies on a wall of the box (bounds %s..%s)' % (at, lo, hi))
 
     xdotool(env, 'key', '--window', window, 'Escape')
     try:
