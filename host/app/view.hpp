@@ -124,6 +124,22 @@ class ViewSession {
   // The exposure the newest frame was shown at
   float exposure();
   const RenderArgs& args() const { return args_; }  // as the scene completed them (once ready)
+  // What the panel offers, once ready: the scene's variants, its animations' key times, an
+  // environment map, the AOVs the render holds (Aov bits), whether Open Image Denoise loads
+  struct Offer {
+    std::vector<std::string> variants;
+    bool animated = false, environment = false, denoiser = false;
+    double anim_start = 0.0, anim_end = 0.0;
+    uint32_t aovs = 0;
+  };
+  Offer offer();
+  // Loads and compiles the scene again as the first time, with the options `change` edits
+  // (--default-light, --env-rotation, --variant, --anim-time), the camera kept; status()
+  // says what it waits for meanwhile
+  void reload(std::function<void(RenderArgs&)> change);
+  // The image shown: the beauty (aov 0) or one AOV (an Aov bit), and whether the beauty is
+  // denoised once the render rests at the full size
+  void set_image(uint32_t aov, bool denoise);
   // Saves the image as it stands (PNG through the display transform, EXR linear); the
   // names written come back through saved()
   void request_save();
@@ -134,6 +150,7 @@ class ViewSession {
   void run();
   void setup();
   void render_loop();
+  bool denoise_rested(const RenderResult& r, uint32_t spp, uint32_t limit, double rested);
   void save(const RenderResult& result);
   ViewFrame display(const Film& film, uint32_t spp, uint64_t version, bool preview);
 
@@ -153,6 +170,11 @@ class ViewSession {
   uint64_t display_version_ = 0;
   std::optional<std::pair<Strategy, uint32_t>> kernel_;  // set_kernel's, not applied yet
   std::exception_ptr error_;
+  std::vector<std::function<void(RenderArgs&)>> reloads_;  // reload()'s, not applied yet
+  Offer offer_;
+  bool loaded_ = false;         // the first load is done (a reload keeps the camera)
+  uint32_t image_aov_ = 0;      // set_image's
+  bool denoise_ = false;
   std::atomic<bool> quit_{false};
   int width_ = 0, height_ = 0;
   struct State;

@@ -14,6 +14,7 @@
 #include "base/error.hpp"
 #include "compile/camera.hpp"
 #include "render/aov.hpp"
+#include "render/denoise.hpp"
 #include "render/film.hpp"
 #include "render/tonemap.hpp"
 #include "scene/default_light.hpp"
@@ -45,6 +46,8 @@ struct ViewSession::State {
   // The scene's triangles as loaded (three corners each, world space) for pick(): the
   // device holds the compiled scene, and a click's ray cast is rare enough to test them all
   std::vector<glm::vec3> corners;
+  std::vector<float> denoised;  // the last denoised beauty (the full size), shown until the next
+  uint32_t denoised_spp = 0;    // its samples per pixel; 0: none for this camera
 };
 
 namespace {
@@ -207,10 +210,53 @@ std::vector<std::string> ViewSession::saved() {
   return names;
 }
 
+ViewSession::Offer ViewSession::offer() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return offer_;
+}
+
+void ViewSession::reload(std::function<void(RenderArgs&)> change) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    reloads_.push_back(std::move(change));
+  }
+  changed_.notify_all();
+}
+
+void ViewSession::set_image(uint32_t aov, bool denoise) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    image_aov_ = aov;
+    denoise_ = denoise;
+    ++display_version_;
+  }
+  changed_.notify_all();
+}
+
 void ViewSession::run() {
   try {
     setup();
-    render_loop();
+    while (true) {
+      render_loop();
+      std::vector<std::function<void(RenderArgs&)>> changes;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (quit_ || reloads_.empty()) break;
+        changes.swap(reloads_);
+        ready_ = false;
+        status_ = "loading " + args_.scene;
+      }
+      if (wake_) wake_();
+      for (auto& change : changes) change(args_);
+      state_->renderer.reset();
+      state_->last.reset();
+      state_->corners.clear();
+      state_->denoised.clear();
+      Clock::time_point start = Clock::now();
+      setup();
+      std::printf("loaded the scene again in %.2f s\n", seconds_since(start));
+      std::fflush(stdout);
+    }
   } catch (...) {
     std::lock_guard<std::mutex> lock(mutex_);
     error_ = std::current_exception();
@@ -220,7 +266,7 @@ void ViewSession::run() {
 
 void ViewSession::setup() {
   State& st = *state_;
-  st.devices = select_render_devices(args_.device);
+  if (st.devices.empty()) st.devices = select_render_devices(args_.device);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     device_ = joined_descriptions(st.devices);
@@ -260,9 +306,26 @@ void ViewSession::setup() {
   start.bounds = framing_bounds(scene);
   start.aperture = a.aperture;
   start.focus_distance = a.focus_distance;
+  Offer offer;
+  offer.variants = scene.variants;
+  offer.environment = scene.environment.has_value();
+  for (const AnimationDesc& anim : scene.animations) {
+    offer.anim_start = offer.animated ? std::min(offer.anim_start, anim.start) : anim.start;
+    offer.anim_end = offer.animated ? std::max(offer.anim_end, anim.end) : anim.end;
+    offer.animated = true;
+  }
+  offer.aovs = requested_aovs(args_) & ~aov_bit(Aov::Spp);
+  try {
+    load_denoiser();
+    offer.denoiser = true;
+  } catch (const Error&) {
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    camera_ = ViewCamera(start);
+    if (!loaded_) camera_ = ViewCamera(start);
+    loaded_ = true;
+    offer_ = offer;
+    ++version_;  // a new scene: the render restarts
     width_ = s.width;
     height_ = s.height;
     status_ = "preparing the scene";
@@ -285,11 +348,16 @@ ViewFrame ViewSession::display(const Film& film, uint32_t spp, uint64_t version,
   // automatic, as render meters it), the tone map, the sRGB encoding
   std::optional<float> given;
   Tonemap tonemap;
+  uint32_t aov;
+  bool denoise;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     given = exposure_;
     tonemap = tonemap_;
+    aov = image_aov_;
+    denoise = denoise_;
   }
+  const bool denoised = denoise && !preview && st.denoised.size() == film.pixels() * 3;
   float exposure = given.value_or(0.0f);
   if (!given && args_.auto_exposure_share) {
     std::vector<float> lum(film.pixels());
@@ -311,10 +379,16 @@ ViewFrame ViewSession::display(const Film& film, uint32_t spp, uint64_t version,
   f.version = version;
   f.preview = preview;
   f.rgba.resize(film.pixels() * 4);
+  // One AOV as `-o FILE.png:NAME` shows it (its values already encoded)
+  std::vector<float> values = aov && !film.aov.empty() ? aov_display(film, Aov(aov)) : std::vector<float>();
   for (size_t i = 0; i < film.pixels(); ++i) {
-    glm::vec3 v = tonemap_apply(tonemap, film.pixel(i) * scale);
-    for (int c = 0; c < 3; ++c)
-      f.rgba[4 * i + c] = uint8_t(std::lround(std::clamp(linear_to_srgb(v[c]), 0.0f, 1.0f) * 255.0f));
+    glm::vec3 v = denoised ? glm::vec3(st.denoised[3 * i], st.denoised[3 * i + 1], st.denoised[3 * i + 2])
+                           : film.pixel(i);
+    v = tonemap_apply(tonemap, v * scale);
+    for (int c = 0; c < 3; ++c) {
+      float e = values.empty() ? linear_to_srgb(v[c]) : values[3 * i + c];
+      f.rgba[4 * i + c] = uint8_t(std::lround(std::clamp(e, 0.0f, 1.0f) * 255.0f));
+    }
     f.rgba[4 * i + 3] = 255;
   }
   return f;
@@ -340,6 +414,7 @@ void ViewSession::render_loop() {
       std::unique_lock<std::mutex> lock(mutex_);
       if (version_ == shown && full && next >= limit && !save_asked_ && display_version_ == display_shown)
         changed_.wait_for(lock, std::chrono::milliseconds(100));  // converged: wait for a change
+      if (!reloads_.empty()) return;  // run() loads the scene again
       redisplay = display_version_ != display_shown && st.last && version_ == shown;
       display_shown = display_version_;
       version = version_;
@@ -351,6 +426,7 @@ void ViewSession::render_loop() {
     }
     if (quit_) break;
     if (redisplay) {  // the newest frame through the new display transform
+      if (full) denoise_rested(*st.last, next, limit, st.seconds);
       ViewFrame f = display(st.last->film, st.last->spp, version, !full);
       f.camera = camera.render_args(width, height);
       f.samples_per_second = st.last_rate;
@@ -363,6 +439,8 @@ void ViewSession::render_loop() {
       st.settings.max_depth = kernel->second;
       args_.strategy = enum_name(kStrategyNames, kernel->first);
       args_.settings.max_depth = kernel->second;
+      settings_.strategy = kernel->first;  // kept by a reload
+      settings_.max_depth = kernel->second;
       renderer.set_kernel_settings(st.settings);
     }
     if (version != shown) {  // moved: restart small
@@ -371,6 +449,8 @@ void ViewSession::render_loop() {
       shown = version;
       full = false;
       next = 0;
+      st.denoised.clear();
+      st.denoised_spp = 0;
     } else if (!full) {  // at rest: refine at the full size
       renderer.set_view(make_device_camera(camera.desc(), width, height), width, height);
       full = true;
@@ -386,17 +466,18 @@ void ViewSession::render_loop() {
       if (quit_) return true;
       if (!full) return false;
       std::lock_guard<std::mutex> lock(mutex_);
-      return version_ != version;
+      return version_ != version || !reloads_.empty();
     };
     RenderResult r = renderer.render(next, count, 0.0, {}, moved);
     if (r.interrupted || r.partial_pass || r.spp < count) continue;  // a newer camera: start again
     next += r.spp;
-    ViewFrame f = display(r.film, next, version, !full);
-    f.camera = camera.render_args(width, height);
     if (full) {
       st.seconds = seconds_since(full_start);
-      f.samples_per_second = double(next) * width * height / std::max(st.seconds, 1e-9);
+      denoise_rested(r, next, limit, st.seconds);
     }
+    ViewFrame f = display(r.film, next, version, !full);
+    f.camera = camera.render_args(width, height);
+    if (full) f.samples_per_second = double(next) * width * height / std::max(st.seconds, 1e-9);
     st.last_rate = f.samples_per_second;
     r.spp = next;
     r.seconds = full ? st.seconds : r.seconds;
@@ -406,6 +487,33 @@ void ViewSession::render_loop() {
       frame_ = std::move(f);
     }
     if (wake_) wake_();
+  }
+}
+
+// Denoising when still: once the full-size render has rested a while (or reached its
+// samples), and again each time its samples double; the denoised beauty stays in
+// State::denoised until the next. False when off, not due, or OIDN failed (reported).
+bool ViewSession::denoise_rested(const RenderResult& r, uint32_t spp, uint32_t limit, double rested) {
+  constexpr double kRestSeconds = 0.5;
+  State& st = *state_;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!denoise_ || !offer_.denoiser) return false;
+  }
+  bool due = spp >= limit || rested >= kRestSeconds;
+  if (!due || (st.denoised_spp && spp < 2 * st.denoised_spp && (spp < limit || st.denoised_spp >= spp))) return false;
+  bool gpu = std::any_of(st.devices.begin(), st.devices.end(), [](const DeviceEntry& d) { return d.type == "gpu"; });
+  std::string quality = args_.denoise.empty() || args_.denoise == "true" ? "balanced" : args_.denoise;
+  try {
+    DenoiseResult d = denoise_film(r.film, parse_enum(kDenoiseQualityNames, "--denoise", quality), gpu);
+    st.denoised = std::move(d.rgb);
+    st.denoised_spp = spp;
+    return true;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    std::lock_guard<std::mutex> lock(mutex_);
+    offer_.denoiser = false;
+    return false;
   }
 }
 

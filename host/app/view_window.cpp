@@ -15,6 +15,7 @@
 #include "app/view_panel.hpp"
 #include "base/error.hpp"
 #include "base/file_access.hpp"
+#include "scene/default_light.hpp"
 
 namespace candela {
 namespace {
@@ -43,6 +44,7 @@ struct Viewer {
   uint64_t pending_version = 0;
   std::vector<double> latencies;  // seconds from a change to the first frame that shows it
   PanelState panel;               // the panel's state, the last save's names among it
+  bool was_ready = false;         // the session was ready at the last look
   Clock::time_point last_click;   // the last left press: a second one soon after is a double-click
   double click_x = -1e9, click_y = -1e9;
 
@@ -135,6 +137,14 @@ std::string printed_options(Viewer& v) {
   if (v.panel.strategy != v.panel.first_strategy)
     text += std::string(" --strategy ") + kStrategyNames[v.panel.strategy].name;
   if (v.panel.max_depth != v.panel.first_max_depth) text += " --max-depth " + std::to_string(v.panel.max_depth);
+  std::string light = kDefaultLightNames[v.panel.default_light].name;
+  if (light != "auto") text += " --default-light " + light;
+  char number[48];
+  std::snprintf(number, sizeof number, " --env-rotation %.9g", double(v.panel.env_rotation));
+  if (v.panel.offer.environment && v.panel.env_rotation != 0.0f) text += number;
+  if (v.panel.variant > 0) text += " --variant " + v.panel.offer.variants[size_t(v.panel.variant - 1)];
+  std::snprintf(number, sizeof number, " --anim-time %.9g", double(v.panel.anim_time));
+  if (v.panel.anim_time_set) text += number;
   return text;
 }
 
@@ -163,6 +173,24 @@ void act(Viewer& v, int key) {
     case GLFW_KEY_G:
       focus_at_cursor(v);
       break;
+    case GLFW_KEY_L: {  // the next --default-light: auto, on, off (the scene loads again)
+      v.panel.default_light = (v.panel.default_light + 1) % int(std::size(kDefaultLightNames));
+      std::string name = kDefaultLightNames[v.panel.default_light].name;
+      v.session->reload([name](RenderArgs& a) { a.default_light = name; });
+      break;
+    }
+    case GLFW_KEY_N:  // denoise when still (where Open Image Denoise loads)
+      v.panel.denoise = v.panel.offer.denoiser && !v.panel.denoise;
+      v.session->set_image(uint32_t(v.panel.image), v.panel.denoise);
+      break;
+    case GLFW_KEY_V: {  // the next image: the beauty, then each AOV the render holds
+      uint32_t aovs = v.panel.offer.aovs, next = 0;
+      for (uint32_t bit = v.panel.image ? uint32_t(v.panel.image) << 1 : 1; bit && bit <= aovs && !next; bit <<= 1)
+        if (aovs & bit) next = bit;
+      v.panel.image = int(next);
+      v.session->set_image(next, v.panel.denoise);
+      break;
+    }
     case GLFW_KEY_R:
       v.move([&](ViewCamera& c) { c.reset(); });
       break;
@@ -345,7 +373,9 @@ int run_view(RenderArgs args) {
       f->rgba.clear();
       shown = std::move(f);
     }
-    if (!v.panel.ready && session.ready()) panel_ready(&v.panel);
+    bool ready = session.ready();
+    if (ready && !v.was_ready) panel_ready(&v.panel);  // loaded, or loaded again
+    v.was_ready = ready;
     if (visible) {
       draw(window, texture, shown.has_value());
       v.panel.shown = shown ? &*shown : nullptr;

@@ -9,6 +9,11 @@
   printed options equals the new screenshot;
 - the S key writes OUT-0001.png (the screenshot's pixels) and OUT-0001.exr (the render's
   linear image at the same spp, means per channel within 0.5 %);
+- L (--default-light auto, on, off) loads the scene again: the printed options, now with
+  --default-light on, given to render equal the window (it prints the time the load took);
+- a double-click on the back wall moves the printed --look-at onto the wall's plane (a face of
+  the box's bounds), --look-from unchanged;
+- V in a view with --aov albedo shows the albedo as `render -o FILE.png:albedo` writes it;
 - Escape closes the window: exit 0, with the line timing the frames that followed the drag;
   SIGINT to a second view: exit 0 within 5 s.
 Skipped (77) without Xvfb, xdotool or xwd (scripts/setup.sh installs them), or a candela
@@ -162,10 +167,24 @@ def run_view(candela, scene, device, env, tmp):
     check(timing is not None, 'the view timed the frames after the drag: %s' % (timing.group(0) if timing else err))
 
     # Ctrl-C: exits at once, status 0
-    second = subprocess.Popen([candela, 'view', scene, *common], env=env, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
+    # (with --aov albedo: V shows the albedo AOV as `render -o FILE.png:albedo` writes it)
+    second = subprocess.Popen([candela, 'view', scene, *common, '--aov', 'albedo'], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     window = wait_for_title(env, second, r': %d spp, ' % SPP)
     check(window is not None, 'a second view renders')
+    if window is not None:
+        xdotool(env, 'key', '--window', window, 'Tab')
+        time.sleep(0.3)
+        beauty = xwd_pixels(window, env)
+        xdotool(env, 'key', '--window', window, 'v')
+        time.sleep(0.5)
+        albedo = xwd_pixels(window, env)
+        check(not same_image(albedo, beauty), 'V changed the window')
+        out = os.path.join(tmp, 'albedo.png')
+        r = subprocess.run([candela, 'render', scene, *common, '-q', '--camera', '0', '--aov', 'albedo', '-o',
+                            out + ':albedo'], capture_output=True, text=True)
+        check(r.returncode == 0 and same_image(albedo, png_pixels(out)),
+              'V shows the albedo AOV as render writes it (%s)' % r.stderr.strip())
     second.send_signal(signal.SIGINT)
     try:
         status = second.wait(timeout=5)
@@ -260,11 +279,29 @@ def drive(candela, scene, device, env, tmp, view, out_path, common):
         check(np.all(np.abs(saved - rendered) <= 0.005 * rendered + 1e-6),
               'the saved EXR matches render at %d spp: means %s vs %s' % (SPP, saved, rendered))
 
+    # L: --default-light on (the scene loads again, the camera kept); the printed options
+    # reproduce the window
+    # (the box is closed: the studio adds nothing)
+    xdotool(env, 'key', '--window', window, 'l')
+    end = time.time() + 60
+    while time.time() < end and 'loaded the scene again' not in open(out_path).read():
+        time.sleep(0.1)
+    loaded = re.search(r'loaded the scene again in ([\d.]+) s', open(out_path).read())
+    check(loaded is not None, 'L loaded the scene again: %s' % (loaded.group(0) if loaded else None))
+    lit = wait_for_title(env, view, done + '.*--look-from', window)
+    relit = printed_camera(env, window, out_path, 3)
+    check(lit is not None and relit is not None and relit[-2:] == ['--default-light', 'on'] and
+          relit[:-2] == moved, 'L: the scene loads again with --default-light on: %s' % relit)
+    on = xwd_pixels(window, env)
+    ref = reference(candela, scene, device, relit or [], os.path.join(tmp, 'lit'))
+    check(same_image(on, ref),
+          'the window equals render with --default-light on (max diff %d)' % np.abs(on.astype(int) - ref).max())
+
     # A double-click: the pivot (--look-at) moves to the surface point under the cursor, the
     # camera stays where it is (--look-from)
     xdotool(env, 'mousemove', '--window', window, '40', '40', 'click', '--repeat', '2', '--delay', '80', '1')
     time.sleep(0.3)
-    focused = printed_camera(env, window, out_path, 3)
+    focused = printed_camera(env, window, out_path, 4)
     check(focused is not None and moved is not None and focused[focused.index('--look-from') + 1] ==
           moved[moved.index('--look-from') + 1] and focused[focused.index('--look-at') + 1] !=
           moved[moved.index('--look-at') + 1], 'the double-click moved the pivot, not the camera: %s' % focused)
