@@ -89,6 +89,10 @@ struct ViewFrame {
   std::string camera;  // the camera it shows as render options (ViewCamera::render_args)
 };
 
+// The image set_image shows besides the beauty and the AOVs: each pixel's standard error
+// (the square root of its mean's variance, by luminance) over the image's largest, sRGB-encoded
+constexpr uint32_t kVarianceImage = 1u << 31;
+
 // The render of a view on its own thread: loads and compiles the scene, then renders the
 // camera's latest version, restarting (at the preview size, one sample per pixel a frame)
 // whenever it changes and refining at the full size once it rests
@@ -137,7 +141,7 @@ class ViewSession {
   // (--default-light, --env-rotation, --variant, --anim-time), the camera kept; status()
   // says what it waits for meanwhile
   void reload(std::function<void(RenderArgs&)> change);
-  // The image shown: the beauty (aov 0) or one AOV (an Aov bit), and whether the beauty is
+  // The image shown: the beauty (aov 0), one AOV (an Aov bit) or kVarianceImage, and whether the beauty is
   // denoised once the render rests at the full size
   void set_image(uint32_t aov, bool denoise);
   // Saves the image as it stands (PNG through the display transform, EXR linear); the

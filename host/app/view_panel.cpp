@@ -99,14 +99,16 @@ void scene_controls(PanelState* p) {
       images.push_back(n.name);
       bits.push_back(aov_bit(n.value));
     }
+  images.push_back("variance");
+  bits.push_back(kVarianceImage);
   int index = int(std::find(bits.begin(), bits.end(), uint32_t(p->image)) - bits.begin());
   bool changed = false;
-  if (bits.size() > 1 && ImGui::Combo("image (V)", &index, images.data(), int(images.size()))) {
-    p->image = int(bits[size_t(index)]);
+  if (ImGui::Combo("image (V)", &index, images.data(), int(images.size()))) {
+    p->image = bits[size_t(index)];
     changed = true;
   }
   if (offer.denoiser) changed |= ImGui::Checkbox("denoise when still", &p->denoise);
-  if (changed) session.set_image(uint32_t(p->image), p->denoise);
+  if (changed) session.set_image(p->image, p->denoise);
 }
 
 void panel_init(GLFWwindow* window, PanelState*) {

@@ -31,7 +31,7 @@ struct PanelState {
   float env_rotation = 0.0f, anim_time = 0.0f;
   int variant = 0;
   bool anim_time_set = false;
-  int image = 0;
+  uint32_t image = 0;
   bool denoise = false;
   ViewSession::Offer offer;
   std::string device;

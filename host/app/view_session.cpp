@@ -67,6 +67,22 @@ float hit_distance(glm::vec3 o, glm::vec3 d, glm::vec3 a, glm::vec3 b, glm::vec3
   return glm::dot(e2, q) * inv;
 }
 
+// kVarianceImage's values: 3 per pixel; a pixel without a variance (one sample) at the top
+std::vector<float> standard_error_image(const Film& film) {
+  std::vector<float> error(film.pixels()), rgb(film.pixels() * 3);
+  float largest = 0.0f;
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    glm::vec3 v = film.variance_of_mean(i);
+    error[i] = std::sqrt(std::max(dev::luminance_rgb(v.x, v.y, v.z), 0.0f));
+    if (std::isfinite(error[i])) largest = std::max(largest, error[i]);
+  }
+  for (size_t i = 0; i < film.pixels(); ++i) {
+    float e = std::isfinite(error[i]) ? (largest > 0.0f ? error[i] / largest : 0.0f) : 1.0f;
+    rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = linear_to_srgb(e);
+  }
+  return rgb;
+}
+
 }  // namespace
 
 ViewSession::ViewSession(RenderArgs args, RenderSettings settings, std::function<void()> wake)
@@ -380,7 +396,9 @@ ViewFrame ViewSession::display(const Film& film, uint32_t spp, uint64_t version,
   f.preview = preview;
   f.rgba.resize(film.pixels() * 4);
   // One AOV as `-o FILE.png:NAME` shows it (its values already encoded)
-  std::vector<float> values = aov && !film.aov.empty() ? aov_display(film, Aov(aov)) : std::vector<float>();
+  std::vector<float> values = aov && aov != kVarianceImage && !film.aov.empty() ? aov_display(film, Aov(aov))
+                                                                                 : std::vector<float>();
+  if (aov == kVarianceImage) values = standard_error_image(film);
   for (size_t i = 0; i < film.pixels(); ++i) {
     glm::vec3 v = denoised ? glm::vec3(st.denoised[3 * i], st.denoised[3 * i + 1], st.denoised[3 * i + 2])
                            : film.pixel(i);

@@ -181,13 +181,13 @@ void act(Viewer& v, int key) {
     }
     case GLFW_KEY_N:  // denoise when still (where Open Image Denoise loads)
       v.panel.denoise = v.panel.offer.denoiser && !v.panel.denoise;
-      v.session->set_image(uint32_t(v.panel.image), v.panel.denoise);
+      v.session->set_image(v.panel.image, v.panel.denoise);
       break;
     case GLFW_KEY_V: {  // the next image: the beauty, then each AOV the render holds
-      uint32_t aovs = v.panel.offer.aovs, next = 0;
-      for (uint32_t bit = v.panel.image ? uint32_t(v.panel.image) << 1 : 1; bit && bit <= aovs && !next; bit <<= 1)
-        if (aovs & bit) next = bit;
-      v.panel.image = int(next);
+      uint32_t images = v.panel.offer.aovs | kVarianceImage, next = 0;
+      for (uint32_t bit = v.panel.image ? v.panel.image << 1 : 1; bit && !next; bit <<= 1)
+        if (images & bit) next = bit;
+      v.panel.image = next;
       v.session->set_image(next, v.panel.denoise);
       break;
     }

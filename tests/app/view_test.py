@@ -13,7 +13,8 @@
   --default-light on, given to render equal the window (it prints the time the load took);
 - a double-click on the back wall moves the printed --look-at onto the wall's plane (a face of
   the box's bounds), --look-from unchanged;
-- V in a view with --aov albedo shows the albedo as `render -o FILE.png:albedo` writes it;
+- V in a view with --aov albedo shows the albedo as `render -o FILE.png:albedo` writes it, then
+  the standard error (grey, its largest white), then the image again;
 - Escape closes the window: exit 0, with the line timing the frames that followed the drag;
   SIGINT to a second view: exit 0 within 5 s.
 Skipped (77) without Xvfb, xdotool or xwd (scripts/setup.sh installs them), or a candela
@@ -185,6 +186,14 @@ def run_view(candela, scene, device, env, tmp):
                             out + ':albedo'], capture_output=True, text=True)
         check(r.returncode == 0 and same_image(albedo, png_pixels(out)),
               'V shows the albedo AOV as render writes it (%s)' % r.stderr.strip())
+        xdotool(env, 'key', '--window', window, 'v')  # the standard error: grey
+        time.sleep(0.5)
+        error = xwd_pixels(window, env).astype(int)
+        check(np.all(error[:, :, 0] == error[:, :, 1]) and np.all(error[:, :, 1] == error[:, :, 2]) and
+              error.max() == 255 and error.std() > 5, 'V again shows the standard error in grey')
+        xdotool(env, 'key', '--window', window, 'v')
+        time.sleep(0.5)
+        check(np.array_equal(xwd_pixels(window, env), beauty), 'V once more shows the image again')
     second.send_signal(signal.SIGINT)
     try:
         status = second.wait(timeout=5)
