@@ -20,14 +20,14 @@ namespace candela {
 
 void panel_ready(PanelState* state) {
   const RenderArgs& a = state->session->args();
+  state->device = state->session->device();
+  state->offer = state->session->offer();
+  if (state->ready) return;  // a reload: the panel's values stand
   state->tonemap = int(parse_tonemap(a.tonemap));
   Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
   for (size_t i = 0; i < std::size(kStrategyNames); ++i)
     if (kStrategyNames[i].value == strategy) state->strategy = int(i);
   state->max_depth = int(a.settings.max_depth);
-  state->device = state->session->device();
-  state->offer = state->session->offer();
-  if (state->ready) return;  // a reload: the panel's values stand
   for (size_t i = 0; i < std::size(kDefaultLightNames); ++i)
     if (a.default_light == kDefaultLightNames[i].name) state->default_light = int(i);
   state->env_rotation = a.env_rotation.value_or(0.0f);
@@ -36,10 +36,8 @@ void panel_ready(PanelState* state) {
     if (variants[i] == a.variant) state->variant = int(i) + 1;
   state->anim_time_set = a.anim_time.has_value();
   state->anim_time = float(a.anim_time.value_or(state->offer.anim_start));
-  if (!state->ready) {
-    state->first_strategy = state->strategy;
-    state->first_max_depth = state->max_depth;
-  }
+  state->first_strategy = state->strategy;
+  state->first_max_depth = state->max_depth;
   state->ready = true;
 }
 

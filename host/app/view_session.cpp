@@ -338,7 +338,13 @@ void ViewSession::setup() {
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!loaded_) camera_ = ViewCamera(start);
+    // A reload keeps a moved camera; one as the scene or the options make it is made anew
+    // (an animated camera, a framing of the new pose), the scene camera shown kept
+    if (!loaded_ || !camera_.moved()) {
+      int index = loaded_ ? camera_.scene_camera_index() : -1;
+      camera_ = ViewCamera(start);
+      if (index >= 0) camera_.scene_camera(index);
+    }
     loaded_ = true;
     offer_ = offer;
     ++version_;  // a new scene: the render restarts
