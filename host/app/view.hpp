@@ -119,6 +119,7 @@ class ViewSession {
   // The full image size, once the scene is loaded (false before)
   bool size(int* width, int* height);
   bool ready();                // the scene is compiled and rendering
+  uint64_t loads();            // how many times the scene has been loaded and compiled so far
   std::exception_ptr error();  // what stopped the session, if anything
   // The display transform from now on (the newest frame shown again through it): the
   // exposure in stops (unset: --exposure, or the metered one) and the tone map
@@ -177,6 +178,7 @@ class ViewSession {
   std::vector<std::function<void(RenderArgs&)>> reloads_;  // reload()'s, not applied yet
   Offer offer_;
   bool loaded_ = false;         // the first load is done (a reload keeps the camera)
+  uint64_t loads_ = 0;
   uint32_t image_aov_ = 0;      // set_image's
   bool denoise_ = false;
   std::atomic<bool> quit_{false};

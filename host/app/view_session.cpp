@@ -177,6 +177,11 @@ bool ViewSession::size(int* width, int* height) {
   return width_ > 0;
 }
 
+uint64_t ViewSession::loads() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return loads_;
+}
+
 bool ViewSession::ready() {
   std::lock_guard<std::mutex> lock(mutex_);
   return ready_;
@@ -360,6 +365,8 @@ void ViewSession::setup() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ready_ = true;
+    ++loads_;
+    frame_.reset();  // none of the scene as it was
     status_.clear();
   }
 }

@@ -44,7 +44,7 @@ struct Viewer {
   uint64_t pending_version = 0;
   std::vector<double> latencies;  // seconds from a change to the first frame that shows it
   PanelState panel;               // the panel's state, the last save's names among it
-  bool was_ready = false;         // the session was ready at the last look
+  uint64_t loads = 0;             // the session's loads() at the last look
   Clock::time_point last_click;   // the last left press: a second one soon after is a double-click
   double click_x = -1e9, click_y = -1e9;
 
@@ -367,15 +367,17 @@ int run_view(RenderArgs args) {
       glfwShowWindow(window);
       visible = true;
     }
+    if (session.loads() != v.loads) {  // loaded, or loaded again: no frame of the scene as it was
+      v.loads = session.loads();
+      panel_ready(&v.panel);
+      if (v.loads > 1) shown.reset();
+    }
     std::optional<ViewFrame> f = session.take_frame();
     if (f) {
       upload(texture, *f);
       f->rgba.clear();
       shown = std::move(f);
     }
-    bool ready = session.ready();
-    if (ready && !v.was_ready) panel_ready(&v.panel);  // loaded, or loaded again
-    v.was_ready = ready;
     if (visible) {
       draw(window, texture, shown.has_value());
       v.panel.shown = shown ? &*shown : nullptr;

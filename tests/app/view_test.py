@@ -178,8 +178,10 @@ def run_view(candela, scene, device, env, tmp):
         time.sleep(0.3)
         beauty = xwd_pixels(window, env)
         xdotool(env, 'key', '--window', window, 'v')
-        time.sleep(0.5)
-        albedo = xwd_pixels(window, env)
+        albedo, end = beauty, time.time() + 10
+        while time.time() < end and np.array_equal(albedo, beauty):
+            time.sleep(0.2)
+            albedo = xwd_pixels(window, env)
         check(not same_image(albedo, beauty), 'V changed the window')
         out = os.path.join(tmp, 'albedo.png')
         r = subprocess.run([candela, 'render', scene, *common, '-q', '--camera', '0', '--aov', 'albedo', '-o',
@@ -187,13 +189,19 @@ def run_view(candela, scene, device, env, tmp):
         check(r.returncode == 0 and same_image(albedo, png_pixels(out)),
               'V shows the albedo AOV as render writes it (%s)' % r.stderr.strip())
         xdotool(env, 'key', '--window', window, 'v')  # the standard error: grey
-        time.sleep(0.5)
-        error = xwd_pixels(window, env).astype(int)
+        error, end = albedo, time.time() + 10
+        while time.time() < end and np.array_equal(error, albedo):
+            time.sleep(0.2)
+            error = xwd_pixels(window, env)
+        error = error.astype(int)
         check(np.all(error[:, :, 0] == error[:, :, 1]) and np.all(error[:, :, 1] == error[:, :, 2]) and
               error.max() == 255 and error.std() > 5, 'V again shows the standard error in grey')
         xdotool(env, 'key', '--window', window, 'v')
-        time.sleep(0.5)
-        check(np.array_equal(xwd_pixels(window, env), beauty), 'V once more shows the image again')
+        again, end = error, time.time() + 10
+        while time.time() < end and np.array_equal(again, error):
+            time.sleep(0.2)
+            again = xwd_pixels(window, env)
+        check(np.array_equal(again, beauty), 'V once more shows the image again')
     second.send_signal(signal.SIGINT)
     try:
         status = second.wait(timeout=5)
