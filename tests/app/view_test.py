@@ -14,7 +14,8 @@
 - a double-click on the back wall moves the printed --look-at onto the wall's plane (a face of
   the box's bounds), --look-from unchanged;
 - V in a view with --aov albedo shows the albedo as `render -o FILE.png:albedo` writes it, then
-  the standard error (grey, its largest white), then the image again;
+  the standard error (grey, its largest white), then the image again; N (where Open Image
+  Denoise loads) the image as `render --denoise` writes it;
 - Escape closes the window: exit 0, with the line timing the frames that followed the drag;
   SIGINT to a second view: exit 0 within 5 s.
 Skipped (77) without Xvfb, xdotool or xwd (scripts/setup.sh installs them), or a candela
@@ -202,6 +203,19 @@ def run_view(candela, scene, device, env, tmp):
             time.sleep(0.2)
             again = xwd_pixels(window, env)
         check(np.array_equal(again, beauty), 'V once more shows the image again')
+        # N: denoised as render --denoise writes it, where Open Image Denoise loads
+        out = os.path.join(tmp, 'denoised.png')
+        r = subprocess.run([candela, 'render', scene, *common, '-q', '--camera', '0', '--aov', 'albedo', '--denoise',
+                            '-o', out], capture_output=True, text=True)
+        if r.returncode == 0 and 'error' not in r.stderr:
+            xdotool(env, 'key', '--window', window, 'n')
+            denoised, end = again, time.time() + 20
+            while time.time() < end and np.array_equal(denoised, again):
+                time.sleep(0.2)
+                denoised = xwd_pixels(window, env)
+            check(same_image(denoised, png_pixels(out)), 'N shows the image as render --denoise writes it')
+        else:
+            print('note: no Open Image Denoise: %s' % r.stderr.strip())
     second.send_signal(signal.SIGINT)
     try:
         status = second.wait(timeout=5)
