@@ -60,6 +60,7 @@ class ViewCamera {
   void pan(float dx, float dy, int height);        // pixels of a window `height` tall
   void dolly(float steps);                         // wheel steps, positive: closer
   void frame_all(float aspect);                    // the bounds in view, same direction
+  void focus(glm::vec3 point);                     // the pivot at `point`, turned to face it
   void reset();                                    // the first camera
   void scene_camera(int index);                    // the scene's camera `index`
   int scene_camera_count() const { return int(start_.cameras.size()); }
@@ -88,6 +89,10 @@ struct ViewFrame {
   std::string camera;  // the camera it shows as render options (ViewCamera::render_args)
 };
 
+// The image set_image shows besides the beauty and the AOVs: each pixel's standard error
+// (the square root of its mean's variance, by luminance) over the image's largest, sRGB-encoded
+constexpr uint32_t kVarianceImage = 1u << 31;
+
 // The render of a view on its own thread: loads and compiles the scene, then renders the
 // camera's latest version, restarting (at the preview size, one sample per pixel a frame)
 // whenever it changes and refining at the full size once it rests
@@ -102,6 +107,10 @@ class ViewSession {
   bool update_camera(const std::function<void(ViewCamera&)>& change);
   ViewCamera camera();
   uint64_t camera_version();
+  // The surface point the current camera sees through (u, v) of the image (0..1 across,
+  // 0..1 down), by a ray cast against the scene's triangles as loaded; none when it sees
+  // the background
+  std::optional<glm::vec3> pick(double u, double v);
   // The newest frame not taken yet
   std::optional<ViewFrame> take_frame();
   // What the window title says before the first frame: loading, compiling
@@ -110,6 +119,7 @@ class ViewSession {
   // The full image size, once the scene is loaded (false before)
   bool size(int* width, int* height);
   bool ready();                // the scene is compiled and rendering
+  uint64_t loads();            // how many times the scene has been loaded and compiled so far
   std::exception_ptr error();  // what stopped the session, if anything
   // The display transform from now on (the newest frame shown again through it): the
   // exposure in stops (unset: --exposure, or the metered one) and the tone map
@@ -119,6 +129,22 @@ class ViewSession {
   // The exposure the newest frame was shown at
   float exposure();
   const RenderArgs& args() const { return args_; }  // as the scene completed them (once ready)
+  // What the panel offers, once ready: the scene's variants, its animations' key times, an
+  // environment map, the AOVs the render holds (Aov bits), whether Open Image Denoise loads
+  struct Offer {
+    std::vector<std::string> variants;
+    bool animated = false, environment = false, denoiser = false;
+    double anim_start = 0.0, anim_end = 0.0;
+    uint32_t aovs = 0;
+  };
+  Offer offer();
+  // Loads and compiles the scene again as the first time, with the options `change` edits
+  // (--default-light, --env-rotation, --variant, --anim-time), the camera kept; status()
+  // says what it waits for meanwhile
+  void reload(std::function<void(RenderArgs&)> change);
+  // The image shown: the beauty (aov 0), one AOV (an Aov bit) or kVarianceImage, and whether the beauty is
+  // denoised once the render rests at the full size
+  void set_image(uint32_t aov, bool denoise);
   // Saves the image as it stands (PNG through the display transform, EXR linear); the
   // names written come back through saved()
   void request_save();
@@ -129,6 +155,7 @@ class ViewSession {
   void run();
   void setup();
   void render_loop();
+  bool denoise_rested(const RenderResult& r, uint32_t spp, uint32_t limit, double rested);
   void save(const RenderResult& result);
   ViewFrame display(const Film& film, uint32_t spp, uint64_t version, bool preview);
 
@@ -148,6 +175,12 @@ class ViewSession {
   uint64_t display_version_ = 0;
   std::optional<std::pair<Strategy, uint32_t>> kernel_;  // set_kernel's, not applied yet
   std::exception_ptr error_;
+  std::vector<std::function<void(RenderArgs&)>> reloads_;  // reload()'s, not applied yet
+  Offer offer_;
+  bool loaded_ = false;         // the first load is done (a reload keeps the camera)
+  uint64_t loads_ = 0;
+  uint32_t image_aov_ = 0;      // set_image's
+  bool denoise_ = false;
   std::atomic<bool> quit_{false};
   int width_ = 0, height_ = 0;
   struct State;

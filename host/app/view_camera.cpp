@@ -146,6 +146,12 @@ void ViewCamera::dolly(float steps) {
   from_ = at_ + offset * (next / r);
 }
 
+void ViewCamera::focus(glm::vec3 point) {
+  if (!(glm::length(point - from_) > 1e-6f)) return;
+  detach();
+  at_ = point;
+}
+
 void ViewCamera::frame_all(float aspect) {
   if (start_.bounds.empty()) return;
   detach();

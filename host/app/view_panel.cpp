@@ -13,17 +13,29 @@
 #include <iterator>
 
 #include "app/options.hpp"
+#include "render/aov.hpp"
+#include "scene/default_light.hpp"
 
 namespace candela {
 
 void panel_ready(PanelState* state) {
   const RenderArgs& a = state->session->args();
+  state->device = state->session->device();
+  state->offer = state->session->offer();
+  if (state->ready) return;  // a reload: the panel's values stand
   state->tonemap = int(parse_tonemap(a.tonemap));
   Strategy strategy = parse_enum(kStrategyNames, "--strategy", a.strategy);
   for (size_t i = 0; i < std::size(kStrategyNames); ++i)
     if (kStrategyNames[i].value == strategy) state->strategy = int(i);
   state->max_depth = int(a.settings.max_depth);
-  state->device = state->session->device();
+  for (size_t i = 0; i < std::size(kDefaultLightNames); ++i)
+    if (a.default_light == kDefaultLightNames[i].name) state->default_light = int(i);
+  state->env_rotation = a.env_rotation.value_or(0.0f);
+  const std::vector<std::string>& variants = state->offer.variants;
+  for (size_t i = 0; i < variants.size(); ++i)
+    if (variants[i] == a.variant) state->variant = int(i) + 1;
+  state->anim_time_set = a.anim_time.has_value();
+  state->anim_time = float(a.anim_time.value_or(state->offer.anim_start));
   state->first_strategy = state->strategy;
   state->first_max_depth = state->max_depth;
   state->ready = true;
@@ -42,6 +54,60 @@ bool g_started = false;
 }  // namespace
 
 bool panel_built_in() { return true; }
+
+// The options that reload the scene (where it has them) and the image shown
+void scene_controls(PanelState* p) {
+  ViewSession& session = *p->session;
+  const ViewSession::Offer& offer = p->offer;
+  std::string status = session.status();
+  if (!status.empty()) ImGui::TextUnformatted(status.c_str());
+  const char* lights[std::size(kDefaultLightNames)];
+  for (size_t i = 0; i < std::size(kDefaultLightNames); ++i) lights[i] = kDefaultLightNames[i].name;
+  if (ImGui::Combo("default light", &p->default_light, lights, int(std::size(kDefaultLightNames)))) {
+    std::string name = lights[p->default_light];
+    session.reload([name](RenderArgs& a) { a.default_light = name; });
+  }
+  if (offer.environment) {
+    ImGui::SliderFloat("environment rotation", &p->env_rotation, -180.0f, 180.0f, "%.0f deg");
+    if (ImGui::IsItemDeactivatedAfterEdit()) {
+      float degrees = p->env_rotation;
+      session.reload([degrees](RenderArgs& a) { a.env_rotation = degrees; });
+    }
+  }
+  if (!offer.variants.empty()) {
+    std::vector<const char*> names = {"(default)"};
+    for (const std::string& v : offer.variants) names.push_back(v.c_str());
+    if (ImGui::Combo("variant", &p->variant, names.data(), int(names.size()))) {
+      std::string name = p->variant > 0 ? offer.variants[size_t(p->variant - 1)] : "";
+      session.reload([name](RenderArgs& a) { a.variant = name; });
+    }
+  }
+  if (offer.animated) {
+    ImGui::SliderFloat("animation time", &p->anim_time, float(offer.anim_start), float(offer.anim_end), "%.3f s");
+    if (ImGui::IsItemDeactivatedAfterEdit()) {
+      double t = p->anim_time;
+      p->anim_time_set = true;
+      session.reload([t](RenderArgs& a) { a.anim_time = t; });
+    }
+  }
+  std::vector<const char*> images = {"beauty"};
+  std::vector<uint32_t> bits = {0};
+  for (const auto& n : kAovNames)
+    if (offer.aovs & aov_bit(n.value)) {
+      images.push_back(n.name);
+      bits.push_back(aov_bit(n.value));
+    }
+  images.push_back("variance");
+  bits.push_back(kVarianceImage);
+  int index = int(std::find(bits.begin(), bits.end(), uint32_t(p->image)) - bits.begin());
+  bool changed = false;
+  if (ImGui::Combo("image (V)", &index, images.data(), int(images.size()))) {
+    p->image = bits[size_t(index)];
+    changed = true;
+  }
+  if (offer.denoiser) changed |= ImGui::Checkbox("denoise when still", &p->denoise);
+  if (changed) session.set_image(p->image, p->denoise);
+}
 
 void panel_init(GLFWwindow* window, PanelState*) {
   IMGUI_CHECKVERSION();
@@ -101,6 +167,7 @@ void panel_draw(PanelState* p) {
     changed |= ImGui::Combo("tone map", &p->tonemap, names, int(std::size(kTonemapNames)));
     if (changed)
       session.set_display(p->exposure_automatic ? a.exposure : std::optional<float>(p->exposure), Tonemap(p->tonemap));
+    scene_controls(p);
     if (ImGui::Button("Frame all (F)")) p->press('F');
     ImGui::SameLine();
     if (ImGui::Button("Reset (R)")) p->press('R');

@@ -25,6 +25,15 @@ struct PanelState {
   int strategy = 0;  // kStrategyNames index
   int max_depth = 16;
   int first_strategy = 0, first_max_depth = 16;  // as the options gave them
+  // The options a reload applies (kDefaultLightNames index, degrees, variant index + 1
+  // (0: the default), seconds) and the image shown (0: beauty, else an Aov bit)
+  int default_light = 0;
+  float env_rotation = 0.0f, anim_time = 0.0f;
+  int variant = 0;
+  bool anim_time_set = false;
+  uint32_t image = 0;
+  bool denoise = false;
+  ViewSession::Offer offer;
   std::string device;
   bool ready = false;                  // panel_ready ran
   std::function<void(int key)> press;  // the key's action (P, S, F, R, C)

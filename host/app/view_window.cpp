@@ -15,6 +15,7 @@
 #include "app/view_panel.hpp"
 #include "base/error.hpp"
 #include "base/file_access.hpp"
+#include "scene/default_light.hpp"
 
 namespace candela {
 namespace {
@@ -43,6 +44,9 @@ struct Viewer {
   uint64_t pending_version = 0;
   std::vector<double> latencies;  // seconds from a change to the first frame that shows it
   PanelState panel;               // the panel's state, the last save's names among it
+  uint64_t loads = 0;             // the session's loads() at the last look
+  Clock::time_point last_click;   // the last left press: a second one soon after is a double-click
+  double click_x = -1e9, click_y = -1e9;
 
   void move(const std::function<void(ViewCamera&)>& change) {
     if (!session->update_camera(change)) return;
@@ -55,6 +59,18 @@ struct Viewer {
 };
 
 Viewer& viewer_of(GLFWwindow* w) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(w)); }
+
+// The pivot at the surface point under the cursor (the image spans the window)
+void focus_at_cursor(Viewer& v) {
+  int ww = 0, wh = 0;
+  glfwGetWindowSize(v.window, &ww, &wh);
+  if (ww <= 0 || wh <= 0) return;
+  std::optional<glm::vec3> point = v.session->pick(v.x / ww, v.y / wh);
+  if (point) v.move([&](ViewCamera& c) { c.focus(*point); });
+}
+
+// Two left presses within this long and this many pixels of each other
+constexpr double kDoubleClickSeconds = 0.4, kDoubleClickPixels = 4.0;
 
 void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   Viewer& v = viewer_of(w);
@@ -73,6 +89,18 @@ void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   } else if (button == GLFW_MOUSE_BUTTON_LEFT) {
     v.orbiting = down;
     if (!down) v.panning = false;
+    if (down) {
+      Clock::time_point now = Clock::now();
+      bool twice = std::chrono::duration<double>(now - v.last_click).count() < kDoubleClickSeconds &&
+                   std::abs(v.x - v.click_x) <= kDoubleClickPixels && std::abs(v.y - v.click_y) <= kDoubleClickPixels;
+      v.last_click = now;
+      v.click_x = v.x;
+      v.click_y = v.y;
+      if (twice) {
+        v.click_x = -1e9;  // a third press starts anew
+        focus_at_cursor(v);
+      }
+    }
   }
 }
 
@@ -109,6 +137,14 @@ std::string printed_options(Viewer& v) {
   if (v.panel.strategy != v.panel.first_strategy)
     text += std::string(" --strategy ") + kStrategyNames[v.panel.strategy].name;
   if (v.panel.max_depth != v.panel.first_max_depth) text += " --max-depth " + std::to_string(v.panel.max_depth);
+  std::string light = kDefaultLightNames[v.panel.default_light].name;
+  if (light != "auto") text += " --default-light " + light;
+  char number[48];
+  std::snprintf(number, sizeof number, " --env-rotation %.9g", double(v.panel.env_rotation));
+  if (v.panel.offer.environment && v.panel.env_rotation != 0.0f) text += number;
+  if (v.panel.variant > 0) text += " --variant " + v.panel.offer.variants[size_t(v.panel.variant - 1)];
+  std::snprintf(number, sizeof number, " --anim-time %.9g", double(v.panel.anim_time));
+  if (v.panel.anim_time_set) text += number;
   return text;
 }
 
@@ -134,6 +170,27 @@ void act(Viewer& v, int key) {
     case GLFW_KEY_F:
       v.move([&](ViewCamera& c) { c.frame_all(aspect); });
       break;
+    case GLFW_KEY_G:
+      focus_at_cursor(v);
+      break;
+    case GLFW_KEY_L: {  // the next --default-light: auto, on, off (the scene loads again)
+      v.panel.default_light = (v.panel.default_light + 1) % int(std::size(kDefaultLightNames));
+      std::string name = kDefaultLightNames[v.panel.default_light].name;
+      v.session->reload([name](RenderArgs& a) { a.default_light = name; });
+      break;
+    }
+    case GLFW_KEY_N:  // denoise when still (where Open Image Denoise loads)
+      v.panel.denoise = v.panel.offer.denoiser && !v.panel.denoise;
+      v.session->set_image(v.panel.image, v.panel.denoise);
+      break;
+    case GLFW_KEY_V: {  // the next image: the beauty, then each AOV the render holds
+      uint32_t images = v.panel.offer.aovs | kVarianceImage, next = 0;
+      for (uint32_t bit = v.panel.image ? v.panel.image << 1 : 1; bit && !next; bit <<= 1)
+        if (images & bit) next = bit;
+      v.panel.image = next;
+      v.session->set_image(next, v.panel.denoise);
+      break;
+    }
     case GLFW_KEY_R:
       v.move([&](ViewCamera& c) { c.reset(); });
       break;
@@ -310,13 +367,17 @@ int run_view(RenderArgs args) {
       glfwShowWindow(window);
       visible = true;
     }
+    if (session.loads() != v.loads) {  // loaded, or loaded again: no frame of the scene as it was
+      v.loads = session.loads();
+      panel_ready(&v.panel);
+      if (v.loads > 1) shown.reset();
+    }
     std::optional<ViewFrame> f = session.take_frame();
     if (f) {
       upload(texture, *f);
       f->rgba.clear();
       shown = std::move(f);
     }
-    if (!v.panel.ready && session.ready()) panel_ready(&v.panel);
     if (visible) {
       draw(window, texture, shown.has_value());
       v.panel.shown = shown ? &*shown : nullptr;

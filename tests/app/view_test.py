@@ -9,12 +9,20 @@
   printed options equals the new screenshot;
 - the S key writes OUT-0001.png (the screenshot's pixels) and OUT-0001.exr (the render's
   linear image at the same spp, means per channel within 0.5 %);
+- L (--default-light auto, on, off) loads the scene again: the printed options, now with
+  --default-light on, given to render equal the window (it prints the time the load took);
+- a double-click on the back wall moves the printed --look-at onto the wall's plane (a face of
+  the box's bounds), --look-from unchanged;
+- V in a view with --aov albedo shows the albedo as `render -o FILE.png:albedo` writes it, then
+  the standard error (grey, its largest white), then the image again; N (where Open Image
+  Denoise loads) the image as `render --denoise` writes it;
 - Escape closes the window: exit 0, with the line timing the frames that followed the drag;
   SIGINT to a second view: exit 0 within 5 s.
 Skipped (77) without Xvfb, xdotool or xwd (scripts/setup.sh installs them), or a candela
 built without GLFW.
 Usage: view_test.py path/to/candela repo_root
 """
+import json
 import os
 import re
 import shutil
@@ -81,6 +89,16 @@ def png_pixels(path):
 
 def exr_rgb(path):
     return oiio.ImageBuf(path).get_pixels(oiio.FLOAT)[:, :, :3].astype(np.float64)
+
+
+def scene_bounds(scene):
+    """The bounds of a glTF's POSITION accessors (min, max: the box's walls for the Cornell box)"""
+    with open(scene) as f:
+        gltf = json.load(f)
+    used = [p['attributes']['POSITION'] for m in gltf['meshes'] for p in m['primitives']]
+    lo = np.min([gltf['accessors'][a]['min'] for a in used], axis=0)
+    hi = np.max([gltf['accessors'][a]['max'] for a in used], axis=0)
+    return lo, hi
 
 
 def same_image(a, b):
@@ -151,10 +169,53 @@ def run_view(candela, scene, device, env, tmp):
     check(timing is not None, 'the view timed the frames after the drag: %s' % (timing.group(0) if timing else err))
 
     # Ctrl-C: exits at once, status 0
-    second = subprocess.Popen([candela, 'view', scene, *common], env=env, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
+    # (with --aov albedo: V shows the albedo AOV as `render -o FILE.png:albedo` writes it)
+    second = subprocess.Popen([candela, 'view', scene, *common, '--aov', 'albedo'], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     window = wait_for_title(env, second, r': %d spp, ' % SPP)
     check(window is not None, 'a second view renders')
+    if window is not None:
+        xdotool(env, 'key', '--window', window, 'Tab')
+        time.sleep(0.3)
+        beauty = xwd_pixels(window, env)
+        xdotool(env, 'key', '--window', window, 'v')
+        albedo, end = beauty, time.time() + 10
+        while time.time() < end and np.array_equal(albedo, beauty):
+            time.sleep(0.2)
+            albedo = xwd_pixels(window, env)
+        check(not same_image(albedo, beauty), 'V changed the window')
+        out = os.path.join(tmp, 'albedo.png')
+        r = subprocess.run([candela, 'render', scene, *common, '-q', '--camera', '0', '--aov', 'albedo', '-o',
+                            out + ':albedo'], capture_output=True, text=True)
+        check(r.returncode == 0 and same_image(albedo, png_pixels(out)),
+              'V shows the albedo AOV as render writes it (%s)' % r.stderr.strip())
+        xdotool(env, 'key', '--window', window, 'v')  # the standard error: grey
+        error, end = albedo, time.time() + 10
+        while time.time() < end and np.array_equal(error, albedo):
+            time.sleep(0.2)
+            error = xwd_pixels(window, env)
+        error = error.astype(int)
+        check(np.all(error[:, :, 0] == error[:, :, 1]) and np.all(error[:, :, 1] == error[:, :, 2]) and
+              error.max() == 255 and error.std() > 5, 'V again shows the standard error in grey')
+        xdotool(env, 'key', '--window', window, 'v')
+        again, end = error, time.time() + 10
+        while time.time() < end and np.array_equal(again, error):
+            time.sleep(0.2)
+            again = xwd_pixels(window, env)
+        check(np.array_equal(again, beauty), 'V once more shows the image again')
+        # N: denoised as render --denoise writes it, where Open Image Denoise loads
+        out = os.path.join(tmp, 'denoised.png')
+        r = subprocess.run([candela, 'render', scene, *common, '-q', '--camera', '0', '--aov', 'albedo', '--denoise',
+                            '-o', out], capture_output=True, text=True)
+        if r.returncode == 0 and 'error' not in r.stderr:
+            xdotool(env, 'key', '--window', window, 'n')
+            denoised, end = again, time.time() + 20
+            while time.time() < end and np.array_equal(denoised, again):
+                time.sleep(0.2)
+                denoised = xwd_pixels(window, env)
+            check(same_image(denoised, png_pixels(out)), 'N shows the image as render --denoise writes it')
+        else:
+            print('note: no Open Image Denoise: %s' % r.stderr.strip())
     second.send_signal(signal.SIGINT)
     try:
         status = second.wait(timeout=5)
@@ -248,6 +309,39 @@ def drive(candela, scene, device, env, tmp, view, out_path, common):
         saved, rendered = exr_rgb(exr).mean(axis=(0, 1)), exr_rgb(os.path.join(tmp, 'moved.exr')).mean(axis=(0, 1))
         check(np.all(np.abs(saved - rendered) <= 0.005 * rendered + 1e-6),
               'the saved EXR matches render at %d spp: means %s vs %s' % (SPP, saved, rendered))
+
+    # L: --default-light on (the scene loads again, the camera kept); the printed options
+    # reproduce the window
+    # (the box is closed: the studio adds nothing)
+    xdotool(env, 'key', '--window', window, 'l')
+    end = time.time() + 60
+    while time.time() < end and 'loaded the scene again' not in open(out_path).read():
+        time.sleep(0.1)
+    loaded = re.search(r'loaded the scene again in ([\d.]+) s', open(out_path).read())
+    check(loaded is not None, 'L loaded the scene again: %s' % (loaded.group(0) if loaded else None))
+    lit = wait_for_title(env, view, done + '.*--look-from', window)
+    relit = printed_camera(env, window, out_path, 3)
+    check(lit is not None and relit is not None and relit[-2:] == ['--default-light', 'on'] and
+          relit[:-2] == moved, 'L: the scene loads again with --default-light on: %s' % relit)
+    on = xwd_pixels(window, env)
+    ref = reference(candela, scene, device, relit or [], os.path.join(tmp, 'lit'))
+    check(same_image(on, ref),
+          'the window equals render with --default-light on (max diff %d)' % np.abs(on.astype(int) - ref).max())
+
+    # A double-click: the pivot (--look-at) moves to the surface point under the cursor, the
+    # camera stays where it is (--look-from)
+    xdotool(env, 'mousemove', '--window', window, '40', '40', 'click', '--repeat', '2', '--delay', '80', '1')
+    time.sleep(0.3)
+    focused = printed_camera(env, window, out_path, 4)
+    check(focused is not None and moved is not None and focused[focused.index('--look-from') + 1] ==
+          moved[moved.index('--look-from') + 1] and focused[focused.index('--look-at') + 1] !=
+          moved[moved.index('--look-at') + 1], 'the double-click moved the pivot, not the camera: %s' % focused)
+    if focused is not None:
+        at = np.array([float(x) for x in focused[focused.index('--look-at') + 1].split(',')])
+        lo, hi = scene_bounds(scene)
+        gap = np.minimum(np.abs(at - lo), np.abs(at - hi))
+        check(np.all(at >= lo - 1e-4) and np.all(at <= hi + 1e-4) and gap.min() < 1e-4 * np.abs(hi - lo).max(),
+              'the new pivot %s lies on a wall of the box (bounds %s..%s)' % (at, lo, hi))
 
     xdotool(env, 'key', '--window', window, 'Escape')
     try:
