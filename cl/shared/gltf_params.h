@@ -102,7 +102,8 @@ enum { GLTF_TEXTURES(GLTF_TEXTURE_ID) TEX_SLOTS };
 #undef GLTF_TEXTURE_ID
 
 // Each parameter's first word in GltfMaterial (GLTF_WORD_name), and the words they take
-#define GLTF_PARAM_WORD(_, name, n, ...) GLTF_WORD_##name, GLTF_LAST_WORD_##name = GLTF_WORD_##name + (n)-1,
+#define GLTF_PARAM_WORD(_, name, n, value, lo, hi, extension, key, slot, load, feature, role) \
+  GLTF_WORD_##name, GLTF_LAST_WORD_##name = GLTF_WORD_##name + (n)-1,
 enum { GLTF_PARAMS(GLTF_PARAM_WORD) GLTF_PARAM_WORDS };
 #undef GLTF_PARAM_WORD
 #define GLTF_MATERIAL_BYTES (4 * (GLTF_PARAM_WORDS + 4 - GLTF_PARAM_WORDS % 4))
@@ -111,7 +112,7 @@ enum { GLTF_PARAMS(GLTF_PARAM_WORD) GLTF_PARAM_WORDS };
 // texture slots
 #define GLTF_DECLARE_1(name) float name;
 #define GLTF_DECLARE_3(name) float name[3];
-#define GLTF_DECLARE_PARAM(_, name, n, ...) GLTF_DECLARE_##n(name)
+#define GLTF_DECLARE_PARAM(_, name, n, value, lo, hi, extension, key, slot, load, feature, role) GLTF_DECLARE_##n(name)
 typedef struct {
   GLTF_PARAMS(GLTF_DECLARE_PARAM)
   float pad[4 - GLTF_PARAM_WORDS % 4];
@@ -119,7 +120,8 @@ typedef struct {
 #undef GLTF_DECLARE_PARAM
 
 // Its layout asserts (CD_LAYOUT): its size and each parameter's offset
-#define GLTF_LAYOUT_FIELD(FIELD, name, n, ...) FIELD(GltfMaterial, name, 4 * GLTF_WORD_##name)
+#define GLTF_LAYOUT_FIELD(FIELD, name, n, value, lo, hi, extension, key, slot, load, feature, role) \
+  FIELD(GltfMaterial, name, 4 * GLTF_WORD_##name)
 #define GLTF_MATERIAL_LAYOUT(SIZE, FIELD) \
   SIZE(GltfMaterial, GLTF_MATERIAL_BYTES) GLTF_PARAM_LIST(GLTF_LAYOUT_FIELD, FIELD)
 

@@ -389,7 +389,9 @@ TEST(Iridescence, GlassSplitsByTheFilm) {
         want[c] = k.thin ? 2.0 * f / (1.0 + f) : f;
         share += want[c] / 3.0;
       }
-      if (k.ior == 1.0) EXPECT_GT(want[2], 0.05) << "the film reflects where the bare base would not";
+      if (k.ior == 1.0) {
+        EXPECT_GT(want[2], 0.05) << "the film reflects where the bare base would not";
+      }
       std::vector<cl_float4> s = sample(r, p.program, t, m, 0u, wo, n, 11u);
       size_t reflected = 0;
       for (size_t i = 0; i < n; ++i) {
